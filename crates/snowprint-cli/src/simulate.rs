@@ -1,0 +1,136 @@
+//! `snowprint simulate`: run a scene file and dump each surface's heightmap.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use snowprint::scene::{Scene, SceneShape};
+use snowprint::{Deformer, GpuContext, GpuOptions, Shape, SnowWorld, WorldConfig};
+
+/// The scene `make demo` runs when given no other.
+pub const DEMO_SCENE: &str = include_str!("../../../scenes/walker.toml");
+
+/// Run `scene` for `frames` frames of `dt` seconds and write `<surface>.png` and `<surface>.json`
+/// into `dump`. Files appear only when the whole run succeeded.
+pub fn run(gpu: &GpuOptions, scene: &Path, frames: u32, dt: f32, dump: &Path) -> Result<(), String> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(format!("--dt {dt} is not usable; give a finite number of seconds above 0, such as 0.0166"));
+    }
+    let scene = Scene::load(scene).map_err(|e| e.to_string())?;
+    simulate(gpu, &scene, frames, dt, dump)
+}
+
+/// Run the built-in walker scene into `out`.
+pub fn demo(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), String> {
+    let scene = Scene::parse(DEMO_SCENE, Path::new("scenes/walker.toml")).map_err(|e| e.to_string())?;
+    let dt = 1.0 / 60.0;
+    let frames = frames.unwrap_or(((scene.duration() / dt).ceil() as u32).max(1) + 30);
+    simulate(gpu, &scene, frames, dt, out)?;
+    eprintln!("snowprint: wrote the heightmaps of {} surface(s) to {}", scene.surfaces.len(), out.display());
+    Ok(())
+}
+
+fn simulate(gpu: &GpuOptions, scene: &Scene, frames: u32, dt: f32, dump: &Path) -> Result<(), String> {
+    let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
+    let pool: u64 = scene
+        .surfaces
+        .iter()
+        .map(|s| snowprint::pool::slot_bytes(s.layout().texels()))
+        .sum();
+    let mut world = SnowWorld::new(
+        &ctx,
+        WorldConfig {
+            capture: scene.capture,
+            pool_bytes: pool.max(1 << 20),
+            ..Default::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let mut ids = Vec::new();
+    for s in &scene.surfaces {
+        ids.push(world.add_surface(s.clone()).map_err(|e| e.to_string())?);
+    }
+    let mut shapes = Vec::new();
+    for d in &scene.deformers {
+        shapes.push(match &d.shape {
+            SceneShape::Sphere { radius } => Shape::Sphere { radius: *radius },
+            SceneShape::Capsule { radius, half_height } => Shape::Capsule {
+                radius: *radius,
+                half_height: *half_height,
+            },
+            SceneShape::Box { half_extents } => Shape::Box {
+                half_extents: *half_extents,
+            },
+            SceneShape::Mesh { mesh, .. } => Shape::Mesh(world.add_mesh(&d.name, mesh).map_err(|e| e.to_string())?),
+        });
+    }
+
+    let bar = ProgressBar::new(frames as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} simulate [{bar:30}] {pos}/{len} frames {elapsed}")
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+    );
+    for f in 1..=frames {
+        let t = f as f32 * dt;
+        let deformers: Vec<Deformer> = scene
+            .deformers
+            .iter()
+            .zip(&shapes)
+            .map(|(d, &shape)| Deformer::moving(shape, d.pose_at(t - dt), d.pose_at(t)))
+            .collect();
+        world.step(dt, &deformers).map_err(|e| e.to_string())?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    // Write everything into a fresh folder beside the destination, then move the files in: an
+    // error leaves no output that looks complete.
+    std::fs::create_dir_all(dump).map_err(|e| format!("cannot create the dump folder {}: {e}", dump.display()))?;
+    let staging = dump.join(format!(".snowprint-partial-{}", std::process::id()));
+    let result = write_dump(&world, scene, &ids, frames, dt, &staging, dump);
+    let _ = std::fs::remove_dir_all(&staging);
+    result
+}
+
+fn write_dump(
+    world: &SnowWorld,
+    scene: &Scene,
+    ids: &[snowprint::SurfaceId],
+    frames: u32,
+    dt: f32,
+    staging: &Path,
+    dump: &Path,
+) -> Result<(), String> {
+    std::fs::create_dir_all(staging).map_err(|e| format!("cannot write into {}: {e}", dump.display()))?;
+    let mut files: Vec<PathBuf> = Vec::new();
+    for (desc, &id) in scene.surfaces.iter().zip(ids) {
+        let map = world.read_heightmap(id).map_err(|e| e.to_string())?;
+        let png = staging.join(format!("{}.png", desc.name));
+        map.save_png(&png).map_err(|e| e.to_string())?;
+        let layout = desc.layout();
+        let meta = serde_json::json!({
+            "name": desc.name,
+            "resolution": [layout.width, layout.height],
+            "texel_size": [desc.size.x / layout.width as f32, desc.size.y / layout.height as f32],
+            "center": desc.center.to_array(),
+            "size": desc.size.to_array(),
+            "yaw_degrees": desc.yaw_degrees,
+            "snow_depth": desc.snow_depth,
+            "replenish_rate": desc.replenish_rate,
+            "frames": frames,
+            "dt": dt,
+            "png": "16-bit greyscale depression: 0 = untouched, 65535 = pressed to the ground; column 0 = smallest x, row 0 = smallest z, before yaw",
+        });
+        let json = staging.join(format!("{}.json", desc.name));
+        let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
+        std::fs::write(&json, text + "\n").map_err(|e| format!("cannot write {}: {e}", json.display()))?;
+        files.push(png);
+        files.push(json);
+    }
+    for f in files {
+        let name = f.file_name().ok_or("internal: staged file without a name")?;
+        let dest = dump.join(name);
+        std::fs::rename(&f, &dest).map_err(|e| format!("cannot move {} into place: {e}", dest.display()))?;
+    }
+    Ok(())
+}

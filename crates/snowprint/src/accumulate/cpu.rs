@@ -1,0 +1,192 @@
+//! CPU references of the accumulation passes: the same maths, in the same order, as the WGSL.
+
+use glam::Vec3;
+
+use crate::world::CaptureMode;
+
+/// Tap offsets of the blur, texels. Must match `TAPS` in `blur.wgsl`.
+pub const TAPS: [[f32; 2]; 4] = [[-0.25, -0.75], [0.75, -0.25], [0.25, 0.75], [-0.75, 0.25]];
+/// Depression units: 65535 = pressed to the ground.
+pub const UNITS: f32 = 65535.0;
+
+/// Settings the blur needs from a surface.
+#[derive(Clone, Copy, Debug)]
+pub struct BlurInput {
+    /// Texels along x.
+    pub width: u32,
+    /// Texels along z.
+    pub height: u32,
+    /// Depth or mask.
+    pub mode: CaptureMode,
+    /// Mask imprint, fraction of snow depth.
+    pub mask_fraction: f32,
+    /// Snow depth, metres.
+    pub snow_depth: f32,
+    /// Snow depth plus ankle height, metres.
+    pub frustum_height: f32,
+}
+
+fn depression(inp: &BlurInput, capture: &[f32], x: i32, y: i32) -> f32 {
+    let cx = x.clamp(0, inp.width as i32 - 1) as usize;
+    let cy = y.clamp(0, inp.height as i32 - 1) as usize;
+    let z = capture[cy * inp.width as usize + cx];
+    if inp.mode == CaptureMode::Mask {
+        return if z < 1.0 { inp.mask_fraction } else { 0.0 };
+    }
+    let h = z * inp.frustum_height;
+    ((inp.snow_depth - h) / inp.snow_depth).clamp(0.0, 1.0)
+}
+
+fn bilinear(inp: &BlurInput, capture: &[f32], px: f32, py: f32) -> f32 {
+    let (qx, qy) = (px - 0.5, py - 0.5);
+    let (bx, by) = (qx.floor(), qy.floor());
+    let (fx, fy) = (qx - bx, qy - by);
+    let (ix, iy) = (bx as i32, by as i32);
+    let a = depression(inp, capture, ix, iy);
+    let b = depression(inp, capture, ix + 1, iy);
+    let c = depression(inp, capture, ix, iy + 1);
+    let d = depression(inp, capture, ix + 1, iy + 1);
+    let top = a * (1.0 - fx) + b * fx;
+    let bottom = c * (1.0 - fx) + d * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// Stage 1: depression of a capture (depths, 1 = nothing) blurred by the 4-tap bilinear Poisson
+/// kernel.
+pub fn blur(inp: &BlurInput, capture: &[f32]) -> Vec<f32> {
+    let mut out = Vec::with_capacity(capture.len());
+    for y in 0..inp.height {
+        for x in 0..inp.width {
+            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+            let mut sum = 0.0;
+            for t in TAPS {
+                sum += bilinear(inp, capture, px + t[0], py + t[1]);
+            }
+            out.push(sum * 0.25);
+        }
+    }
+    out
+}
+
+/// The unblurred depression of a capture (used by analytic tests).
+pub fn depression_of(inp: &BlurInput, capture: &[f32]) -> Vec<f32> {
+    (0..inp.height as i32)
+        .flat_map(|y| (0..inp.width as i32).map(move |x| (x, y)))
+        .map(|(x, y)| depression(inp, capture, x, y))
+        .collect()
+}
+
+/// Quantize a depression fraction to units the way `merge.wgsl` does.
+pub fn to_units(d: f32) -> u32 {
+    (d.clamp(0.0, 1.0) * UNITS + 0.5).floor() as u32
+}
+
+/// Stage 2: replenish `old` by `replenish_units`, then deepen it by the blurred capture (when there
+/// is one). Texels pack the depression in the low 16 bits and displaced snow in the high 16.
+pub fn merge(old: &[u32], blurred: Option<&[f32]>, replenish_units: u32) -> Vec<u32> {
+    old.iter()
+        .enumerate()
+        .map(|(i, &o)| {
+            let depressed = (o & 0xffff).max(replenish_units) - replenish_units;
+            let displaced = (o >> 16).max(replenish_units) - replenish_units;
+            let captured = blurred.map_or(0, |b| to_units(b[i]));
+            let new_depressed = depressed.max(captured);
+            let pushed = new_depressed - depressed;
+            let new_displaced = (displaced + pushed).min(0xffff);
+            new_depressed | (new_displaced << 16)
+        })
+        .collect()
+}
+
+/// WGSL's `pack2x16snorm`.
+pub fn pack2x16snorm(a: f32, b: f32) -> u32 {
+    let q = |v: f32| ((0.5 + 32767.0 * v.clamp(-1.0, 1.0)).floor() as i32 as i16) as u16 as u32;
+    q(a) | (q(b) << 16)
+}
+
+/// WGSL's `unpack2x16snorm`.
+pub fn unpack2x16snorm(v: u32) -> (f32, f32) {
+    let q = |bits: u32| ((bits as u16 as i16) as f32 / 32767.0).max(-1.0);
+    (q(v & 0xffff), q(v >> 16))
+}
+
+/// A normal from its packed `x` and `z` (y from unit length).
+pub fn unpack_normal(v: u32) -> Vec3 {
+    let (x, z) = unpack2x16snorm(v);
+    Vec3::new(x, (1.0 - x * x - z * z).max(0.0).sqrt(), z)
+}
+
+/// Normals of the snow top of packed heights, packed as `normals.wgsl` packs them.
+pub fn normals(heights: &[u32], width: u32, height: u32, snow_depth: f32, texel_x: f32, texel_z: f32) -> Vec<u32> {
+    let h = |x: i32, y: i32| {
+        let cx = x.clamp(0, width as i32 - 1) as usize;
+        let cy = y.clamp(0, height as i32 - 1) as usize;
+        -((heights[cy * width as usize + cx] & 0xffff) as f32) / UNITS * snow_depth
+    };
+    let mut out = Vec::with_capacity(heights.len());
+    for y in 0..height as i32 {
+        for x in 0..width as i32 {
+            let dhdx = (h(x + 1, y) - h(x - 1, y)) / (2.0 * texel_x);
+            let dhdz = (h(x, y + 1) - h(x, y - 1)) / (2.0 * texel_z);
+            let n = Vec3::new(-dhdx, 1.0, -dhdz).normalize();
+            out.push(pack2x16snorm(n.x, n.z));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blur_preserves_constants_and_spreads_one_texel() {
+        let inp = BlurInput {
+            width: 9,
+            height: 7,
+            mode: CaptureMode::Depth,
+            mask_fraction: 1.0,
+            snow_depth: 0.3,
+            frustum_height: 0.55,
+        };
+        // Ground everywhere: depression 1, blurred 1.
+        let flat = vec![0.0; 63];
+        assert!(blur(&inp, &flat).iter().all(|&v| (v - 1.0).abs() < 1e-6));
+        // One pressed texel in the middle: the blur keeps its mass and spreads it over the 3x3
+        // neighbourhood only.
+        let mut one = vec![1.0; 63];
+        one[3 * 9 + 4] = 0.0;
+        let b = blur(&inp, &one);
+        let total: f32 = b.iter().sum();
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
+        for y in 0..7 {
+            for x in 0..9 {
+                if (x as i32 - 4).abs() > 1 || (y as i32 - 3).abs() > 1 {
+                    assert_eq!(b[y * 9 + x], 0.0);
+                }
+            }
+        }
+        // Centre keeps 4 taps x 9/16 / 4 = 9/16.
+        assert!((b[3 * 9 + 4] - 9.0 / 16.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn merge_never_shallower_and_replenishes() {
+        let old = [1000u32, 500, 0];
+        let blurred = [0.0, 0.5, 0.01];
+        let m = merge(&old, Some(&blurred), 100);
+        assert_eq!(m[0] & 0xffff, 900);
+        assert_eq!(m[1] & 0xffff, to_units(0.5));
+        assert_eq!(m[1] >> 16, to_units(0.5) - 400);
+        assert_eq!(m[2] & 0xffff, to_units(0.01));
+        // Replenishment saturates at untouched snow.
+        assert_eq!(merge(&[50], None, 100), vec![0]);
+    }
+
+    #[test]
+    fn snorm_round_trip() {
+        let v = pack2x16snorm(-0.5, 1.0);
+        let (a, b) = unpack2x16snorm(v);
+        assert!((a + 0.5).abs() < 1e-4 && (b - 1.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,187 @@
+//! The accumulation chain of the talk, one WGSL pass per stage, each dispatched once per frame over
+//! every surface updated in it (`z` of the dispatch is the surface's record):
+//!
+//! 1. [`blur.wgsl`](BLUR_SHADER): capture to depression, 4-tap bilinear Poisson blur
+//!    (reads the capture atlas, writes the scratch buffer);
+//! 2. [`merge.wgsl`](MERGE_SHADER): replenish the history, then deepen it by the blurred capture
+//!    (reads one half of each slot's ping-pong pair and the scratch, writes the other half);
+//! 3. [`normals.wgsl`](NORMALS_SHADER): normals of the new snow top (reads the new half, writes
+//!    the normals region).
+//!
+//! CPU reference: [`cpu`].
+
+pub mod cpu;
+
+use bytemuck::{Pod, Zeroable};
+
+/// Record layout shared by every pass.
+pub const SHARED: &str = include_str!("../shared.wgsl");
+/// Stage 1 (without the shared prelude).
+pub const BLUR_SHADER: &str = include_str!("blur.wgsl");
+/// Stage 2 (without the shared prelude).
+pub const MERGE_SHADER: &str = include_str!("merge.wgsl");
+/// Normals (without the shared prelude).
+pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
+
+/// Workgroup side of every accumulation pass.
+pub const WORKGROUP: u32 = 8;
+
+/// Uniform of the blur pass: which capture batch it reads. Must match `BlurParams` in `blur.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BlurParams {
+    /// Capture batch.
+    pub batch: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// The shader source of a stage with the shared prelude, as compiled.
+pub fn with_prelude(stage: &str) -> String {
+    format!("{SHARED}\n{stage}")
+}
+
+/// The three compute pipelines and their layouts.
+pub struct AccumulatePipelines {
+    /// Stage 1.
+    pub blur: wgpu::ComputePipeline,
+    /// Stage 2.
+    pub merge: wgpu::ComputePipeline,
+    /// Normals.
+    pub normals: wgpu::ComputePipeline,
+    /// Layout of the blur's group 0.
+    pub blur_layout: wgpu::BindGroupLayout,
+    /// Layout of the merge's group 0.
+    pub merge_layout: wgpu::BindGroupLayout,
+    /// Layout of the normals' group 0.
+    pub normals_layout: wgpu::BindGroupLayout,
+}
+
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl AccumulatePipelines {
+    /// Compile the three passes.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("blur"),
+            entries: &[
+                storage(0, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                storage(2, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("merge"),
+            entries: &[storage(0, true), storage(1, true), storage(2, false)],
+        });
+        let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("normals"),
+            entries: &[storage(0, true), storage(1, false)],
+        });
+        let make = |name: &str, src: &str, layout: &wgpu::BindGroupLayout| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(with_prelude(src).into()),
+            });
+            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(name),
+                bind_group_layouts: &[Some(layout)],
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some(name),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self {
+            blur: make("blur", BLUR_SHADER, &blur_layout),
+            merge: make("merge", MERGE_SHADER, &merge_layout),
+            normals: make("normals", NORMALS_SHADER, &normals_layout),
+            blur_layout,
+            merge_layout,
+            normals_layout,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every shader parses and validates with naga, so a broken shader fails `cargo test`.
+    #[test]
+    fn shaders_validate() {
+        for (name, src) in [
+            ("blur", with_prelude(BLUR_SHADER)),
+            ("merge", with_prelude(MERGE_SHADER)),
+            ("normals", with_prelude(NORMALS_SHADER)),
+            ("capture", crate::capture::SHADER.to_owned()),
+        ] {
+            let module = naga::front::wgsl::parse_str(&src)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                .validate(&module)
+                .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        }
+    }
+
+    /// The Rust record and the WGSL record have the same size and field offsets.
+    #[test]
+    fn record_layout_matches_wgsl() {
+        let src = with_prelude(MERGE_SHADER);
+        let module = naga::front::wgsl::parse_str(&src).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let (handle, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("SurfaceRecord"))
+            .unwrap();
+        let naga::TypeInner::Struct { members, .. } = &ty.inner else { panic!() };
+        assert_eq!(layouter[handle].size as usize, std::mem::size_of::<crate::pool::SurfaceRecord>());
+        let names: Vec<_> = members.iter().map(|m| (m.name.clone().unwrap(), m.offset)).collect();
+        let expect = [
+            "heights_read", "heights_write", "normals", "scratch", "width", "height", "atlas_x",
+            "atlas_y", "mode", "replenish_units", "batch", "mask_fraction", "snow_depth",
+            "frustum_height", "texel_x", "texel_z",
+        ];
+        for (i, (name, offset)) in names.iter().enumerate() {
+            assert_eq!(name, expect[i]);
+            assert_eq!(*offset as usize, i * 4);
+        }
+    }
+}

@@ -1,0 +1,205 @@
+// Capture from below: renders deformers into a depth target through an orthographic frustum whose
+// near plane is the ground under the snow and whose far plane is the snow top plus an ankle height.
+// Depth 0 = ground, 1 = top of the frustum; the depth test keeps the lowest point per texel.
+//
+// Reads: `view` (one per surface, dynamic offset), `prims` (analytic deformers in surface-local
+// coordinates), mesh vertex buffers and `draw` (mesh-to-surface-local transform, dynamic offset).
+// Writes: the capture atlas's depth, inside the viewport of the surface.
+
+struct CaptureView {
+    half_size: vec2<f32>,   // half the surface's sides, metres
+    frustum_height: f32,    // metres
+    _pad: f32,
+}
+// Must match `CaptureView` in capture/mod.rs.
+
+struct Primitive {
+    // kind.x: 0 = capsule (a sphere is a capsule with a == b), 1 = box.
+    kind: vec4<u32>,
+    // capsule: p0 = segment start (xyz) and radius (w), p1 = segment end.
+    // box: p0 = centre, p1/p2/p3 = unit axes (xyz) and half extents (w).
+    p0: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+    p3: vec4<f32>,
+}
+// Must match `GpuPrimitive` in capture/mod.rs.
+
+@group(0) @binding(0) var<uniform> view: CaptureView;
+@group(0) @binding(1) var<storage, read> prims: array<Primitive>;
+
+const BIG: f32 = 1e30;
+
+struct PrimOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) local_xz: vec2<f32>,
+    @location(1) @interpolate(flat) index: u32,
+}
+
+fn to_clip(local_xz: vec2<f32>, depth: f32) -> vec4<f32> {
+    // Column 0 is the smallest x and row 0 the smallest z: NDC y is +1 at row 0.
+    return vec4<f32>(local_xz.x / view.half_size.x, -local_xz.y / view.half_size.y, depth, 1.0);
+}
+
+@vertex
+fn vs_prim(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> PrimOut {
+    let p = prims[ii];
+    var lo: vec2<f32>;
+    var hi: vec2<f32>;
+    if p.kind.x == 0u {
+        let r = p.p0.w;
+        lo = min(p.p0.xz, p.p1.xz) - vec2<f32>(r);
+        hi = max(p.p0.xz, p.p1.xz) + vec2<f32>(r);
+    } else {
+        let e = abs(p.p1.xz) * p.p1.w + abs(p.p2.xz) * p.p2.w + abs(p.p3.xz) * p.p3.w;
+        lo = p.p0.xz - e;
+        hi = p.p0.xz + e;
+    }
+    // Two triangles covering the footprint's bounding rectangle.
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),
+        vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+    );
+    let xz = mix(lo, hi, corners[vi]);
+    var out: PrimOut;
+    out.clip = to_clip(xz, 0.5);
+    out.local_xz = xz;
+    out.index = ii;
+    return out;
+}
+
+fn sphere_interval(c: vec3<f32>, r: f32, x: f32, z: f32) -> vec2<f32> {
+    let dx = x - c.x;
+    let dz = z - c.z;
+    let s2 = r * r - dx * dx - dz * dz;
+    if s2 < 0.0 {
+        return vec2<f32>(BIG, -BIG);
+    }
+    let s = sqrt(s2);
+    return vec2<f32>(c.y - s, c.y + s);
+}
+
+// Heights where the vertical line through (x, z) is inside the capsule (empty when x > y).
+fn capsule_interval(a: vec3<f32>, b: vec3<f32>, r: f32, x: f32, z: f32) -> vec2<f32> {
+    let ia = sphere_interval(a, r, x, z);
+    let ib = sphere_interval(b, r, x, z);
+    var iv = vec2<f32>(min(ia.x, ib.x), max(ia.y, ib.y));
+    let ab = b - a;
+    let len = length(ab);
+    if len > 1e-6 {
+        let u = ab / len;
+        let w = vec3<f32>(x, 0.0, z) - a;
+        let wu = dot(w, u);
+        let e_perp = vec3<f32>(0.0, 1.0, 0.0) - u.y * u;
+        let w_perp = w - wu * u;
+        let qa = dot(e_perp, e_perp);
+        if qa > 1e-6 {
+            let qb = dot(e_perp, w_perp);
+            let qc = dot(w_perp, w_perp) - r * r;
+            let disc = qb * qb - qa * qc;
+            if disc >= 0.0 {
+                let sq = sqrt(disc);
+                var y0 = (-qb - sq) / qa;
+                var y1 = (-qb + sq) / qa;
+                if abs(u.y) > 1e-6 {
+                    let ya = -wu / u.y;
+                    let yb = (len - wu) / u.y;
+                    y0 = max(y0, min(ya, yb));
+                    y1 = min(y1, max(ya, yb));
+                } else if wu < 0.0 || wu > len {
+                    y0 = BIG;
+                    y1 = -BIG;
+                }
+                if y0 <= y1 {
+                    iv = vec2<f32>(min(iv.x, y0), max(iv.y, y1));
+                }
+            }
+        }
+    }
+    return iv;
+}
+
+fn box_interval(c: vec3<f32>, ax: vec4<f32>, ay: vec4<f32>, az: vec4<f32>, x: f32, z: f32) -> vec2<f32> {
+    let o = vec3<f32>(x, 0.0, z) - c;
+    var lo = -BIG;
+    var hi = BIG;
+    var axes = array<vec4<f32>, 3>(ax, ay, az);
+    for (var i = 0; i < 3; i++) {
+        let axis = axes[i];
+        let oi = dot(o, axis.xyz);
+        let ei = axis.y;
+        let h = axis.w;
+        if abs(ei) < 1e-7 {
+            if abs(oi) > h {
+                return vec2<f32>(BIG, -BIG);
+            }
+        } else {
+            let t1 = (-h - oi) / ei;
+            let t2 = (h - oi) / ei;
+            lo = max(lo, min(t1, t2));
+            hi = min(hi, max(t1, t2));
+        }
+    }
+    return vec2<f32>(lo, hi);
+}
+
+struct DepthOut {
+    @builtin(frag_depth) depth: f32,
+}
+
+@fragment
+fn fs_prim(in: PrimOut) -> DepthOut {
+    let p = prims[in.index];
+    var iv: vec2<f32>;
+    if p.kind.x == 0u {
+        iv = capsule_interval(p.p0.xyz, p.p1.xyz, p.p0.w, in.local_xz.x, in.local_xz.y);
+    } else {
+        iv = box_interval(p.p0.xyz, p.p1, p.p2, p.p3, in.local_xz.x, in.local_xz.y);
+    }
+    // Keep only the part inside the frustum: a solid reaching below the ground is clamped to the
+    // ground, one entirely below it or above the frustum leaves nothing.
+    if iv.x > iv.y || iv.y < 0.0 || iv.x >= view.frustum_height {
+        discard;
+    }
+    var out: DepthOut;
+    out.depth = max(iv.x, 0.0) / view.frustum_height;
+    return out;
+}
+
+struct MeshDraw {
+    to_local: mat4x4<f32>,
+}
+// Must match `MeshDraw` in capture/mod.rs.
+
+@group(1) @binding(0) var<uniform> draw: MeshDraw;
+
+struct MeshOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) height: f32,
+}
+
+@vertex
+fn vs_mesh(@location(0) position: vec3<f32>) -> MeshOut {
+    let local = draw.to_local * vec4<f32>(position, 1.0);
+    var out: MeshOut;
+    // Linear depth: the near plane (depth 0) is the ground, the far plane the frustum top. The
+    // rasterizer clips what lies outside.
+    out.clip = to_clip(local.xz, local.y / view.frustum_height);
+    out.height = local.y;
+    return out;
+}
+
+@fragment
+fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> DepthOut {
+    var out: DepthOut;
+    // Seen from below, the first surface of a closed solid is a face turned towards the camera.
+    // Seeing a face turned away means the near plane cut the solid open: the solid fills the
+    // ground here, so this texel is pressed to the ground (depth clamping; the far side of the
+    // clipped mesh must never leak through).
+    if front {
+        out.depth = clamp(in.height / view.frustum_height, 0.0, 1.0);
+    } else {
+        out.depth = 0.0;
+    }
+    return out;
+}

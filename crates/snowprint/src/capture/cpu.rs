@@ -1,0 +1,208 @@
+//! CPU reference of the capture: the same maths as `capture.wgsl`, evaluated at every texel centre.
+//! Depth 0 is the ground, 1 the top of the frustum; 1 also means "nothing captured" (the clear value).
+
+use glam::{Vec2, Vec3, Vec3Swizzles};
+
+use super::{GpuPrimitive, PRIM_CAPSULE};
+
+const BIG: f32 = 1e30;
+
+/// Local `(x, z)` of the centre of texel `(column, row)`.
+pub fn texel_center(column: u32, row: u32, width: u32, height: u32, half_size: Vec2) -> Vec2 {
+    Vec2::new(
+        -half_size.x + (column as f32 + 0.5) / width as f32 * 2.0 * half_size.x,
+        -half_size.y + (row as f32 + 0.5) / height as f32 * 2.0 * half_size.y,
+    )
+}
+
+fn sphere_interval(c: Vec3, r: f32, x: f32, z: f32) -> (f32, f32) {
+    let (dx, dz) = (x - c.x, z - c.z);
+    let s2 = r * r - dx * dx - dz * dz;
+    if s2 < 0.0 {
+        return (BIG, -BIG);
+    }
+    let s = s2.sqrt();
+    (c.y - s, c.y + s)
+}
+
+/// Heights where the vertical line through `(x, z)` is inside the capsule; empty when `lo > hi`.
+pub fn capsule_interval(a: Vec3, b: Vec3, r: f32, x: f32, z: f32) -> (f32, f32) {
+    let ia = sphere_interval(a, r, x, z);
+    let ib = sphere_interval(b, r, x, z);
+    let mut iv = (ia.0.min(ib.0), ia.1.max(ib.1));
+    let ab = b - a;
+    let len = ab.length();
+    if len > 1e-6 {
+        let u = ab / len;
+        let w = Vec3::new(x, 0.0, z) - a;
+        let wu = w.dot(u);
+        let e_perp = Vec3::Y - u.y * u;
+        let w_perp = w - wu * u;
+        let qa = e_perp.dot(e_perp);
+        if qa > 1e-6 {
+            let qb = e_perp.dot(w_perp);
+            let qc = w_perp.dot(w_perp) - r * r;
+            let disc = qb * qb - qa * qc;
+            if disc >= 0.0 {
+                let sq = disc.sqrt();
+                let (mut y0, mut y1) = ((-qb - sq) / qa, (-qb + sq) / qa);
+                if u.y.abs() > 1e-6 {
+                    let ya = -wu / u.y;
+                    let yb = (len - wu) / u.y;
+                    y0 = y0.max(ya.min(yb));
+                    y1 = y1.min(ya.max(yb));
+                } else if wu < 0.0 || wu > len {
+                    (y0, y1) = (BIG, -BIG);
+                }
+                if y0 <= y1 {
+                    iv = (iv.0.min(y0), iv.1.max(y1));
+                }
+            }
+        }
+    }
+    iv
+}
+
+/// Heights where the vertical line through `(x, z)` is inside the box; empty when `lo > hi`.
+pub fn box_interval(p: &GpuPrimitive, x: f32, z: f32) -> (f32, f32) {
+    let c = Vec3::from_slice(&p.p0[..3]);
+    let o = Vec3::new(x, 0.0, z) - c;
+    let (mut lo, mut hi) = (-BIG, BIG);
+    for axis in [p.p1, p.p2, p.p3] {
+        let a = Vec3::from_slice(&axis[..3]);
+        let (oi, ei, h) = (o.dot(a), a.y, axis[3]);
+        if ei.abs() < 1e-7 {
+            if oi.abs() > h {
+                return (BIG, -BIG);
+            }
+        } else {
+            let (t1, t2) = ((-h - oi) / ei, (h - oi) / ei);
+            lo = lo.max(t1.min(t2));
+            hi = hi.min(t1.max(t2));
+        }
+    }
+    (lo, hi)
+}
+
+/// Depth one primitive leaves at local `(x, z)`, or `None` where it leaves nothing.
+pub fn primitive_depth(p: &GpuPrimitive, x: f32, z: f32, frustum_height: f32) -> Option<f32> {
+    let (lo, hi) = if p.kind[0] == PRIM_CAPSULE {
+        capsule_interval(
+            Vec3::from_slice(&p.p0[..3]),
+            Vec3::from_slice(&p.p1[..3]),
+            p.p0[3],
+            x,
+            z,
+        )
+    } else {
+        box_interval(p, x, z)
+    };
+    if lo > hi || hi < 0.0 || lo >= frustum_height {
+        return None;
+    }
+    Some(lo.max(0.0) / frustum_height)
+}
+
+/// A triangle in surface-local coordinates, counter-clockwise seen from outside its solid.
+pub type LocalTriangle = [Vec3; 3];
+
+/// Depth a triangle leaves at local `(x, z)`, as the rasterizer would: the part inside the frustum
+/// only; a face turned away from the camera (up) marks the inside of a solid cut open by the ground
+/// and gives depth 0.
+pub fn triangle_depth(t: &LocalTriangle, x: f32, z: f32, frustum_height: f32) -> Option<f32> {
+    let [a, b, c] = *t;
+    let p = Vec2::new(x, z);
+    let (a2, b2, c2) = (a.xz(), b.xz(), c.xz());
+    let area = (b2 - a2).perp_dot(c2 - a2);
+    if area.abs() < 1e-12 {
+        return None;
+    }
+    let w0 = (c2 - b2).perp_dot(p - b2) / area;
+    let w1 = (a2 - c2).perp_dot(p - c2) / area;
+    let w2 = 1.0 - w0 - w1;
+    if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+        return None;
+    }
+    let y = w0 * a.y + w1 * b.y + w2 * c.y;
+    if !(0.0..=frustum_height).contains(&y) {
+        return None;
+    }
+    let normal_y = (b - a).cross(c - a).y;
+    Some(if normal_y < 0.0 { y / frustum_height } else { 0.0 })
+}
+
+/// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen.
+pub fn capture(
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+    frustum_height: f32,
+    primitives: &[GpuPrimitive],
+    triangles: &[LocalTriangle],
+) -> Vec<f32> {
+    let mut out = vec![1.0f32; (width * height) as usize];
+    for row in 0..height {
+        for col in 0..width {
+            let c = texel_center(col, row, width, height, half_size);
+            let mut d = 1.0f32;
+            for p in primitives {
+                if let Some(v) = primitive_depth(p, c.x, c.y, frustum_height) {
+                    d = d.min(v);
+                }
+            }
+            for t in triangles {
+                if let Some(v) = triangle_depth(t, c.x, c.y, frustum_height) {
+                    d = d.min(v);
+                }
+            }
+            out[(row * width + col) as usize] = d;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn capsule_matches_sphere_when_degenerate() {
+        let c = Vec3::new(0.0, 1.0, 0.0);
+        let (lo, hi) = capsule_interval(c, c, 0.5, 0.3, 0.0);
+        let s = (0.25f32 - 0.09).sqrt();
+        assert!((lo - (1.0 - s)).abs() < 1e-6 && (hi - (1.0 + s)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn horizontal_capsule_bottom_is_analytic() {
+        // Capsule along x from -1 to 1 at height 0.4, radius 0.3: at x = 0.5, z = 0.1 the lowest
+        // point is 0.4 - sqrt(0.09 - 0.01).
+        let (lo, _) = capsule_interval(Vec3::new(-1.0, 0.4, 0.0), Vec3::new(1.0, 0.4, 0.0), 0.3, 0.5, 0.1);
+        assert!((lo - (0.4 - 0.08f32.sqrt())).abs() < 1e-6, "{lo}");
+        // Slanted capsule, vertical line through its middle: the cylinder part.
+        let (lo, hi) = capsule_interval(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), 0.2, 0.0, 0.0);
+        // Distance from (0, y, 0) to the axis line through (0, 0.5, 0) with direction (2, 1)/sqrt5
+        // is |y - 0.5| * 2 / sqrt5, equal to 0.2 at |y - 0.5| = 0.1 * sqrt5.
+        let d = 0.1 * 5f32.sqrt();
+        assert!((lo - (0.5 - d)).abs() < 1e-5 && (hi - (0.5 + d)).abs() < 1e-5, "{lo} {hi}");
+    }
+
+    #[test]
+    fn rotated_box_interval() {
+        // A cube of half side 0.5 turned 45 degrees about z: a vertical line through x = 0 meets it
+        // from -sqrt(0.5) to +sqrt(0.5) around the centre height.
+        let r = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_4);
+        let p = GpuPrimitive::oriented_box(Vec3::new(0.0, 1.0, 0.0), [r * Vec3::X, r * Vec3::Y, r * Vec3::Z], Vec3::splat(0.5));
+        let (lo, hi) = box_interval(&p, 0.0, 0.2);
+        let s = 0.5f32.sqrt();
+        assert!((lo - (1.0 - s)).abs() < 1e-5 && (hi - (1.0 + s)).abs() < 1e-5, "{lo} {hi}");
+    }
+
+    #[test]
+    fn sunk_sphere_clamps_to_its_ground_cross_section() {
+        // Centre 0.3 below the ground, radius 0.5: cross-section at the ground has radius 0.4.
+        let p = GpuPrimitive::capsule(Vec3::new(0.0, -0.3, 0.0), Vec3::new(0.0, -0.3, 0.0), 0.5);
+        assert_eq!(primitive_depth(&p, 0.39, 0.0, 0.5), Some(0.0));
+        assert_eq!(primitive_depth(&p, 0.41, 0.0, 0.5), None);
+    }
+}

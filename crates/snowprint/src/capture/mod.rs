@@ -1,0 +1,431 @@
+//! Capture from below: the ankle-high orthographic frustum of the talk.
+//!
+//! For every surface updated in a frame, the deformers over it are rendered into a rectangle of a
+//! shared depth atlas, looking up from the ground. The frustum runs from the ground (depth 0) to the
+//! snow top plus an ankle height (depth 1); the depth test keeps the lowest point of any deformer per
+//! texel, the talk's minimum-height field. Surfaces are packed into the atlas so that one render pass
+//! captures many of them, each in its own viewport.
+//!
+//! Analytic deformers (spheres, capsules, boxes) are drawn as one bounding rectangle each and
+//! ray-cast exactly in the fragment shader; a moving sphere is swept into a capsule, other shapes
+//! are sub-stepped along their motion. Meshes are rasterized with the override material of the
+//! talk: depth only. Both honour depth clamping: a solid that reaches below the ground fills the
+//! ground, one entirely below it or above the frustum leaves nothing.
+//!
+//! CPU reference: [`cpu`].
+
+pub mod cpu;
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+
+use crate::deformer::{Deformer, Pose, Shape};
+
+/// WGSL of the capture pass.
+pub const SHADER: &str = include_str!("capture.wgsl");
+
+/// Format of the capture atlas.
+pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Most sub-steps an analytic deformer is split into along its motion in one update.
+pub const MAX_SUBSTEPS: u32 = 32;
+
+/// Uniform block of one surface's capture. Must match `CaptureView` in `capture.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CaptureView {
+    /// Half the surface's sides, metres.
+    pub half_size: [f32; 2],
+    /// Snow depth plus ankle height, metres.
+    pub frustum_height: f32,
+    /// Padding.
+    pub _pad: f32,
+}
+
+/// An analytic deformer in surface-local coordinates. Must match `Primitive` in `capture.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuPrimitive {
+    /// `kind[0]`: [`PRIM_CAPSULE`] or [`PRIM_BOX`].
+    pub kind: [u32; 4],
+    /// Capsule: segment start and radius. Box: centre.
+    pub p0: [f32; 4],
+    /// Capsule: segment end. Box: unit x axis and half extent.
+    pub p1: [f32; 4],
+    /// Box: unit y axis and half extent.
+    pub p2: [f32; 4],
+    /// Box: unit z axis and half extent.
+    pub p3: [f32; 4],
+}
+
+/// Primitive kind: capsule (a sphere is a capsule of zero length).
+pub const PRIM_CAPSULE: u32 = 0;
+/// Primitive kind: oriented box.
+pub const PRIM_BOX: u32 = 1;
+
+/// Per-draw uniform of a mesh deformer. Must match `MeshDraw` in `capture.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct MeshDraw {
+    /// Mesh space to surface-local space.
+    pub to_local: [[f32; 4]; 4],
+}
+
+impl GpuPrimitive {
+    /// A capsule from `a` to `b` of radius `r`.
+    pub fn capsule(a: Vec3, b: Vec3, r: f32) -> Self {
+        Self {
+            kind: [PRIM_CAPSULE, 0, 0, 0],
+            p0: [a.x, a.y, a.z, r],
+            p1: [b.x, b.y, b.z, 0.0],
+            ..Default::default()
+        }
+    }
+
+    /// A box with centre `c`, orthonormal axes and half extents.
+    pub fn oriented_box(c: Vec3, axes: [Vec3; 3], half: Vec3) -> Self {
+        let v = |a: Vec3, h: f32| [a.x, a.y, a.z, h];
+        Self {
+            kind: [PRIM_BOX, 0, 0, 0],
+            p0: [c.x, c.y, c.z, 0.0],
+            p1: v(axes[0], half.x),
+            p2: v(axes[1], half.y),
+            p3: v(axes[2], half.z),
+        }
+    }
+
+    /// Local-space bounds `(min, max)`.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let p0 = Vec3::from_slice(&self.p0[..3]);
+        if self.kind[0] == PRIM_CAPSULE {
+            let p1 = Vec3::from_slice(&self.p1[..3]);
+            let r = Vec3::splat(self.p0[3]);
+            (p0.min(p1) - r, p0.max(p1) + r)
+        } else {
+            let e = [self.p1, self.p2, self.p3]
+                .iter()
+                .map(|a| Vec3::from_slice(&a[..3]).abs() * a[3])
+                .fold(Vec3::ZERO, |acc, v| acc + v);
+            (p0 - e, p0 + e)
+        }
+    }
+}
+
+/// The capture volume of a surface in its local frame: `|x| <= half.x`, `|z| <= half.z`,
+/// `0 <= y <= frustum_height`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CaptureVolume {
+    /// World to surface-local transform.
+    pub world_to_local: Mat4,
+    /// Half the surface's sides.
+    pub half_size: glam::Vec2,
+    /// Snow depth plus ankle height.
+    pub frustum_height: f32,
+}
+
+impl CaptureVolume {
+    /// Whether local bounds overlap the volume.
+    pub fn overlaps(&self, lo: Vec3, hi: Vec3) -> bool {
+        hi.x >= -self.half_size.x
+            && lo.x <= self.half_size.x
+            && hi.z >= -self.half_size.y
+            && lo.z <= self.half_size.y
+            && hi.y >= 0.0
+            && lo.y < self.frustum_height
+    }
+
+    /// Whether a world-space ball overlaps the volume.
+    pub fn overlaps_ball(&self, center: Vec3, radius: f32) -> bool {
+        let c = self.world_to_local.transform_point3(center);
+        self.overlaps(c - Vec3::splat(radius), c + Vec3::splat(radius))
+    }
+}
+
+/// Number of sub-steps for a motion of `distance` metres by a shape whose smallest feature is
+/// `feature` metres: steps no longer than half the feature, at most [`MAX_SUBSTEPS`].
+pub fn substeps(distance: f32, feature: f32) -> u32 {
+    if distance <= 0.0 || feature <= 0.0 {
+        return 1;
+    }
+    ((distance / (0.5 * feature)).ceil() as u32).clamp(1, MAX_SUBSTEPS)
+}
+
+/// Append the analytic primitives of one deformer, in the local frame of `volume`, culled against
+/// it. Meshes append nothing (they are drawn separately).
+pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Vec<GpuPrimitive>) {
+    let m = volume.world_to_local;
+    let (_, local_rot, _) = m.to_scale_rotation_translation();
+    let prev = deformer.previous.unwrap_or(deformer.pose);
+    let mut push = |p: GpuPrimitive| {
+        let (lo, hi) = p.bounds();
+        if volume.overlaps(lo, hi) {
+            out.push(p);
+        }
+    };
+    match deformer.shape {
+        Shape::Sphere { radius } => {
+            // A sphere swept along a straight line is exactly a capsule.
+            push(GpuPrimitive::capsule(
+                m.transform_point3(prev.position),
+                m.transform_point3(deformer.pose.position),
+                radius,
+            ));
+        }
+        Shape::Capsule {
+            radius,
+            half_height,
+        } => {
+            let ends = |p: &Pose| {
+                let axis = p.rotation * Vec3::Y * half_height;
+                (p.position - axis, p.position + axis)
+            };
+            let (a0, b0) = ends(&prev);
+            let (a1, b1) = ends(&deformer.pose);
+            let n = substeps(a0.distance(a1).max(b0.distance(b1)), radius);
+            for k in 0..=n {
+                let t = k as f32 / n as f32;
+                let (a, b) = ends(&prev.lerp(&deformer.pose, t));
+                push(GpuPrimitive::capsule(
+                    m.transform_point3(a),
+                    m.transform_point3(b),
+                    radius,
+                ));
+                if deformer.previous.is_none() {
+                    break;
+                }
+            }
+        }
+        Shape::Box { half_extents } => {
+            let corner_move = prev.position.distance(deformer.pose.position)
+                + prev.rotation.angle_between(deformer.pose.rotation) * half_extents.length();
+            let n = substeps(corner_move, half_extents.min_element() * 2.0);
+            for k in 0..=n {
+                let t = k as f32 / n as f32;
+                let p = prev.lerp(&deformer.pose, t);
+                let r = local_rot * p.rotation;
+                push(GpuPrimitive::oriented_box(
+                    m.transform_point3(p.position),
+                    [r * Vec3::X, r * Vec3::Y, r * Vec3::Z],
+                    half_extents,
+                ));
+                if deformer.previous.is_none() {
+                    break;
+                }
+            }
+        }
+        Shape::Mesh(_) => {}
+    }
+}
+
+/// The render pipelines of the capture and their bind group layouts.
+pub struct CapturePipelines {
+    /// Analytic deformers: bounding rectangles, ray-cast per texel.
+    pub primitives: wgpu::RenderPipeline,
+    /// Mesh deformers.
+    pub meshes: wgpu::RenderPipeline,
+    /// Group 0: view (dynamic uniform) and primitives (storage).
+    pub view_layout: wgpu::BindGroupLayout,
+    /// Group 1: mesh draw (dynamic uniform).
+    pub draw_layout: wgpu::BindGroupLayout,
+}
+
+impl CapturePipelines {
+    /// Build both pipelines.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("capture.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let uniform = |binding, visibility| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("capture view"),
+            entries: &[
+                uniform(0, vf),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: vf,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("capture mesh draw"),
+            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
+        });
+        let prim_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("capture primitives"),
+            bind_group_layouts: &[Some(&view_layout)],
+            immediate_size: 0,
+        });
+        let mesh_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("capture meshes"),
+            bind_group_layouts: &[Some(&view_layout), Some(&draw_layout)],
+            immediate_size: 0,
+        });
+        let depth = Some(wgpu::DepthStencilState {
+            format: ATLAS_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: wgpu::StencilState::default(),
+            bias: wgpu::DepthBiasState::default(),
+        });
+        let primitives = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("capture primitives"),
+            layout: Some(&prim_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_prim"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: depth.clone(),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_prim"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let meshes = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("capture meshes"),
+            layout: Some(&mesh_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_mesh"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                // Seen from below through this projection, a face whose outward normal points down
+                // (towards the camera) is wound clockwise; that is the front face.
+                front_face: wgpu::FrontFace::Cw,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: depth,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_mesh"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self {
+            primitives,
+            meshes,
+            view_layout,
+            draw_layout,
+        }
+    }
+}
+
+/// Where a surface's capture lies in the atlas.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtlasPlacement {
+    /// Which pass over the atlas (when the surfaces of a frame do not fit in one).
+    pub batch: u32,
+    /// Left texel.
+    pub x: u32,
+    /// Top texel.
+    pub y: u32,
+}
+
+/// Shelf-pack rectangles `(width, height)` into an atlas of `side` x `side`, opening a new batch
+/// when one is full. Rectangles are placed tallest first; the result is in input order.
+pub fn pack_atlas(rects: &[(u32, u32)], side: u32) -> Vec<AtlasPlacement> {
+    let mut order: Vec<usize> = (0..rects.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse((rects[i].1, rects[i].0)));
+    let mut out = vec![AtlasPlacement { batch: 0, x: 0, y: 0 }; rects.len()];
+    let (mut batch, mut x, mut y, mut shelf) = (0u32, 0u32, 0u32, 0u32);
+    for i in order {
+        let (w, h) = rects[i];
+        if x + w > side {
+            x = 0;
+            y += shelf;
+            shelf = 0;
+        }
+        if y + h > side {
+            batch += 1;
+            x = 0;
+            y = 0;
+            shelf = 0;
+        }
+        out[i] = AtlasPlacement { batch, x, y };
+        x += w;
+        shelf = shelf.max(h);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atlas_packing_never_overlaps() {
+        let rects: Vec<(u32, u32)> = (0..300).map(|i| (17 + (i * 37) % 500, 9 + (i * 53) % 400)).collect();
+        let side = 1024;
+        let p = pack_atlas(&rects, side);
+        for (i, a) in p.iter().enumerate() {
+            assert!(a.x + rects[i].0 <= side && a.y + rects[i].1 <= side);
+            for (j, b) in p.iter().enumerate().skip(i + 1) {
+                if a.batch != b.batch {
+                    continue;
+                }
+                let sep = a.x + rects[i].0 <= b.x
+                    || b.x + rects[j].0 <= a.x
+                    || a.y + rects[i].1 <= b.y
+                    || b.y + rects[j].1 <= a.y;
+                assert!(sep, "{i} and {j} overlap");
+            }
+        }
+    }
+
+    #[test]
+    fn sweeping_sphere_is_one_capsule() {
+        let vol = CaptureVolume {
+            world_to_local: Mat4::IDENTITY,
+            half_size: glam::Vec2::new(5.0, 5.0),
+            frustum_height: 0.5,
+        };
+        let d = Deformer::moving(
+            Shape::Sphere { radius: 0.2 },
+            Pose::at([-1.0, 0.1, 0.0]),
+            Pose::at([1.0, 0.1, 0.0]),
+        );
+        let mut out = vec![];
+        push_primitives(&d, &vol, &mut out);
+        assert_eq!(out, vec![GpuPrimitive::capsule(Vec3::new(-1.0, 0.1, 0.0), Vec3::new(1.0, 0.1, 0.0), 0.2)]);
+        // Above the frustum: culled.
+        let high = Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([0.0, 0.71, 0.0]));
+        out.clear();
+        push_primitives(&high, &vol, &mut out);
+        assert!(out.is_empty());
+    }
+}

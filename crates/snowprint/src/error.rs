@@ -1,0 +1,125 @@
+//! Typed errors of the library: one variant per cause, each carrying the value that was wrong.
+
+use std::path::PathBuf;
+
+/// Everything the library can report instead of panicking.
+#[derive(Debug, thiserror::Error)]
+pub enum SnowError {
+    /// No GPU adapter could be found at all.
+    #[error(
+        "no GPU adapter was found: install a Vulkan driver (on Debian or Ubuntu: `apt-get install mesa-vulkan-drivers` for the software one)"
+    )]
+    NoAdapter,
+    /// An adapter was requested by name and none matched.
+    #[error("no GPU adapter matches {requested:?}; the adapters found are: {available}")]
+    AdapterNotFound {
+        /// The name asked for (by `--adapter` or `SNOWPRINT_ADAPTER`).
+        requested: String,
+        /// Names of the adapters that exist, comma separated.
+        available: String,
+    },
+    /// The device could not be created.
+    #[error("the GPU device could not be created on {adapter}: {source}")]
+    RequestDevice {
+        /// The adapter's name.
+        adapter: String,
+        /// The underlying wgpu error.
+        source: wgpu::RequestDeviceError,
+    },
+    /// A surface description is not usable.
+    #[error("surface {name:?}: {what} is {value}, but it must be {expected}")]
+    InvalidSurface {
+        /// Name of the surface.
+        name: String,
+        /// Which field.
+        what: &'static str,
+        /// The offending value, printed.
+        value: String,
+        /// What would be accepted.
+        expected: &'static str,
+    },
+    /// A deformer description is not usable.
+    #[error("deformer {name:?}: {what} is {value}, but it must be {expected}")]
+    InvalidDeformer {
+        /// Name of the deformer.
+        name: String,
+        /// Which field.
+        what: &'static str,
+        /// The offending value, printed.
+        value: String,
+        /// What would be accepted.
+        expected: &'static str,
+    },
+    /// A mesh is not usable as a deformer.
+    #[error("mesh {name:?}: {reason}")]
+    InvalidMesh {
+        /// Name or path of the mesh.
+        name: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A mesh file could not be read.
+    #[error("mesh file {}: {reason}", path.display())]
+    MeshFile {
+        /// The file.
+        path: PathBuf,
+        /// Why it could not be used.
+        reason: String,
+    },
+    /// A handle does not name a live object of this world.
+    #[error("{what} handle {index} does not belong to this world (it was removed or never existed)")]
+    StaleHandle {
+        /// Kind of handle.
+        what: &'static str,
+        /// Its index.
+        index: u32,
+    },
+    /// The heightmap pool has no room for a surface. A normal state: free or evict a surface, or give
+    /// the pool more bytes.
+    #[error(
+        "the heightmap pool has no room for surface {name:?}: it needs {needed} bytes, {free} of {budget} bytes are free in one piece"
+    )]
+    PoolExhausted {
+        /// The surface that did not fit.
+        name: String,
+        /// Bytes the surface needs.
+        needed: u64,
+        /// Largest free block.
+        free: u64,
+        /// The pool's budget.
+        budget: u64,
+    },
+    /// The GPU did not finish or a readback failed.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+    /// Writing an output file failed.
+    #[error("could not write {}: {reason}", path.display())]
+    Output {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// A time step is not usable.
+    #[error("time step {dt} s is not usable: it must be a finite number of seconds, 0 or more")]
+    InvalidTimeStep {
+        /// The step given.
+        dt: f32,
+    },
+    /// A posed vertex buffer does not match its mesh.
+    #[error("posed vertices for mesh {mesh}: got {got} vertices, the mesh has {expected}")]
+    PoseMismatch {
+        /// Mesh index.
+        mesh: u32,
+        /// Vertices given.
+        got: usize,
+        /// Vertices of the mesh.
+        expected: usize,
+    },
+    /// A scene file is not valid.
+    #[error("{0}")]
+    Scene(String),
+}
+
+/// Result alias of the library.
+pub type Result<T, E = SnowError> = std::result::Result<T, E>;

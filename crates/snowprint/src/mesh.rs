@@ -1,0 +1,237 @@
+//! Triangle meshes used as deformers: closed, wound counter-clockwise seen from outside (the glTF
+//! convention). The capture relies on that winding to fill what lies below the ground (see
+//! `capture/capture.wgsl`).
+
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+
+use crate::error::{Result, SnowError};
+
+/// Handle of a mesh registered with a [`crate::SnowWorld`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct MeshId(pub(crate) u32);
+
+/// An indexed triangle list in the mesh's own frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions, metres.
+    pub positions: Vec<Vec3>,
+    /// Three indices per triangle, counter-clockwise seen from outside.
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// Check indices are in range and positions finite.
+    pub fn validate(&self, name: &str) -> Result<()> {
+        let err = |reason: String| {
+            Err(SnowError::InvalidMesh {
+                name: name.to_owned(),
+                reason,
+            })
+        };
+        if self.indices.is_empty() || self.indices.len() % 3 != 0 {
+            return err(format!(
+                "has {} indices; a triangle list needs a positive multiple of 3",
+                self.indices.len()
+            ));
+        }
+        if let Some(i) = self.indices.iter().find(|&&i| i as usize >= self.positions.len()) {
+            return err(format!(
+                "index {i} is out of range for {} vertices",
+                self.positions.len()
+            ));
+        }
+        if let Some(p) = self.positions.iter().find(|p| !p.is_finite()) {
+            return err(format!("vertex {:?} is not finite", p.to_array()));
+        }
+        Ok(())
+    }
+
+    /// Radius of the ball around the mesh origin that holds every vertex.
+    pub fn bounding_radius(&self) -> f32 {
+        self.positions.iter().map(|p| p.length()).fold(0.0, f32::max)
+    }
+
+    /// The mesh with every vertex transformed.
+    pub fn transformed(&self, m: Mat4) -> Mesh {
+        Mesh {
+            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            indices: self.indices.clone(),
+        }
+    }
+
+    /// Append another mesh.
+    pub fn append(&mut self, other: &Mesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.indices.extend(other.indices.iter().map(|i| i + base));
+    }
+
+    /// A UV sphere of `radius` with `rings` latitude bands and `segments` longitude slices.
+    pub fn uv_sphere(radius: f32, rings: u32, segments: u32) -> Mesh {
+        Self::capsule(radius, 0.0, rings.max(2) & !1, segments)
+    }
+
+    /// A capsule along `Y`: inner segment `-half_height..half_height`, `radius`; `rings` bands over
+    /// the two hemispheres together (even), `segments` slices.
+    pub fn capsule(radius: f32, half_height: f32, rings: u32, segments: u32) -> Mesh {
+        let rings = rings.max(2) & !1;
+        let segments = segments.max(3);
+        let mut positions = Vec::new();
+        // Top pole, ring vertices from top to bottom, bottom pole.
+        positions.push(Vec3::new(0.0, half_height + radius, 0.0));
+        for r in 1..rings {
+            let phi = std::f32::consts::PI * r as f32 / rings as f32;
+            let y = radius * phi.cos() + if r <= rings / 2 { half_height } else { -half_height };
+            let ring_r = radius * phi.sin();
+            for s in 0..segments {
+                let theta = std::f32::consts::TAU * s as f32 / segments as f32;
+                positions.push(Vec3::new(ring_r * theta.cos(), y, ring_r * theta.sin()));
+            }
+            if r == rings / 2 && half_height > 0.0 {
+                // Duplicate the equator ring at the bottom of the cylinder.
+                for s in 0..segments {
+                    let theta = std::f32::consts::TAU * s as f32 / segments as f32;
+                    positions.push(Vec3::new(
+                        ring_r * theta.cos(),
+                        y - 2.0 * half_height,
+                        ring_r * theta.sin(),
+                    ));
+                }
+            }
+        }
+        positions.push(Vec3::new(0.0, -half_height - radius, 0.0));
+        let ring_count = rings - 1 + u32::from(half_height > 0.0);
+        let bottom = positions.len() as u32 - 1;
+        let ring = |k: u32, s: u32| 1 + k * segments + (s % segments);
+        let mut indices = Vec::new();
+        for s in 0..segments {
+            // Seen from above (outside at the top pole), counter-clockwise is decreasing theta
+            // when x = cos, z = sin (because +Y x +X points to -Z).
+            indices.extend_from_slice(&[0, ring(0, s + 1), ring(0, s)]);
+        }
+        for k in 0..ring_count - 1 {
+            for s in 0..segments {
+                let (a, b, c, d) = (ring(k, s), ring(k, s + 1), ring(k + 1, s), ring(k + 1, s + 1));
+                indices.extend_from_slice(&[a, b, d, a, d, c]);
+            }
+        }
+        let last = ring_count - 1;
+        for s in 0..segments {
+            indices.extend_from_slice(&[bottom, ring(last, s), ring(last, s + 1)]);
+        }
+        Mesh { positions, indices }
+    }
+
+    /// An axis-aligned box centred on the origin.
+    pub fn cuboid(half_extents: Vec3) -> Mesh {
+        let h = half_extents;
+        let positions = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    if i & 1 == 0 { -h.x } else { h.x },
+                    if i & 2 == 0 { -h.y } else { h.y },
+                    if i & 4 == 0 { -h.z } else { h.z },
+                )
+            })
+            .collect();
+        // Each face as a quad (a, b, c, d) counter-clockwise seen from outside.
+        let faces = [
+            [0, 4, 6, 2], // -x
+            [1, 3, 7, 5], // +x
+            [0, 1, 5, 4], // -y
+            [2, 6, 7, 3], // +y
+            [0, 2, 3, 1], // -z
+            [4, 5, 7, 6], // +z
+        ];
+        let mut indices = Vec::new();
+        for [a, b, c, d] in faces {
+            indices.extend_from_slice(&[a, b, c, a, c, d]);
+        }
+        Mesh { positions, indices }
+    }
+
+    /// Load every triangle primitive of a glTF or GLB file, with node transforms applied, into one
+    /// mesh in the file's frame (metres, +Y up as glTF defines).
+    pub fn load_gltf(path: &Path) -> Result<Mesh> {
+        let err = |reason: String| SnowError::MeshFile {
+            path: path.to_owned(),
+            reason,
+        };
+        let (doc, buffers, _) = gltf::import(path).map_err(|e| err(e.to_string()))?;
+        let mut mesh = Mesh::default();
+        let scene = doc
+            .default_scene()
+            .or_else(|| doc.scenes().next())
+            .ok_or_else(|| err("has no scene".into()))?;
+        let mut stack: Vec<(gltf::Node, Mat4)> =
+            scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+        while let Some((node, parent)) = stack.pop() {
+            let m = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if let Some(gm) = node.mesh() {
+                for prim in gm.primitives() {
+                    if prim.mode() != gltf::mesh::Mode::Triangles {
+                        continue;
+                    }
+                    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+                    let Some(pos) = reader.read_positions() else { continue };
+                    let base = mesh.positions.len() as u32;
+                    let first_index = mesh.indices.len();
+                    let pos: Vec<Vec3> = pos.map(|p| m.transform_point3(Vec3::from(p))).collect();
+                    let n = pos.len() as u32;
+                    mesh.positions.extend(pos);
+                    match reader.read_indices() {
+                        Some(ix) => mesh.indices.extend(ix.into_u32().map(|i| base + i)),
+                        None => mesh.indices.extend(base..base + n),
+                    }
+                    // A mirroring transform flips the winding; keep triangles outward-facing.
+                    if m.determinant() < 0.0 {
+                        for tri in mesh.indices[first_index..].chunks_exact_mut(3) {
+                            tri.swap(1, 2);
+                        }
+                    }
+                }
+            }
+            stack.extend(node.children().map(|c| (c, m)));
+        }
+        if mesh.indices.is_empty() {
+            return Err(err("holds no triangles".into()));
+        }
+        mesh.validate(&path.display().to_string())?;
+        Ok(mesh)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Signed volume by the divergence theorem: positive for a closed mesh wound outward.
+    fn signed_volume(m: &Mesh) -> f32 {
+        m.indices
+            .chunks(3)
+            .map(|t| {
+                let (a, b, c) = (m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn generated_meshes_are_closed_and_outward() {
+        let s = Mesh::uv_sphere(1.0, 32, 64);
+        s.validate("sphere").unwrap();
+        let v = signed_volume(&s);
+        let exact = 4.0 / 3.0 * std::f32::consts::PI;
+        assert!(v > 0.97 * exact && v < exact, "sphere volume {v}");
+
+        let c = Mesh::capsule(0.5, 1.0, 16, 32);
+        let v = signed_volume(&c);
+        let exact = 4.0 / 3.0 * std::f32::consts::PI * 0.125 + std::f32::consts::PI * 0.25 * 2.0;
+        assert!(v > 0.97 * exact && v < exact, "capsule volume {v} vs {exact}");
+
+        let b = Mesh::cuboid(Vec3::new(1.0, 2.0, 3.0));
+        assert!((signed_volume(&b) - 48.0).abs() < 1e-4);
+    }
+}

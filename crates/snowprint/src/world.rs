@@ -1,0 +1,1052 @@
+//! The snow world: surfaces, deformers and the per-frame update.
+//!
+//! [`SnowWorld::step`] runs one frame: for every resident surface it culls the deformers against
+//! the surface's capture volume, packs the surfaces that something touches into the capture atlas,
+//! renders them from below (one render pass per atlas batch), and runs the accumulation chain with
+//! one dispatch per stage over all updated surfaces. Surfaces that nothing touched and on which no
+//! snow fell are left alone.
+
+use std::time::Instant;
+
+use glam::{Mat4, Vec2};
+
+use crate::accumulate::{self, AccumulatePipelines, BlurParams, WORKGROUP};
+use crate::capture::{self, AtlasPlacement, CaptureView, CaptureVolume, CapturePipelines, GpuPrimitive, MeshDraw};
+use crate::deformer::{Deformer, Shape};
+use crate::error::{Result, SnowError};
+use crate::gpu::{Capabilities, GpuContext};
+use crate::heightmap::Heightmap;
+use crate::mesh::{Mesh, MeshId};
+use crate::pool::{NO_CAPTURE, Slot, SlotAllocator, SurfaceRecord};
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+
+/// Which of the talk's two capture paths to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CaptureMode {
+    /// The talk's PC path: the lowest point of any deformer per texel, a minimum-height field.
+    #[default]
+    Depth,
+    /// The talk's console path: clear black, deformers white, a fixed imprint depth.
+    Mask,
+}
+
+/// How surfaces are captured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CaptureConfig {
+    /// Depth or mask capture.
+    pub mode: CaptureMode,
+    /// Height of the frustum above the snow top, metres (default 0.25).
+    pub ankle_height: f32,
+    /// In mask mode, the fraction of the snow depth a covered texel is pressed down (default 1).
+    pub mask_depth: f32,
+}
+
+impl Default for CaptureConfig {
+    fn default() -> Self {
+        Self {
+            mode: CaptureMode::Depth,
+            ankle_height: 0.25,
+            mask_depth: 1.0,
+        }
+    }
+}
+
+/// Settings of a world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldConfig {
+    /// Capture settings.
+    pub capture: CaptureConfig,
+    /// Bytes of GPU memory for heightmaps (the pool). Clamped to the device's largest storage
+    /// binding, with a warning.
+    pub pool_bytes: u64,
+    /// Largest side of the capture atlas, texels (clamped to the device's limit).
+    pub atlas_side: u32,
+}
+
+impl Default for WorldConfig {
+    fn default() -> Self {
+        Self {
+            capture: CaptureConfig::default(),
+            pool_bytes: 32 << 20,
+            atlas_side: 2048,
+        }
+    }
+}
+
+/// GPU time of each stage of one frame, milliseconds (from timestamp queries).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StageTimes {
+    /// All capture render passes.
+    pub capture_ms: f64,
+    /// All blur dispatches.
+    pub blur_ms: f64,
+    /// The merge dispatch.
+    pub merge_ms: f64,
+    /// The normals dispatch.
+    pub normals_ms: f64,
+}
+
+impl StageTimes {
+    /// Sum of the stages.
+    pub fn total_ms(&self) -> f64 {
+        self.capture_ms + self.blur_ms + self.merge_ms + self.normals_ms
+    }
+}
+
+/// What one [`SnowWorld::step`] did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FrameStats {
+    /// Surfaces whose heightmap was updated.
+    pub updated: u32,
+    /// Of those, surfaces something was captured on.
+    pub captured: u32,
+    /// Capture atlas passes.
+    pub capture_batches: u32,
+    /// Analytic primitives drawn (after sweeping and culling).
+    pub primitives: u32,
+    /// Mesh draws.
+    pub mesh_draws: u32,
+    /// CPU time spent building and encoding the frame, milliseconds.
+    pub cpu_encode_ms: f64,
+    /// Per-stage GPU times, when profiling is on and the adapter has timestamp queries.
+    pub gpu: Option<StageTimes>,
+}
+
+/// Bytes of GPU memory the world holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct MemoryReport {
+    /// The pool's budget.
+    pub pool_budget: u64,
+    /// Pool bytes in slots now.
+    pub pool_used: u64,
+    /// Most pool bytes ever in slots.
+    pub pool_high_water: u64,
+    /// Scratch buffer (blurred captures of one frame).
+    pub scratch: u64,
+    /// Capture atlas textures.
+    pub capture_atlas: u64,
+    /// Per-frame tables (records, views, primitives, mesh draws).
+    pub frame_tables: u64,
+}
+
+struct SurfaceState {
+    desc: SurfaceDesc,
+    layout: SurfaceLayout,
+    slot: Slot,
+    /// Which half of the ping-pong pair holds the current heightmap.
+    parity: u32,
+    /// Replenishment not yet applied, units (fraction kept between frames).
+    carry: f64,
+}
+
+impl SurfaceState {
+    fn texel(&self) -> Vec2 {
+        self.desc.size / Vec2::new(self.layout.width as f32, self.layout.height as f32)
+    }
+}
+
+struct MeshGpu {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    vertex_count: usize,
+    radius: f32,
+}
+
+/// A growable GPU buffer.
+struct Growable {
+    buffer: wgpu::Buffer,
+    usage: wgpu::BufferUsages,
+    label: &'static str,
+}
+
+impl Growable {
+    fn new(device: &wgpu::Device, label: &'static str, usage: wgpu::BufferUsages, size: u64) -> Self {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        });
+        Self { buffer, usage, label }
+    }
+
+    fn ensure(&mut self, device: &wgpu::Device, size: u64) {
+        if self.buffer.size() < size {
+            *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
+        }
+    }
+}
+
+const UNIFORM_STRIDE: u64 = 256;
+
+/// One surface's work in a frame.
+struct Job {
+    surface: usize,
+    record: SurfaceRecord,
+    captured: bool,
+    prims: std::ops::Range<u32>,
+    draws: std::ops::Range<u32>,
+}
+
+/// What the last frame did, for debug readbacks.
+#[derive(Default)]
+struct LastFrame {
+    /// (surface index, record, placement) of every captured job.
+    captured: Vec<(usize, SurfaceRecord, AtlasPlacement)>,
+    last_batch: u32,
+    atlas_side: u32,
+}
+
+struct Timestamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    period_ns: f32,
+    capacity: u32,
+}
+
+/// Which stage a pair of timestamps measured.
+#[derive(Clone, Copy)]
+enum Stage {
+    Capture,
+    Blur,
+    Merge,
+    Normals,
+}
+
+/// The snow world: every surface's heightmap in one GPU pool, updated by [`SnowWorld::step`].
+pub struct SnowWorld {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    caps: Capabilities,
+    config: WorldConfig,
+    capture_pipes: CapturePipelines,
+    acc: AccumulatePipelines,
+    pool: wgpu::Buffer,
+    alloc: SlotAllocator,
+    surfaces: Vec<Option<SurfaceState>>,
+    meshes: Vec<Option<MeshGpu>>,
+    atlases: Vec<(u32, wgpu::Texture, wgpu::TextureView)>,
+    records: Growable,
+    views: Growable,
+    prims: Growable,
+    draws: Growable,
+    blur_params: Growable,
+    scratch: Growable,
+    last: LastFrame,
+    profiling: bool,
+    timestamps: Option<Timestamps>,
+}
+
+impl std::fmt::Debug for SnowWorld {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SnowWorld")
+            .field("surfaces", &self.surfaces.iter().flatten().count())
+            .field("pool_used", &self.alloc.used())
+            .finish()
+    }
+}
+
+impl SnowWorld {
+    /// Create a world on a GPU context.
+    pub fn new(gpu: &GpuContext, config: WorldConfig) -> Result<Self> {
+        let device = gpu.device.clone();
+        let mut config = config;
+        let c = config.capture;
+        if !(c.ankle_height.is_finite() && c.ankle_height > 0.0) {
+            return Err(SnowError::Scene(format!(
+                "capture ankle_height {} must be a finite number of metres above 0",
+                c.ankle_height
+            )));
+        }
+        if !(c.mask_depth.is_finite() && c.mask_depth > 0.0 && c.mask_depth <= 1.0) {
+            return Err(SnowError::Scene(format!(
+                "capture mask_depth {} must be a fraction in (0, 1]",
+                c.mask_depth
+            )));
+        }
+        let max_pool = gpu.caps.max_storage_binding.min(device.limits().max_buffer_size) / 256 * 256;
+        if config.pool_bytes > max_pool {
+            tracing::warn!(
+                "heightmap pool of {} bytes exceeds this device's largest storage binding; using {} bytes",
+                config.pool_bytes,
+                max_pool
+            );
+            config.pool_bytes = max_pool;
+        }
+        config.atlas_side = config.atlas_side.clamp(64, gpu.caps.max_texture_side);
+        let alloc = SlotAllocator::new(config.pool_bytes);
+        let pool = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("heightmap pool"),
+            size: alloc.budget().max(256),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        use wgpu::BufferUsages as U;
+        let timestamps = gpu.caps.timestamps.then(|| {
+            let capacity = 256;
+            Timestamps {
+                set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("snowprint timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: capacity,
+                }),
+                resolve: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamp resolve"),
+                    size: capacity as u64 * 8,
+                    usage: U::QUERY_RESOLVE | U::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+                readback: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamp readback"),
+                    size: capacity as u64 * 8,
+                    usage: U::MAP_READ | U::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                period_ns: gpu.queue.get_timestamp_period(),
+                capacity,
+            }
+        });
+        Ok(Self {
+            capture_pipes: CapturePipelines::new(&device),
+            acc: AccumulatePipelines::new(&device),
+            records: Growable::new(&device, "surface records", U::STORAGE | U::COPY_DST, 64 * 64),
+            views: Growable::new(&device, "capture views", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 16),
+            prims: Growable::new(&device, "capture primitives", U::STORAGE | U::COPY_DST, 80 * 64),
+            draws: Growable::new(&device, "capture mesh draws", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 16),
+            blur_params: Growable::new(&device, "blur params", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 4),
+            scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
+            queue: gpu.queue.clone(),
+            caps: gpu.caps.clone(),
+            device,
+            config,
+            pool,
+            alloc,
+            surfaces: Vec::new(),
+            meshes: Vec::new(),
+            atlases: Vec::new(),
+            last: LastFrame::default(),
+            profiling: false,
+            timestamps,
+        })
+    }
+
+    /// The world's settings (after clamping to the device).
+    pub fn config(&self) -> &WorldConfig {
+        &self.config
+    }
+
+    /// Measure each stage with GPU timestamp queries (when the adapter has them). Each
+    /// [`SnowWorld::step`] then waits for the GPU and reports [`FrameStats::gpu`].
+    pub fn set_profiling(&mut self, on: bool) {
+        self.profiling = on;
+    }
+
+    /// Whether per-stage GPU times can be measured on this device.
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps.is_some()
+    }
+
+    /// Add a surface; its heightmap starts untouched. Fails with [`SnowError::PoolExhausted`] when
+    /// the pool has no room (a normal state: remove a surface or give the pool more bytes).
+    pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
+        desc.validate()?;
+        let layout = desc.layout();
+        let slot = self.alloc.alloc(layout.texels()).ok_or_else(|| SnowError::PoolExhausted {
+            name: desc.name.clone(),
+            needed: crate::pool::slot_bytes(layout.texels()),
+            free: self.alloc.largest_free(),
+            budget: self.alloc.budget(),
+        })?;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
+        self.queue.submit([enc.finish()]);
+        let state = SurfaceState {
+            desc,
+            layout,
+            slot,
+            parity: 0,
+            carry: 0.0,
+        };
+        let index = match self.surfaces.iter().position(Option::is_none) {
+            Some(i) => {
+                self.surfaces[i] = Some(state);
+                i
+            }
+            None => {
+                self.surfaces.push(Some(state));
+                self.surfaces.len() - 1
+            }
+        };
+        Ok(SurfaceId(index as u32))
+    }
+
+    /// Remove a surface and give its pool bytes back.
+    pub fn remove_surface(&mut self, id: SurfaceId) -> Result<()> {
+        let state = self
+            .surfaces
+            .get_mut(id.0 as usize)
+            .and_then(Option::take)
+            .ok_or(SnowError::StaleHandle { what: "surface", index: id.0 })?;
+        self.alloc.free(state.slot);
+        Ok(())
+    }
+
+    /// The description of a surface.
+    pub fn surface(&self, id: SurfaceId) -> Result<&SurfaceDesc> {
+        Ok(&self.state(id)?.desc)
+    }
+
+    /// Heightmap resolution of a surface.
+    pub fn layout(&self, id: SurfaceId) -> Result<SurfaceLayout> {
+        Ok(self.state(id)?.layout)
+    }
+
+    /// Every live surface.
+    pub fn surfaces(&self) -> impl Iterator<Item = (SurfaceId, &SurfaceDesc)> {
+        self.surfaces
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.as_ref().map(|s| (SurfaceId(i as u32), &s.desc)))
+    }
+
+    fn state(&self, id: SurfaceId) -> Result<&SurfaceState> {
+        self.surfaces
+            .get(id.0 as usize)
+            .and_then(Option::as_ref)
+            .ok_or(SnowError::StaleHandle { what: "surface", index: id.0 })
+    }
+
+    /// Register a closed triangle mesh as a deformer shape.
+    pub fn add_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<MeshId> {
+        mesh.validate(name)?;
+        use wgpu::util::DeviceExt;
+        let vertices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("deformer mesh vertices"),
+            contents: bytemuck::cast_slice(&mesh.positions),
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        });
+        let indices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("deformer mesh indices"),
+            contents: bytemuck::cast_slice(&mesh.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        self.meshes.push(Some(MeshGpu {
+            vertices,
+            indices,
+            index_count: mesh.indices.len() as u32,
+            vertex_count: mesh.positions.len(),
+            radius: mesh.bounding_radius(),
+        }));
+        Ok(MeshId(self.meshes.len() as u32 - 1))
+    }
+
+    /// Replace a mesh's vertex positions (an animated mesh posed for this frame). The count must
+    /// match the mesh; the triangles stay.
+    pub fn pose_mesh(&mut self, id: MeshId, positions: &[glam::Vec3]) -> Result<()> {
+        let mesh = self
+            .meshes
+            .get_mut(id.0 as usize)
+            .and_then(Option::as_mut)
+            .ok_or(SnowError::StaleHandle { what: "mesh", index: id.0 })?;
+        if positions.len() != mesh.vertex_count {
+            return Err(SnowError::PoseMismatch {
+                mesh: id.0,
+                got: positions.len(),
+                expected: mesh.vertex_count,
+            });
+        }
+        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(SnowError::InvalidMesh {
+                name: format!("mesh {}", id.0),
+                reason: format!("posed vertex {:?} is not finite", p.to_array()),
+            });
+        }
+        mesh.radius = positions.iter().map(|p| p.length()).fold(0.0, f32::max);
+        self.queue.write_buffer(&mesh.vertices, 0, bytemuck::cast_slice(positions));
+        Ok(())
+    }
+
+    /// Bytes of GPU memory held.
+    pub fn memory(&self) -> MemoryReport {
+        MemoryReport {
+            pool_budget: self.alloc.budget(),
+            pool_used: self.alloc.used(),
+            pool_high_water: self.alloc.high_water(),
+            scratch: self.scratch.buffer.size(),
+            capture_atlas: self.atlases.iter().map(|a| a.0 as u64 * a.0 as u64 * 4).sum(),
+            frame_tables: self.records.buffer.size()
+                + self.views.buffer.size()
+                + self.prims.buffer.size()
+                + self.draws.buffer.size()
+                + self.blur_params.buffer.size(),
+        }
+    }
+
+    fn atlas(&mut self, side: u32) -> usize {
+        if let Some(i) = self.atlases.iter().position(|a| a.0 == side) {
+            return i;
+        }
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("capture atlas"),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: capture::ATLAS_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        self.atlases.push((side, texture, view));
+        self.atlases.len() - 1
+    }
+
+    /// Advance every surface by `dt` seconds with the deformers as posed at the end of the frame.
+    pub fn step(&mut self, dt: f32, deformers: &[Deformer]) -> Result<FrameStats> {
+        let start = Instant::now();
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Err(SnowError::InvalidTimeStep { dt });
+        }
+        for (i, d) in deformers.iter().enumerate() {
+            d.validate(&format!("#{i}"))?;
+            if let Shape::Mesh(id) = d.shape
+                && self.meshes.get(id.0 as usize).and_then(Option::as_ref).is_none()
+            {
+                return Err(SnowError::StaleHandle { what: "mesh", index: id.0 });
+            }
+        }
+        let capture_cfg = self.config.capture;
+        let mut jobs: Vec<Job> = Vec::new();
+        let mut prims: Vec<GpuPrimitive> = Vec::new();
+        let mut draws: Vec<(MeshDraw, MeshId)> = Vec::new();
+        for (index, state) in self.surfaces.iter_mut().enumerate() {
+            let Some(state) = state else { continue };
+            state.carry += state.desc.replenish_rate as f64 * dt as f64 * accumulate::cpu::UNITS as f64;
+            let units = state.carry.floor().min(u32::MAX as f64);
+            state.carry -= units;
+            let units = units as u32;
+            let frustum_height = state.desc.snow_depth + capture_cfg.ankle_height;
+            let volume = CaptureVolume {
+                world_to_local: state.desc.world_to_local(),
+                half_size: state.desc.size * 0.5,
+                frustum_height,
+            };
+            let p0 = prims.len() as u32;
+            let d0 = draws.len() as u32;
+            for d in deformers {
+                match d.shape {
+                    Shape::Mesh(id) => {
+                        let Some(Some(mesh)) = self.meshes.get(id.0 as usize) else { continue };
+                        if volume.overlaps_ball(d.pose.position, mesh.radius) {
+                            let model = Mat4::from_rotation_translation(d.pose.rotation, d.pose.position);
+                            draws.push((
+                                MeshDraw {
+                                    to_local: (volume.world_to_local * model).to_cols_array_2d(),
+                                },
+                                id,
+                            ));
+                        }
+                    }
+                    _ => capture::push_primitives(d, &volume, &mut prims),
+                }
+            }
+            let captured = prims.len() as u32 > p0 || draws.len() as u32 > d0;
+            if !captured && units == 0 {
+                continue;
+            }
+            let texel = state.texel();
+            let (read, write) = (state.parity as u64, 1 - state.parity as u64);
+            jobs.push(Job {
+                surface: index,
+                record: SurfaceRecord {
+                    heights_read: state.slot.region(read),
+                    heights_write: state.slot.region(write),
+                    normals: state.slot.region(2),
+                    scratch: 0,
+                    width: state.layout.width,
+                    height: state.layout.height,
+                    atlas_x: 0,
+                    atlas_y: 0,
+                    mode: match capture_cfg.mode {
+                        CaptureMode::Depth => 0,
+                        CaptureMode::Mask => 1,
+                    },
+                    replenish_units: units,
+                    batch: NO_CAPTURE,
+                    mask_fraction: capture_cfg.mask_depth,
+                    snow_depth: state.desc.snow_depth,
+                    frustum_height,
+                    texel_x: texel.x,
+                    texel_z: texel.y,
+                },
+                captured,
+                prims: p0..prims.len() as u32,
+                draws: d0..draws.len() as u32,
+            });
+        }
+        let mut stats = FrameStats {
+            updated: jobs.len() as u32,
+            primitives: prims.len() as u32,
+            mesh_draws: draws.len() as u32,
+            ..Default::default()
+        };
+        if jobs.is_empty() {
+            stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
+            return Ok(stats);
+        }
+
+        // Place captured surfaces in the atlas and the scratch buffer.
+        let captured: Vec<usize> = (0..jobs.len()).filter(|&j| jobs[j].captured).collect();
+        let rects: Vec<(u32, u32)> = captured
+            .iter()
+            .map(|&j| (jobs[j].record.width, jobs[j].record.height))
+            .collect();
+        let placements = capture::pack_atlas(&rects, self.config.atlas_side);
+        let batches = placements.iter().map(|p| p.batch + 1).max().unwrap_or(0);
+        let atlas_side = if batches > 1 {
+            self.config.atlas_side
+        } else {
+            let extent = placements
+                .iter()
+                .zip(&rects)
+                .map(|(p, r)| (p.x + r.0).max(p.y + r.1))
+                .max()
+                .unwrap_or(1);
+            extent.next_power_of_two().clamp(64, self.config.atlas_side)
+        };
+        let mut scratch_len = 0u32;
+        for (k, &j) in captured.iter().enumerate() {
+            let r = &mut jobs[j].record;
+            r.atlas_x = placements[k].x;
+            r.atlas_y = placements[k].y;
+            r.batch = placements[k].batch;
+            r.scratch = scratch_len;
+            scratch_len += r.width * r.height;
+        }
+        stats.captured = captured.len() as u32;
+        stats.capture_batches = batches;
+
+        // Upload the frame's tables.
+        let records: Vec<SurfaceRecord> = jobs.iter().map(|j| j.record).collect();
+        self.records.ensure(&self.device, (records.len() * 64) as u64);
+        self.queue.write_buffer(&self.records.buffer, 0, bytemuck::cast_slice(&records));
+        let mut view_bytes = vec![0u8; captured.len().max(1) * UNIFORM_STRIDE as usize];
+        for (k, &j) in captured.iter().enumerate() {
+            let r = &jobs[j].record;
+            let state = self.surfaces[jobs[j].surface].as_ref().expect("job of a live surface");
+            let v = CaptureView {
+                half_size: (state.desc.size * 0.5).to_array(),
+                frustum_height: r.frustum_height,
+                _pad: 0.0,
+            };
+            let o = k * UNIFORM_STRIDE as usize;
+            view_bytes[o..o + 16].copy_from_slice(bytemuck::bytes_of(&v));
+        }
+        self.views.ensure(&self.device, view_bytes.len() as u64);
+        self.queue.write_buffer(&self.views.buffer, 0, &view_bytes);
+        if !prims.is_empty() {
+            self.prims.ensure(&self.device, (prims.len() * 80) as u64);
+            self.queue.write_buffer(&self.prims.buffer, 0, bytemuck::cast_slice(&prims));
+        }
+        if !draws.is_empty() {
+            let mut bytes = vec![0u8; draws.len() * UNIFORM_STRIDE as usize];
+            for (k, (d, _)) in draws.iter().enumerate() {
+                let o = k * UNIFORM_STRIDE as usize;
+                bytes[o..o + 64].copy_from_slice(bytemuck::bytes_of(d));
+            }
+            self.draws.ensure(&self.device, bytes.len() as u64);
+            self.queue.write_buffer(&self.draws.buffer, 0, &bytes);
+        }
+        let mut params = vec![0u8; batches.max(1) as usize * UNIFORM_STRIDE as usize];
+        for b in 0..batches {
+            let o = (b as u64 * UNIFORM_STRIDE) as usize;
+            params[o..o + 16].copy_from_slice(bytemuck::bytes_of(&BlurParams { batch: b, _pad: [0; 3] }));
+        }
+        self.blur_params.ensure(&self.device, params.len() as u64);
+        self.queue.write_buffer(&self.blur_params.buffer, 0, &params);
+        self.scratch.ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+
+        let atlas_index = self.atlas(atlas_side);
+        let atlas_view = &self.atlases[atlas_index].2;
+        let max_w = jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
+        let max_h = jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
+        let groups = (max_w.div_ceil(WORKGROUP), max_h.div_ceil(WORKGROUP), jobs.len() as u32);
+
+        let view_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("capture view"),
+            layout: &self.capture_pipes.view_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.views.buffer,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(16),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.prims.buffer.as_entire_binding(),
+                },
+            ],
+        });
+        let draw_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("capture mesh draw"),
+            layout: &self.capture_pipes.draw_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.draws.buffer,
+                    offset: 0,
+                    size: std::num::NonZeroU64::new(64),
+                }),
+            }],
+        });
+        let blur_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("blur"),
+            layout: &self.acc.blur_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.records.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(atlas_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.scratch.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.blur_params.buffer,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(16),
+                    }),
+                },
+            ],
+        });
+        let merge_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("merge"),
+            layout: &self.acc.merge_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.records.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.scratch.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.pool.as_entire_binding(),
+                },
+            ],
+        });
+        let normals_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("normals"),
+            layout: &self.acc.normals_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.records.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.pool.as_entire_binding(),
+                },
+            ],
+        });
+
+        let ts = if self.profiling { self.timestamps.as_ref() } else { None };
+        let mut stages: Vec<Stage> = Vec::new();
+        let next_query = |stage: Stage, stages: &mut Vec<Stage>| -> Option<u32> {
+            let ts = ts?;
+            let q = stages.len() as u32 * 2;
+            if q + 2 > ts.capacity {
+                return None;
+            }
+            stages.push(stage);
+            Some(q)
+        };
+
+        let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("snow update"),
+        });
+        for batch in 0..batches {
+            let q = next_query(Stage::Capture, &mut stages);
+            {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("capture"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: atlas_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: q.map(|q| wgpu::RenderPassTimestampWrites {
+                        query_set: &ts.expect("query implies timestamps").set,
+                        beginning_of_pass_write_index: Some(q),
+                        end_of_pass_write_index: Some(q + 1),
+                    }),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                for (k, &j) in captured.iter().enumerate() {
+                    let job = &jobs[j];
+                    let r = &job.record;
+                    if r.batch != batch {
+                        continue;
+                    }
+                    pass.set_viewport(r.atlas_x as f32, r.atlas_y as f32, r.width as f32, r.height as f32, 0.0, 1.0);
+                    pass.set_scissor_rect(r.atlas_x, r.atlas_y, r.width, r.height);
+                    pass.set_bind_group(0, &view_bg, &[(k as u64 * UNIFORM_STRIDE) as u32]);
+                    if !job.prims.is_empty() {
+                        pass.set_pipeline(&self.capture_pipes.primitives);
+                        pass.draw(0..6, job.prims.clone());
+                    }
+                    if !job.draws.is_empty() {
+                        pass.set_pipeline(&self.capture_pipes.meshes);
+                        for d in job.draws.clone() {
+                            let mesh = self.meshes[draws[d as usize].1.0 as usize]
+                                .as_ref()
+                                .expect("mesh checked at the start of the step");
+                            pass.set_bind_group(1, &draw_bg, &[(d as u64 * UNIFORM_STRIDE) as u32]);
+                            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                            pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+                        }
+                    }
+                }
+            }
+            let q = next_query(Stage::Blur, &mut stages);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("blur"),
+                timestamp_writes: q.map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: &ts.expect("query implies timestamps").set,
+                    beginning_of_pass_write_index: Some(q),
+                    end_of_pass_write_index: Some(q + 1),
+                }),
+            });
+            pass.set_pipeline(&self.acc.blur);
+            pass.set_bind_group(0, &blur_bg, &[(batch as u64 * UNIFORM_STRIDE) as u32]);
+            pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+        }
+        for (stage, pipeline, bg) in [
+            (Stage::Merge, &self.acc.merge, &merge_bg),
+            (Stage::Normals, &self.acc.normals, &normals_bg),
+        ] {
+            let q = next_query(stage, &mut stages);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(match stage {
+                    Stage::Merge => "merge",
+                    _ => "normals",
+                }),
+                timestamp_writes: q.map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: &ts.expect("query implies timestamps").set,
+                    beginning_of_pass_write_index: Some(q),
+                    end_of_pass_write_index: Some(q + 1),
+                }),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+        }
+        if let (Some(ts), false) = (ts, stages.is_empty()) {
+            let n = stages.len() as u32 * 2;
+            enc.resolve_query_set(&ts.set, 0..n, &ts.resolve, 0);
+            enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.readback, 0, n as u64 * 8);
+        }
+        self.queue.submit([enc.finish()]);
+        stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
+
+        // The new heightmap is now the other half of each pair.
+        for job in &jobs {
+            if let Some(state) = self.surfaces[job.surface].as_mut() {
+                state.parity ^= 1;
+            }
+        }
+        self.last = LastFrame {
+            captured: captured
+                .iter()
+                .enumerate()
+                .map(|(k, &j)| (jobs[j].surface, jobs[j].record, placements[k]))
+                .collect(),
+            last_batch: batches.saturating_sub(1),
+            atlas_side,
+        };
+        if let (Some(ts), false) = (ts, stages.is_empty()) {
+            let bytes = self.read_buffer(&ts.readback, 0, stages.len() as u64 * 16)?;
+            let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+            let mut t = StageTimes::default();
+            for (i, stage) in stages.iter().enumerate() {
+                let ms = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * ts.period_ns as f64 * 1e-6;
+                match stage {
+                    Stage::Capture => t.capture_ms += ms,
+                    Stage::Blur => t.blur_ms += ms,
+                    Stage::Merge => t.merge_ms += ms,
+                    Stage::Normals => t.normals_ms += ms,
+                }
+            }
+            stats.gpu = Some(t);
+        }
+        Ok(stats)
+    }
+
+    /// Map a buffer (MAP_READ) range and copy it out, waiting for the GPU.
+    fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<u8>> {
+        let slice = buffer.slice(offset..offset + size);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| SnowError::Readback(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| SnowError::Readback(e.to_string()))?
+            .map_err(|e| SnowError::Readback(e.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| SnowError::Readback(format!("{e:?}")))?
+            .to_vec();
+        buffer.unmap();
+        Ok(data)
+    }
+
+    /// Copy `size` bytes of a GPU buffer to the CPU.
+    fn download(&self, source: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<u8>> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(source, offset, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        self.read_buffer(&staging, 0, size)
+    }
+
+    /// The packed texels of a surface's current heightmap (depression low 16 bits, displaced high).
+    pub fn read_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
+        let s = self.state(id)?;
+        let bytes = self.download(&self.pool, s.slot.region_bytes(s.parity as u64), s.layout.texels() * 4)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// Read a surface's current heightmap back to the CPU (waits for the GPU).
+    pub fn read_heightmap(&self, id: SurfaceId) -> Result<Heightmap> {
+        let s = self.state(id)?;
+        let packed = self.read_packed(id)?;
+        Ok(Heightmap::from_packed(s.layout.width, s.layout.height, &packed))
+    }
+
+    /// Read a surface's packed normals (see [`crate::accumulate::cpu::unpack_normal`]).
+    pub fn read_normals_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
+        let s = self.state(id)?;
+        let bytes = self.download(&self.pool, s.slot.region_bytes(2), s.layout.texels() * 4)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// Read a surface's normals in its local frame.
+    pub fn read_normals(&self, id: SurfaceId) -> Result<Vec<glam::Vec3>> {
+        Ok(self
+            .read_normals_packed(id)?
+            .into_iter()
+            .map(accumulate::cpu::unpack_normal)
+            .collect())
+    }
+
+    /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing), when
+    /// it was captured in that step's last atlas batch; `None` otherwise.
+    pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        let Some(&(_, r, placement)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
+            return Ok(None);
+        };
+        if placement.batch != self.last.last_batch {
+            return Ok(None);
+        }
+        let Some((_, texture, _)) = self.atlases.iter().find(|a| a.0 == self.last.atlas_side) else {
+            return Ok(None);
+        };
+        // Depth textures can only be copied whole.
+        let side = self.last.atlas_side;
+        let row_bytes = side * 4;
+        let size = row_bytes as u64 * side as u64;
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("capture readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::DepthOnly,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row_bytes),
+                    rows_per_image: Some(side),
+                },
+            },
+            wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+        );
+        self.queue.submit([enc.finish()]);
+        let bytes = self.read_buffer(&staging, 0, size)?;
+        let mut out = Vec::with_capacity((r.width * r.height) as usize);
+        for row in 0..r.height as usize {
+            let start = (r.atlas_y as usize + row) * row_bytes as usize + r.atlas_x as usize * 4;
+            let line: &[f32] = bytemuck::cast_slice(&bytes[start..start + r.width as usize * 4]);
+            out.extend_from_slice(line);
+        }
+        Ok(Some(out))
+    }
+
+    /// Debug readback of the last step: the blurred capture (stage 1 output) of a surface, when it
+    /// was captured in that step.
+    pub fn read_last_blurred(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        let Some(&(_, r, _)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
+            return Ok(None);
+        };
+        let bytes = self.download(&self.scratch.buffer, r.scratch as u64 * 4, (r.width * r.height) as u64 * 4)?;
+        Ok(Some(bytemuck::cast_slice(&bytes).to_vec()))
+    }
+
+    /// Pool placement of a surface's slot, for renderers that read the heightmap on the GPU:
+    /// `(current heights element offset, normals element offset)`. Valid until the next step.
+    pub fn gpu_offsets(&self, id: SurfaceId) -> Result<(u32, u32)> {
+        let s = self.state(id)?;
+        Ok((s.slot.region(s.parity as u64), s.slot.region(2)))
+    }
+
+    /// The pool buffer (`array<u32>` in WGSL), for renderers that sample heightmaps on the GPU.
+    pub fn pool_buffer(&self) -> &wgpu::Buffer {
+        &self.pool
+    }
+
+    /// The device's capabilities as checked at start.
+    pub fn capabilities(&self) -> &Capabilities {
+        &self.caps
+    }
+}

@@ -1,0 +1,458 @@
+//! The deformation core on the GPU: every stage against its CPU reference, and analytic cases
+//! computed by hand.
+
+mod common;
+
+use glam::{Quat, Vec2, Vec3};
+use snowprint::accumulate::cpu::{self as acc_cpu, BlurInput};
+use snowprint::capture::{self, CaptureVolume, cpu as cap_cpu};
+use snowprint::{
+    CaptureConfig, CaptureMode, Deformer, Mesh, Pose, Shape, SnowError, SnowWorld, SurfaceDesc,
+    WorldConfig,
+};
+
+const ANKLE: f32 = 0.25;
+
+fn world(mode: CaptureMode) -> SnowWorld {
+    SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            capture: CaptureConfig {
+                mode,
+                ankle_height: ANKLE,
+                mask_depth: 0.6,
+            },
+            pool_bytes: 16 << 20,
+            ..Default::default()
+        },
+    )
+    .expect("world")
+}
+
+fn volume(desc: &SurfaceDesc) -> CaptureVolume {
+    CaptureVolume {
+        world_to_local: desc.world_to_local(),
+        half_size: desc.size * 0.5,
+        frustum_height: desc.snow_depth + ANKLE,
+    }
+}
+
+fn blur_input(desc: &SurfaceDesc, mode: CaptureMode) -> BlurInput {
+    let l = desc.layout();
+    BlurInput {
+        width: l.width,
+        height: l.height,
+        mode,
+        mask_fraction: 0.6,
+        snow_depth: desc.snow_depth,
+        frustum_height: desc.snow_depth + ANKLE,
+    }
+}
+
+/// A mixed set of analytic deformers over a surface centred at `c` (ground height c.y).
+fn crowd(c: Vec3) -> Vec<Deformer> {
+    vec![
+        Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at((c + Vec3::new(-0.8, 0.2, 0.3)).into())),
+        Deformer::moving(
+            Shape::Sphere { radius: 0.15 },
+            Pose::at((c + Vec3::new(0.2, 0.1, -0.9)).into()),
+            Pose::at((c + Vec3::new(1.3, 0.05, -0.4)).into()),
+        ),
+        Deformer::new(
+            Shape::Capsule { radius: 0.1, half_height: 0.4 },
+            Pose {
+                position: c + Vec3::new(0.6, 0.12, 0.7),
+                rotation: Quat::from_euler(glam::EulerRot::YXZ, 0.5, 0.3, 1.2),
+            },
+        ),
+        Deformer::new(
+            Shape::Box { half_extents: Vec3::new(0.3, 0.1, 0.15) },
+            Pose {
+                position: c + Vec3::new(-1.2, 0.15, -0.8),
+                rotation: Quat::from_euler(glam::EulerRot::YXZ, 0.7, 0.2, -0.3),
+            },
+        ),
+        // Sunk into the ground.
+        Deformer::new(Shape::Sphere { radius: 0.4 }, Pose::at((c + Vec3::new(1.4, -0.25, 0.9)).into())),
+        // Above the frustum: leaves nothing.
+        Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at((c + Vec3::new(0.0, 0.3 + ANKLE + 0.21, 0.0)).into())),
+    ]
+}
+
+/// Every stage of one update against its CPU reference, on several sizes, non-square and yawed.
+#[test]
+fn every_stage_matches_its_cpu_reference() {
+    for (size, yaw) in [([4.0, 3.0], 0.0), ([3.3, 2.1], 30.0), ([1.0, 4.5], -75.0), ([6.0, 6.0], 0.0)] {
+        let mut w = world(CaptureMode::Depth);
+        let mut desc = SurfaceDesc::new("s", [2.0, 1.0, -3.0], size, 0.3);
+        desc.yaw_degrees = yaw;
+        desc.replenish_rate = 0.5;
+        let id = w.add_surface(desc.clone()).unwrap();
+        let deformers = crowd(desc.center);
+        let l = desc.layout();
+        // Two frames: the second merges into a non-empty history and replenishes.
+        let mut before = vec![0u32; l.texels() as usize];
+        for frame in 0..2 {
+            let dt = 0.1;
+            let stats = w.step(dt, &deformers[frame..]).unwrap();
+            assert_eq!(stats.updated, 1);
+            let vol = volume(&desc);
+            let mut prims = vec![];
+            for d in &deformers[frame..] {
+                capture::push_primitives(d, &vol, &mut prims);
+            }
+            // Capture.
+            let gpu_cap = w.read_last_capture(id).unwrap().expect("captured in the last batch");
+            let cpu_cap = cap_cpu::capture(l.width, l.height, vol.half_size, vol.frustum_height, &prims, &[]);
+            let mut coverage_mismatch = 0;
+            for (g, c) in gpu_cap.iter().zip(&cpu_cap) {
+                if (*g < 1.0) != (*c < 1.0) {
+                    coverage_mismatch += 1;
+                } else {
+                    assert!((g - c).abs() < 2e-5, "capture {g} vs cpu {c} ({size:?})");
+                }
+            }
+            assert!(coverage_mismatch * 1000 <= gpu_cap.len(), "{coverage_mismatch} texels differ in coverage");
+            assert!(gpu_cap.iter().any(|&d| d < 1.0), "something was captured");
+            // Stage 1.
+            let inp = blur_input(&desc, CaptureMode::Depth);
+            let gpu_blur = w.read_last_blurred(id).unwrap().unwrap();
+            let cpu_blur = acc_cpu::blur(&inp, &gpu_cap);
+            for (g, c) in gpu_blur.iter().zip(&cpu_blur) {
+                assert!((g - c).abs() < 1e-5, "blur {g} vs {c}");
+            }
+            // Stage 2: 0.5/s x 0.1 s x 65535 = 3276.75 units, applied whole, 0.75 carried.
+            let units = if frame == 0 { 3276 } else { 3277 };
+            let gpu_heights = w.read_packed(id).unwrap();
+            let cpu_heights = acc_cpu::merge(&before, Some(&gpu_blur), units);
+            for (g, c) in gpu_heights.iter().zip(&cpu_heights) {
+                let dd = ((g & 0xffff) as i32 - (c & 0xffff) as i32).abs();
+                let dg = ((g >> 16) as i32 - (c >> 16) as i32).abs();
+                assert!(dd <= 1 && dg <= 1, "merge {g:x} vs {c:x}");
+            }
+            // Normals.
+            let texel = desc.size / Vec2::new(l.width as f32, l.height as f32);
+            let cpu_n = acc_cpu::normals(&gpu_heights, l.width, l.height, desc.snow_depth, texel.x, texel.y);
+            let gpu_n = w.read_normals_packed(id).unwrap();
+            for (g, c) in gpu_n.iter().zip(&cpu_n) {
+                let (gx, gz) = acc_cpu::unpack2x16snorm(*g);
+                let (cx, cz) = acc_cpu::unpack2x16snorm(*c);
+                assert!((gx - cx).abs() < 1e-3 && (gz - cz).abs() < 1e-3, "normal {gx},{gz} vs {cx},{cz}");
+            }
+            before = gpu_heights;
+        }
+    }
+}
+
+/// Mesh deformers rasterized from below agree with ray casts, including a mesh sunk below the
+/// ground, where the back faces seen through the cut must fill the ground and never leak the
+/// far side.
+#[test]
+fn mesh_capture_matches_cpu_and_clamps_to_the_ground() {
+    let mut w = world(CaptureMode::Depth);
+    let desc = SurfaceDesc::new("m", [0.0, 0.0, 0.0], [3.0, 2.0], 0.3);
+    let id = w.add_surface(desc.clone()).unwrap();
+    let sphere = Mesh::uv_sphere(0.4, 24, 48);
+    let boxy = Mesh::cuboid(Vec3::new(0.25, 0.2, 0.15));
+    let ms = w.add_mesh("sphere", &sphere).unwrap();
+    let mb = w.add_mesh("box", &boxy).unwrap();
+    let poses = [
+        (ms, &sphere, Pose::at([-0.7, -0.2, 0.0])),
+        (mb, &boxy, Pose { position: Vec3::new(0.7, 0.1, 0.2), rotation: Quat::from_rotation_y(0.6) * Quat::from_rotation_x(0.4) }),
+    ];
+    let deformers: Vec<Deformer> = poses.iter().map(|(m, _, p)| Deformer::new(Shape::Mesh(*m), *p)).collect();
+    w.step(1.0 / 60.0, &deformers).unwrap();
+    let l = desc.layout();
+    let vol = volume(&desc);
+    let mut tris = vec![];
+    for (_, mesh, pose) in &poses {
+        let m = vol.world_to_local * glam::Mat4::from_rotation_translation(pose.rotation, pose.position);
+        let t = mesh.transformed(m);
+        for i in t.indices.chunks(3) {
+            tris.push([t.positions[i[0] as usize], t.positions[i[1] as usize], t.positions[i[2] as usize]]);
+        }
+    }
+    let gpu_cap = w.read_last_capture(id).unwrap().unwrap();
+    let cpu_cap = cap_cpu::capture(l.width, l.height, vol.half_size, vol.frustum_height, &[], &tris);
+    let mut mismatch = 0;
+    for (g, c) in gpu_cap.iter().zip(&cpu_cap) {
+        if (*g < 1.0) != (*c < 1.0) || (g - c).abs() > 1e-4 {
+            mismatch += 1;
+        }
+    }
+    // Only texels whose centre lies on a triangle edge may differ.
+    assert!(mismatch * 100 <= gpu_cap.len(), "{mismatch} of {} texels differ", gpu_cap.len());
+    // The sunk sphere (centre 0.2 below the ground, radius 0.4) fills a disc of radius
+    // sqrt(0.16 - 0.04) = 0.346 at ground level with depth 0, and nothing outside it.
+    let texel = 3.0 / l.width as f32;
+    for row in 0..l.height {
+        for col in 0..l.width {
+            let c = cap_cpu::texel_center(col, row, l.width, l.height, vol.half_size);
+            let d = (c - Vec2::new(-0.7, 0.0)).length();
+            let v = gpu_cap[(row * l.width + col) as usize];
+            if d < 0.346 - texel {
+                assert_eq!(v, 0.0, "inside the cross-section at {c:?}");
+            } else if d > 0.346 + texel && d < 1.0 {
+                assert_eq!(v, 1.0, "outside the cross-section at {c:?}");
+            }
+        }
+    }
+}
+
+/// The analytic depression of a sphere: clamp((top - (c - sqrt(r^2 - d^2))) / D, 0, 1).
+fn sphere_depression(top: f32, c: f32, r: f32, d: f32, depth: f32) -> f32 {
+    if d >= r {
+        return 0.0;
+    }
+    ((top - (c - (r * r - d * d).sqrt())) / depth).clamp(0.0, 1.0)
+}
+
+/// Each texel lies within the analytic values of its 3x3 neighbourhood (the capture samples texel
+/// centres, the blur mixes the 3x3 centres around a texel), give or take one unit of quantization.
+/// Each centre is also probed 0.5 mm away, so that a centre lying exactly on a rim (where the
+/// depression jumps) may fall on either side of it, as it may on the GPU.
+fn assert_within_blur_spread(map: &snowprint::Heightmap, half: Vec2, analytic: impl Fn(Vec2) -> f32) {
+    let (w, h) = (map.width, map.height);
+    let mut checked = 0;
+    let probes = [Vec2::ZERO, Vec2::X, -Vec2::X, Vec2::Y, -Vec2::Y].map(|v| v * 5e-4);
+    for row in 0..h {
+        for col in 0..w {
+            let mut lo = f32::MAX;
+            let mut hi = f32::MIN;
+            for dy in -1i32..=1 {
+                for dx in -1i32..=1 {
+                    let (x, y) = ((col as i32 + dx).clamp(0, w as i32 - 1), (row as i32 + dy).clamp(0, h as i32 - 1));
+                    let n = cap_cpu::texel_center(x as u32, y as u32, w, h, half);
+                    for p in probes {
+                        let v = analytic(n + p);
+                        lo = lo.min(v);
+                        hi = hi.max(v);
+                    }
+                }
+            }
+            let got = map.fraction(col, row);
+            let unit = 1.5 / 65535.0;
+            assert!(got >= lo - unit && got <= hi + unit, "texel ({col},{row}): {got} not in [{lo}, {hi}]");
+            if hi > 0.0 {
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 50, "the deformer touched only {checked} texels");
+}
+
+#[test]
+fn sphere_leaves_the_analytic_depression() {
+    let mut w = world(CaptureMode::Depth);
+    let depth = 0.3;
+    let desc = SurfaceDesc::new("a", [0.0, 5.0, 0.0], [2.0, 2.0], depth);
+    let id = w.add_surface(desc.clone()).unwrap();
+    let (r, c) = (0.35f32, 0.2f32); // centre 0.2 above the ground: bottom 0.15 below it... clamped
+    for (r, c) in [(r, c), (0.25, 0.3), (0.5, 0.62)] {
+        let mut w2 = world(CaptureMode::Depth);
+        let id2 = w2.add_surface(desc.clone()).unwrap();
+        w2.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: r }, Pose::at([0.1, 5.0 + c, -0.2]))]).unwrap();
+        let map = w2.read_heightmap(id2).unwrap();
+        assert_within_blur_spread(&map, Vec2::ONE, |p| {
+            sphere_depression(depth, c, r, (p - Vec2::new(0.1, -0.2)).length(), depth)
+        });
+    }
+    // Untouched surface reads all zero.
+    assert!(w.read_heightmap(id).unwrap().depression.iter().all(|&v| v == 0));
+}
+
+#[test]
+fn dragged_sphere_leaves_a_trench_with_the_same_cross_section() {
+    let mut w = world(CaptureMode::Depth);
+    let depth = 0.3;
+    let desc = SurfaceDesc::new("t", [0.0, 0.0, 0.0], [4.0, 2.0], depth);
+    let id = w.add_surface(desc.clone()).unwrap();
+    let (r, c, z0) = (0.2f32, 0.15f32, 0.1f32);
+    let frames = 40;
+    let pos = |f: u32| Pose::at([-1.5 + 3.0 * f as f32 / frames as f32, c, z0]);
+    for f in 1..=frames {
+        w.step(1.0 / 60.0, &[Deformer::moving(Shape::Sphere { radius: r }, pos(f - 1), pos(f))]).unwrap();
+    }
+    let map = w.read_heightmap(id).unwrap();
+    // Distance from the segment the centre travelled.
+    assert_within_blur_spread(&map, Vec2::new(2.0, 1.0), |p| {
+        let x = p.x.clamp(-1.5, 1.5);
+        sphere_depression(depth, c, r, (p - Vec2::new(x, z0)).length(), depth)
+    });
+}
+
+#[test]
+fn replenishment_refills_at_the_given_rate() {
+    let mut w = world(CaptureMode::Depth);
+    let mut desc = SurfaceDesc::new("r", [0.0, 0.0, 0.0], [1.0, 1.0], 0.3);
+    desc.replenish_rate = 0.05;
+    let id = w.add_surface(desc).unwrap();
+    // Press the middle fully to the ground with a sunk sphere, in a step of dt = 0.
+    w.step(0.0, &[Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, -0.1, 0.0]))]).unwrap();
+    let centre = |w: &SnowWorld| {
+        let m = w.read_heightmap(id).unwrap();
+        m.depression[(m.height / 2 * m.width + m.width / 2) as usize]
+    };
+    assert_eq!(centre(&w), 65535);
+    let dt = 1.0 / 60.0f32;
+    for n in 1..=600u32 {
+        w.step(dt, &[]).unwrap();
+        if n % 150 == 0 {
+            let t = n as f64 * dt as f64;
+            let expect = (1.0 - 0.05 * t).max(0.0) * 65535.0;
+            let got = centre(&w) as f64;
+            assert!((got - expect).abs() <= 1.0, "after {t} s: {got} vs {expect}");
+        }
+    }
+    // After 20 s at 5 %/s it is untouched again; 600 frames = 10 s, half refilled.
+    for _ in 0..700 {
+        w.step(dt, &[]).unwrap();
+    }
+    assert_eq!(centre(&w), 0);
+}
+
+#[test]
+fn deformer_above_the_ankle_zone_leaves_nothing() {
+    let mut w = world(CaptureMode::Depth);
+    let desc = SurfaceDesc::new("h", [0.0, 2.0, 0.0], [2.0, 2.0], 0.3);
+    let id = w.add_surface(desc).unwrap();
+    let top_of_frustum = 2.0 + 0.3 + ANKLE;
+    let d = [
+        Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([0.0, top_of_frustum + 0.2 + 1e-3, 0.0])),
+        // Inside the ankle zone but above the snow: captured, yet it presses nothing.
+        Deformer::new(Shape::Box { half_extents: Vec3::splat(0.1) }, Pose::at([0.5, 2.3 + 0.11, 0.5])),
+    ];
+    let stats = w.step(1.0 / 60.0, &d).unwrap();
+    assert_eq!(stats.primitives, 1, "the sphere above the frustum is culled");
+    assert!(w.read_heightmap(id).unwrap().depression.iter().all(|&v| v == 0));
+}
+
+#[test]
+fn sunk_sphere_flattens_exactly_its_ground_cross_section() {
+    let mut w = world(CaptureMode::Depth);
+    let desc = SurfaceDesc::new("g", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
+    let id = w.add_surface(desc.clone()).unwrap();
+    // Centre 0.3 below the ground, radius 0.5: cross-section radius 0.4 at the ground.
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, -0.3, 0.0]))]).unwrap();
+    let map = w.read_heightmap(id).unwrap();
+    let l = desc.layout();
+    let texel = 2.0 / l.width as f32;
+    let (mut inside, mut outside) = (0, 0);
+    for row in 0..l.height {
+        for col in 0..l.width {
+            let c = cap_cpu::texel_center(col, row, l.width, l.height, Vec2::ONE);
+            let d = c.length();
+            let v = map.depression[(row * l.width + col) as usize];
+            if d < 0.4 - 1.5 * texel {
+                assert_eq!(v, 65535, "inside at {c:?}");
+                inside += 1;
+            } else if d > 0.4 + 1.5 * texel {
+                assert_eq!(v, 0, "outside at {c:?}");
+                outside += 1;
+            }
+        }
+    }
+    assert!(inside > 100 && outside > 100);
+}
+
+#[test]
+fn surfaces_side_by_side_each_see_only_what_is_over_them() {
+    let mut w = world(CaptureMode::Depth);
+    let a = w.add_surface(SurfaceDesc::new("a", [-1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    let b = w.add_surface(SurfaceDesc::new("b", [1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    // Only over a:
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([-1.0, 0.1, 0.0]))]).unwrap();
+    assert!(w.read_heightmap(a).unwrap().depression.iter().any(|&v| v > 0));
+    assert!(w.read_heightmap(b).unwrap().depression.iter().all(|&v| v == 0));
+    // On a fresh pair, a box straddling the seam at x = 0: a sees its right edge, b its left edge,
+    // nothing else.
+    let mut w = world(CaptureMode::Depth);
+    let a = w.add_surface(SurfaceDesc::new("a", [-1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    let b = w.add_surface(SurfaceDesc::new("b", [1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Box { half_extents: Vec3::new(0.3, 0.5, 0.3) }, Pose::at([0.0, 0.0, 0.5]))]).unwrap();
+    let (ma, mb) = (w.read_heightmap(a).unwrap(), w.read_heightmap(b).unwrap());
+    let l = ma.width;
+    let pressed_cols = |m: &snowprint::Heightmap| {
+        (0..m.width).filter(|&c| (0..m.height).any(|r| m.depression[(r * m.width + c) as usize] == 65535)).collect::<Vec<_>>()
+    };
+    let ca = pressed_cols(&ma);
+    let cb = pressed_cols(&mb);
+    // 0.3 m of box over each side at 4 cm texels: 7 full columns (the eighth is blurred).
+    assert!(ca.iter().all(|&c| c >= l - 8) && ca.len() >= 6, "a: {ca:?}");
+    assert!(cb.iter().all(|&c| c < 8) && cb.len() >= 6, "b: {cb:?}");
+}
+
+#[test]
+fn mask_capture_presses_a_fixed_imprint() {
+    let mut w = world(CaptureMode::Mask);
+    let desc = SurfaceDesc::new("k", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
+    let id = w.add_surface(desc.clone()).unwrap();
+    // A sphere that barely dips into the snow still presses the full mask depth.
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, 0.55, 0.0]))]).unwrap();
+    let map = w.read_heightmap(id).unwrap();
+    let centre = map.depression[(map.height / 2 * map.width + map.width / 2) as usize];
+    assert_eq!(centre as u32, acc_cpu::to_units(0.6));
+    assert_eq!(*map.depression.iter().max().unwrap() as u32, acc_cpu::to_units(0.6));
+    assert_eq!(map.depression[0], 0);
+}
+
+#[test]
+fn displaced_snow_accounts_for_what_was_pressed() {
+    let mut w = world(CaptureMode::Depth);
+    let id = w.add_surface(SurfaceDesc::new("v", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    for k in 0..10 {
+        let x = -0.5 + 0.1 * k as f32;
+        w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([x, 0.2, 0.0]))]).unwrap();
+    }
+    // With no snowfall, every unit pressed out of a texel is counted once in the displaced channel.
+    let map = w.read_heightmap(id).unwrap();
+    assert!(map.pressed_volume() > 10.0);
+    assert_eq!(map.depression, map.displaced);
+}
+
+#[test]
+fn pool_exhaustion_is_an_error_not_a_panic() {
+    let mut w = SnowWorld::new(common::gpu(), WorldConfig { pool_bytes: 1 << 20, ..Default::default() }).unwrap();
+    // 8 m x 6 m = 200 x 150 texels = 360,192 bytes a slot: two fit in 1 MiB, the third does not.
+    let a = w.add_surface(SurfaceDesc::new("a", [0.0; 3], [8.0, 6.0], 0.3)).unwrap();
+    w.add_surface(SurfaceDesc::new("b", [10.0, 0.0, 0.0], [8.0, 6.0], 0.3)).unwrap();
+    let e = w.add_surface(SurfaceDesc::new("c", [20.0, 0.0, 0.0], [8.0, 6.0], 0.3)).unwrap_err();
+    assert!(matches!(e, SnowError::PoolExhausted { needed: 360_192, .. }), "{e}");
+    assert_eq!(w.memory().pool_used, 2 * 360_192);
+    // Freed memory is reused, and a reused slot starts untouched.
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, 0.1, 0.0]))]).unwrap();
+    w.remove_surface(a).unwrap();
+    let c = w.add_surface(SurfaceDesc::new("c", [20.0, 0.0, 0.0], [8.0, 6.0], 0.3)).unwrap();
+    assert!(w.read_heightmap(c).unwrap().depression.iter().all(|&v| v == 0));
+    assert!(matches!(w.read_heightmap(a), Err(SnowError::StaleHandle { .. })) || a == c);
+}
+
+#[test]
+fn yawed_surface_maps_world_to_its_texels() {
+    let mut w = world(CaptureMode::Depth);
+    let mut desc = SurfaceDesc::new("y", [3.0, 0.0, 3.0], [4.0, 2.0], 0.3);
+    desc.yaw_degrees = 90.0;
+    let id = w.add_surface(desc.clone()).unwrap();
+    // Local (x = 1.5, z = -0.5) after a 90 degree yaw about +Y is world offset (-0.5, 0, -1.5):
+    // x' = x cos + z sin, z' = -x sin + z cos.
+    let local = Vec3::new(1.5, 0.0, -0.5);
+    let world_p = desc.center + Quat::from_rotation_y(90f32.to_radians()) * local;
+    assert!((world_p - Vec3::new(2.5, 0.0, 1.5)).length() < 1e-5);
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([world_p.x, 0.0, world_p.z]))]).unwrap();
+    let map = w.read_heightmap(id).unwrap();
+    let (col, row) = ((1.5 + 2.0) / 4.0 * map.width as f32, (-0.5 + 1.0) / 2.0 * map.height as f32);
+    let (imax, _) = map.depression.iter().enumerate().max_by_key(|(_, v)| **v).unwrap();
+    let (mc, mr) = ((imax as u32 % map.width) as f32, (imax as u32 / map.width) as f32);
+    assert!((mc + 0.5 - col).abs() <= 1.5 && (mr + 0.5 - row).abs() <= 1.5, "peak at {mc},{mr}, expected {col},{row}");
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let mut w = world(CaptureMode::Depth);
+    assert!(matches!(w.step(f32::NAN, &[]), Err(SnowError::InvalidTimeStep { .. })));
+    let e = w.step(0.1, &[Deformer::new(Shape::Sphere { radius: -1.0 }, Pose::at([0.0; 3]))]).unwrap_err();
+    assert!(e.to_string().contains("radius"), "{e}");
+    assert!(w.add_surface(SurfaceDesc::new("z", [0.0; 3], [0.0, 1.0], 0.3)).is_err());
+    let m = w.add_mesh("cube", &Mesh::cuboid(Vec3::ONE)).unwrap();
+    assert!(matches!(w.pose_mesh(m, &[Vec3::ZERO; 3]), Err(SnowError::PoseMismatch { .. })));
+}
