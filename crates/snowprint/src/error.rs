@@ -116,6 +116,12 @@ pub enum SnowError {
         /// Vertices of the mesh.
         expected: usize,
     },
+    /// A surface was listed twice in one update.
+    #[error("surface {index} is listed twice in one update; list each surface once")]
+    DuplicateUpdate {
+        /// The surface's index.
+        index: u32,
+    },
     /// A scene file is not valid.
     #[error("{0}")]
     Scene(String),

@@ -39,4 +39,4 @@ pub use gpu::{Capabilities, GpuContext, GpuOptions};
 pub use heightmap::Heightmap;
 pub use mesh::{Mesh, MeshId};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
-pub use world::{CaptureConfig, CaptureMode, FrameStats, SnowWorld, WorldConfig};
+pub use world::{CaptureConfig, CaptureMode, FrameStats, MemoryReport, SnowWorld, StageTimes, SurfaceUpdate, WorldConfig};

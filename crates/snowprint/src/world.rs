@@ -129,6 +129,17 @@ pub struct MemoryReport {
     pub frame_tables: u64,
 }
 
+/// One surface's share of a [`SnowWorld::update`].
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceUpdate<'a> {
+    /// The surface.
+    pub surface: SurfaceId,
+    /// Seconds since the surface was last updated (for replenishment).
+    pub elapsed: f32,
+    /// Everything that touched it since then, with motion (`previous`) where known.
+    pub deformers: &'a [Deformer],
+}
+
 struct SurfaceState {
     desc: SurfaceDesc,
     layout: SurfaceLayout,
@@ -511,24 +522,58 @@ impl SnowWorld {
 
     /// Advance every surface by `dt` seconds with the deformers as posed at the end of the frame.
     pub fn step(&mut self, dt: f32, deformers: &[Deformer]) -> Result<FrameStats> {
-        let start = Instant::now();
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(SnowError::InvalidTimeStep { dt });
         }
         for (i, d) in deformers.iter().enumerate() {
             d.validate(&format!("#{i}"))?;
-            if let Shape::Mesh(id) = d.shape
-                && self.meshes.get(id.0 as usize).and_then(Option::as_ref).is_none()
-            {
-                return Err(SnowError::StaleHandle { what: "mesh", index: id.0 });
+        }
+        let updates: Vec<SurfaceUpdate<'_>> = self
+            .surfaces()
+            .map(|(surface, _)| SurfaceUpdate {
+                surface,
+                elapsed: dt,
+                deformers,
+            })
+            .collect();
+        self.update(&updates)
+    }
+
+    /// Update chosen surfaces, each with its own deformers and the time since its last update
+    /// (snow replenishes by that much). Surfaces not listed keep their heightmap untouched. This is
+    /// what a manager with a per-frame budget calls; [`SnowWorld::step`] updates every surface.
+    /// Everything is checked before anything changes.
+    pub fn update(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<FrameStats> {
+        let start = Instant::now();
+        let mut seen = vec![false; self.surfaces.len()];
+        for u in updates {
+            let dt = u.elapsed;
+            if !(dt.is_finite() && dt >= 0.0) {
+                return Err(SnowError::InvalidTimeStep { dt });
+            }
+            self.state(u.surface)?;
+            let flag = &mut seen[u.surface.0 as usize];
+            if *flag {
+                return Err(SnowError::DuplicateUpdate { index: u.surface.0 });
+            }
+            *flag = true;
+            for (i, d) in u.deformers.iter().enumerate() {
+                d.validate(&format!("#{i}"))?;
+                if let Shape::Mesh(id) = d.shape
+                    && self.meshes.get(id.0 as usize).and_then(Option::as_ref).is_none()
+                {
+                    return Err(SnowError::StaleHandle { what: "mesh", index: id.0 });
+                }
             }
         }
         let capture_cfg = self.config.capture;
         let mut jobs: Vec<Job> = Vec::new();
         let mut prims: Vec<GpuPrimitive> = Vec::new();
         let mut draws: Vec<(MeshDraw, MeshId)> = Vec::new();
-        for (index, state) in self.surfaces.iter_mut().enumerate() {
-            let Some(state) = state else { continue };
+        for u in updates {
+            let index = u.surface.0 as usize;
+            let (dt, deformers) = (u.elapsed, u.deformers);
+            let Some(state) = self.surfaces[index].as_mut() else { continue };
             state.carry += state.desc.replenish_rate as f64 * dt as f64 * accumulate::cpu::UNITS as f64;
             let units = state.carry.floor().min(u32::MAX as f64);
             state.carry -= units;

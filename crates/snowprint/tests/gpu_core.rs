@@ -456,3 +456,26 @@ fn bad_input_is_an_error() {
     let m = w.add_mesh("cube", &Mesh::cuboid(Vec3::ONE)).unwrap();
     assert!(matches!(w.pose_mesh(m, &[Vec3::ZERO; 3]), Err(SnowError::PoseMismatch { .. })));
 }
+
+#[test]
+fn update_touches_only_the_listed_surfaces() {
+    let mut w = world(CaptureMode::Depth);
+    let mut desc = SurfaceDesc::new("u1", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
+    desc.replenish_rate = 0.1;
+    let a = w.add_surface(desc.clone()).unwrap();
+    desc.name = "u2".into();
+    let b = w.add_surface(desc).unwrap();
+    let sphere = [Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, -0.1, 0.0]))];
+    let stats = w.update(&[snowprint::SurfaceUpdate { surface: a, elapsed: 0.0, deformers: &sphere }]).unwrap();
+    assert_eq!(stats.updated, 1);
+    assert!(w.read_heightmap(a).unwrap().depression.contains(&65535));
+    assert!(w.read_heightmap(b).unwrap().depression.iter().all(|&v| v == 0));
+    // A surface updated late replenishes by all the time it waited: 2 s at 10 %/s.
+    w.update(&[snowprint::SurfaceUpdate { surface: a, elapsed: 2.0, deformers: &[] }]).unwrap();
+    assert_eq!(*w.read_heightmap(a).unwrap().depression.iter().max().unwrap(), 65535 - 13107);
+    let twice = [
+        snowprint::SurfaceUpdate { surface: b, elapsed: 0.0, deformers: &[] },
+        snowprint::SurfaceUpdate { surface: b, elapsed: 0.0, deformers: &[] },
+    ];
+    assert!(matches!(w.update(&twice), Err(SnowError::DuplicateUpdate { .. })));
+}
