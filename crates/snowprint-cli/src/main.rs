@@ -1,8 +1,11 @@
 //! The `snowprint` command: run scenes, the demo and the benchmarks.
+//!
+//! Each subcommand lives in its own module with its own arguments; this file only dispatches and
+//! turns errors into one sentence and a non-zero exit.
 
+mod demo;
 mod simulate;
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -21,29 +24,9 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Run a scene file for a number of frames and dump every surface's heightmap.
-    Simulate {
-        /// Scene file (TOML, see docs/SCENES.md).
-        #[arg(long)]
-        scene: PathBuf,
-        /// Frames to run.
-        #[arg(long)]
-        frames: u32,
-        /// Seconds per frame.
-        #[arg(long, default_value_t = 1.0 / 60.0)]
-        dt: f32,
-        /// Folder for `<surface>.png` (16-bit depression) and `<surface>.json`.
-        #[arg(long)]
-        dump: PathBuf,
-    },
-    /// Run the built-in demo scene and write its heightmaps to `--out`.
-    Demo {
-        /// Output folder.
-        #[arg(long, default_value = "out")]
-        out: PathBuf,
-        /// Frames to run (default: the whole walk).
-        #[arg(long)]
-        frames: Option<u32>,
-    },
+    Simulate(simulate::Args),
+    /// Run the built-in demo and write its outputs.
+    Demo(demo::Args),
 }
 
 fn main() -> ExitCode {
@@ -59,13 +42,8 @@ fn main() -> ExitCode {
         adapter: cli.adapter.clone(),
     };
     let result = match cli.command {
-        Command::Simulate {
-            scene,
-            frames,
-            dt,
-            dump,
-        } => simulate::run(&gpu, &scene, frames, dt, &dump),
-        Command::Demo { out, frames } => simulate::demo(&gpu, &out, frames),
+        Command::Simulate(args) => simulate::run(&gpu, &args),
+        Command::Demo(args) => demo::run(&gpu, &args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,30 +6,38 @@ use indicatif::{ProgressBar, ProgressStyle};
 use snowprint::scene::{Scene, SceneShape};
 use snowprint::{Deformer, GpuContext, GpuOptions, Shape, SnowWorld, WorldConfig};
 
-/// The scene `make demo` runs when given no other.
-pub const DEMO_SCENE: &str = include_str!("../../../scenes/walker.toml");
+/// Arguments of `snowprint simulate`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene file (TOML, see docs/SCENES.md).
+    #[arg(long)]
+    pub scene: PathBuf,
+    /// Frames to run.
+    #[arg(long)]
+    pub frames: u32,
+    /// Seconds per frame.
+    #[arg(long, default_value_t = 1.0 / 60.0)]
+    pub dt: f32,
+    /// Folder for `<surface>.png` (16-bit depression) and `<surface>.json`.
+    #[arg(long)]
+    pub dump: PathBuf,
+}
 
-/// Run `scene` for `frames` frames of `dt` seconds and write `<surface>.png` and `<surface>.json`
-/// into `dump`. Files appear only when the whole run succeeded.
-pub fn run(gpu: &GpuOptions, scene: &Path, frames: u32, dt: f32, dump: &Path) -> Result<(), String> {
-    if !(dt.is_finite() && dt > 0.0) {
-        return Err(format!("--dt {dt} is not usable; give a finite number of seconds above 0, such as 0.0166"));
+/// Run the scene for the frames asked and write `<surface>.png` and `<surface>.json` into the dump
+/// folder. Files appear only when the whole run succeeded.
+pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
+    if !(args.dt.is_finite() && args.dt > 0.0) {
+        return Err(format!(
+            "--dt {} is not usable; give a finite number of seconds above 0, such as 0.0166",
+            args.dt
+        ));
     }
-    let scene = Scene::load(scene).map_err(|e| e.to_string())?;
-    simulate(gpu, &scene, frames, dt, dump)
+    let scene = Scene::load(&args.scene).map_err(|e| e.to_string())?;
+    simulate(gpu, &scene, args.frames, args.dt, &args.dump)
 }
 
-/// Run the built-in walker scene into `out`.
-pub fn demo(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), String> {
-    let scene = Scene::parse(DEMO_SCENE, Path::new("scenes/walker.toml")).map_err(|e| e.to_string())?;
-    let dt = 1.0 / 60.0;
-    let frames = frames.unwrap_or(((scene.duration() / dt).ceil() as u32).max(1) + 30);
-    simulate(gpu, &scene, frames, dt, out)?;
-    eprintln!("snowprint: wrote the heightmaps of {} surface(s) to {}", scene.surfaces.len(), out.display());
-    Ok(())
-}
-
-fn simulate(gpu: &GpuOptions, scene: &Scene, frames: u32, dt: f32, dump: &Path) -> Result<(), String> {
+/// Run a loaded scene and dump its heightmaps.
+pub fn simulate(gpu: &GpuOptions, scene: &Scene, frames: u32, dt: f32, dump: &Path) -> Result<(), String> {
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let pool: u64 = scene
         .surfaces
