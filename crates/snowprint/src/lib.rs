@@ -31,6 +31,7 @@ pub mod mesh;
 pub mod pool;
 pub mod scene;
 pub mod surface;
+pub mod view;
 pub mod world;
 
 pub use deformer::{Deformer, Pose, Shape};
@@ -39,4 +40,5 @@ pub use gpu::{Capabilities, GpuContext, GpuOptions};
 pub use heightmap::Heightmap;
 pub use mesh::{Mesh, MeshId};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+pub use view::{Camera, GroundMaterial};
 pub use world::{CaptureConfig, CaptureMode, FrameStats, MemoryReport, SnowWorld, StageTimes, SurfaceUpdate, WorldConfig};
