@@ -28,11 +28,11 @@ pub struct Camera {
 impl Camera {
     /// World-to-view transform (right-handed, +Y up).
     pub fn view(&self) -> Mat4 {
-        Mat4::look_at_rh(self.eye, self.target, Vec3::Y)
+        glam::camera::rh::view::look_at_mat4(self.eye, self.target, Vec3::Y)
     }
 
     /// View-to-clip transform for an aspect ratio, with wgpu's 0..1 depth.
     pub fn projection(&self, aspect: f32, near: f32, far: f32) -> Mat4 {
-        Mat4::perspective_rh(self.fov_y_degrees.to_radians(), aspect, near, far)
+        glam::camera::rh::proj::directx::perspective(self.fov_y_degrees.to_radians(), aspect, near, far)
     }
 }
