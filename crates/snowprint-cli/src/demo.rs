@@ -21,7 +21,8 @@ pub struct Args {
 
 /// Run the built-in walker scene and write its heightmaps.
 pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
-    let scene = Scene::parse(DEMO_SCENE, Path::new("scenes/walker.toml")).map_err(|e| e.to_string())?;
+    let scene =
+        Scene::parse(DEMO_SCENE, Path::new("scenes/walker.toml")).map_err(|e| e.to_string())?;
     let dt = 1.0 / 60.0;
     let frames = args
         .frames

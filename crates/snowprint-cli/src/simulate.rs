@@ -37,7 +37,13 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
 }
 
 /// Run a loaded scene and dump its heightmaps.
-pub fn simulate(gpu: &GpuOptions, scene: &Scene, frames: u32, dt: f32, dump: &Path) -> Result<(), String> {
+pub fn simulate(
+    gpu: &GpuOptions,
+    scene: &Scene,
+    frames: u32,
+    dt: f32,
+    dump: &Path,
+) -> Result<(), String> {
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let pool: u64 = scene
         .surfaces
@@ -61,14 +67,19 @@ pub fn simulate(gpu: &GpuOptions, scene: &Scene, frames: u32, dt: f32, dump: &Pa
     for d in &scene.deformers {
         shapes.push(match &d.shape {
             SceneShape::Sphere { radius } => Shape::Sphere { radius: *radius },
-            SceneShape::Capsule { radius, half_height } => Shape::Capsule {
+            SceneShape::Capsule {
+                radius,
+                half_height,
+            } => Shape::Capsule {
                 radius: *radius,
                 half_height: *half_height,
             },
             SceneShape::Box { half_extents } => Shape::Box {
                 half_extents: *half_extents,
             },
-            SceneShape::Mesh { mesh, .. } => Shape::Mesh(world.add_mesh(&d.name, mesh).map_err(|e| e.to_string())?),
+            SceneShape::Mesh { mesh, .. } => {
+                Shape::Mesh(world.add_mesh(&d.name, mesh).map_err(|e| e.to_string())?)
+            }
         });
     }
 
@@ -93,7 +104,8 @@ pub fn simulate(gpu: &GpuOptions, scene: &Scene, frames: u32, dt: f32, dump: &Pa
 
     // Write everything into a fresh folder beside the destination, then move the files in: an
     // error leaves no output that looks complete.
-    std::fs::create_dir_all(dump).map_err(|e| format!("cannot create the dump folder {}: {e}", dump.display()))?;
+    std::fs::create_dir_all(dump)
+        .map_err(|e| format!("cannot create the dump folder {}: {e}", dump.display()))?;
     let staging = dump.join(format!(".snowprint-partial-{}", std::process::id()));
     let result = write_dump(&world, scene, &ids, frames, dt, &staging, dump);
     let _ = std::fs::remove_dir_all(&staging);
@@ -109,7 +121,8 @@ fn write_dump(
     staging: &Path,
     dump: &Path,
 ) -> Result<(), String> {
-    std::fs::create_dir_all(staging).map_err(|e| format!("cannot write into {}: {e}", dump.display()))?;
+    std::fs::create_dir_all(staging)
+        .map_err(|e| format!("cannot write into {}: {e}", dump.display()))?;
     let mut files: Vec<PathBuf> = Vec::new();
     for (desc, &id) in scene.surfaces.iter().zip(ids) {
         let map = world.read_heightmap(id).map_err(|e| e.to_string())?;
@@ -131,14 +144,18 @@ fn write_dump(
         });
         let json = staging.join(format!("{}.json", desc.name));
         let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
-        std::fs::write(&json, text + "\n").map_err(|e| format!("cannot write {}: {e}", json.display()))?;
+        std::fs::write(&json, text + "\n")
+            .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
         files.push(png);
         files.push(json);
     }
     for f in files {
-        let name = f.file_name().ok_or("internal: staged file without a name")?;
+        let name = f
+            .file_name()
+            .ok_or("internal: staged file without a name")?;
         let dest = dump.join(name);
-        std::fs::rename(&f, &dest).map_err(|e| format!("cannot move {} into place: {e}", dest.display()))?;
+        std::fs::rename(&f, &dest)
+            .map_err(|e| format!("cannot move {} into place: {e}", dest.display()))?;
     }
     Ok(())
 }

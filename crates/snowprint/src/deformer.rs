@@ -119,14 +119,22 @@ impl Deformer {
         let positive = |v: f32| v.is_finite() && v > 0.0;
         match self.shape {
             Shape::Sphere { radius } if !positive(radius) => {
-                return bad("radius", radius.to_string(), "a finite number of metres above 0");
+                return bad(
+                    "radius",
+                    radius.to_string(),
+                    "a finite number of metres above 0",
+                );
             }
             Shape::Capsule {
                 radius,
                 half_height,
             } => {
                 if !positive(radius) {
-                    return bad("radius", radius.to_string(), "a finite number of metres above 0");
+                    return bad(
+                        "radius",
+                        radius.to_string(),
+                        "a finite number of metres above 0",
+                    );
                 }
                 if !(half_height.is_finite() && half_height >= 0.0) {
                     return bad(
@@ -136,7 +144,9 @@ impl Deformer {
                     );
                 }
             }
-            Shape::Box { half_extents } if !(half_extents.is_finite() && half_extents.min_element() > 0.0) => {
+            Shape::Box { half_extents }
+                if !(half_extents.is_finite() && half_extents.min_element() > 0.0) =>
+            {
                 return bad(
                     "half_extents",
                     format!("{:?}", half_extents.to_array()),

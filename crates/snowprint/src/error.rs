@@ -67,7 +67,9 @@ pub enum SnowError {
         reason: String,
     },
     /// A handle does not name a live object of this world.
-    #[error("{what} handle {index} does not belong to this world (it was removed or never existed)")]
+    #[error(
+        "{what} handle {index} does not belong to this world (it was removed or never existed)"
+    )]
     StaleHandle {
         /// Kind of handle.
         what: &'static str,

@@ -50,7 +50,11 @@ impl Heightmap {
             let mut w = enc
                 .write_header()
                 .map_err(|e| SnowError::Readback(format!("PNG encoding failed: {e}")))?;
-            let data: Vec<u8> = self.depression.iter().flat_map(|v| v.to_be_bytes()).collect();
+            let data: Vec<u8> = self
+                .depression
+                .iter()
+                .flat_map(|v| v.to_be_bytes())
+                .collect();
             w.write_image_data(&data)
                 .map_err(|e| SnowError::Readback(format!("PNG encoding failed: {e}")))?;
         }
@@ -77,11 +81,14 @@ impl Heightmap {
             .read_info()
             .map_err(|e| err(e.to_string()))?;
         let info = reader.info().clone();
-        if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Sixteen {
+        if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Sixteen
+        {
             return Err(err("is not a 16-bit greyscale PNG".into()));
         }
         let mut buf = vec![0; reader.output_buffer_size().unwrap_or(0)];
-        reader.next_frame(&mut buf).map_err(|e| err(e.to_string()))?;
+        reader
+            .next_frame(&mut buf)
+            .map_err(|e| err(e.to_string()))?;
         let depression: Vec<u16> = buf
             .chunks_exact(2)
             .map(|c| u16::from_be_bytes([c[0], c[1]]))

@@ -41,4 +41,7 @@ pub use heightmap::Heightmap;
 pub use mesh::{Mesh, MeshId};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
-pub use world::{CaptureConfig, CaptureMode, FrameStats, MemoryReport, SnowWorld, StageTimes, SurfaceUpdate, WorldConfig};
+pub use world::{
+    CaptureConfig, CaptureMode, FrameStats, MemoryReport, SnowWorld, StageTimes, SurfaceUpdate,
+    WorldConfig,
+};

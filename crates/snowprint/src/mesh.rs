@@ -30,13 +30,17 @@ impl Mesh {
                 reason,
             })
         };
-        if self.indices.is_empty() || self.indices.len() % 3 != 0 {
+        if self.indices.is_empty() || !self.indices.len().is_multiple_of(3) {
             return err(format!(
                 "has {} indices; a triangle list needs a positive multiple of 3",
                 self.indices.len()
             ));
         }
-        if let Some(i) = self.indices.iter().find(|&&i| i as usize >= self.positions.len()) {
+        if let Some(i) = self
+            .indices
+            .iter()
+            .find(|&&i| i as usize >= self.positions.len())
+        {
             return err(format!(
                 "index {i} is out of range for {} vertices",
                 self.positions.len()
@@ -50,13 +54,20 @@ impl Mesh {
 
     /// Radius of the ball around the mesh origin that holds every vertex.
     pub fn bounding_radius(&self) -> f32 {
-        self.positions.iter().map(|p| p.length()).fold(0.0, f32::max)
+        self.positions
+            .iter()
+            .map(|p| p.length())
+            .fold(0.0, f32::max)
     }
 
     /// The mesh with every vertex transformed.
     pub fn transformed(&self, m: Mat4) -> Mesh {
         Mesh {
-            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            positions: self
+                .positions
+                .iter()
+                .map(|&p| m.transform_point3(p))
+                .collect(),
             indices: self.indices.clone(),
         }
     }
@@ -83,7 +94,12 @@ impl Mesh {
         positions.push(Vec3::new(0.0, half_height + radius, 0.0));
         for r in 1..rings {
             let phi = std::f32::consts::PI * r as f32 / rings as f32;
-            let y = radius * phi.cos() + if r <= rings / 2 { half_height } else { -half_height };
+            let y = radius * phi.cos()
+                + if r <= rings / 2 {
+                    half_height
+                } else {
+                    -half_height
+                };
             let ring_r = radius * phi.sin();
             for s in 0..segments {
                 let theta = std::f32::consts::TAU * s as f32 / segments as f32;
@@ -113,7 +129,12 @@ impl Mesh {
         }
         for k in 0..ring_count - 1 {
             for s in 0..segments {
-                let (a, b, c, d) = (ring(k, s), ring(k, s + 1), ring(k + 1, s), ring(k + 1, s + 1));
+                let (a, b, c, d) = (
+                    ring(k, s),
+                    ring(k, s + 1),
+                    ring(k + 1, s),
+                    ring(k + 1, s + 1),
+                );
                 indices.extend_from_slice(&[a, b, d, a, d, c]);
             }
         }
@@ -175,7 +196,9 @@ impl Mesh {
                         continue;
                     }
                     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-                    let Some(pos) = reader.read_positions() else { continue };
+                    let Some(pos) = reader.read_positions() else {
+                        continue;
+                    };
                     let base = mesh.positions.len() as u32;
                     let first_index = mesh.indices.len();
                     let pos: Vec<Vec3> = pos.map(|p| m.transform_point3(Vec3::from(p))).collect();
@@ -212,7 +235,11 @@ mod tests {
         m.indices
             .chunks(3)
             .map(|t| {
-                let (a, b, c) = (m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]);
+                let (a, b, c) = (
+                    m.positions[t[0] as usize],
+                    m.positions[t[1] as usize],
+                    m.positions[t[2] as usize],
+                );
                 a.dot(b.cross(c)) / 6.0
             })
             .sum()
@@ -229,7 +256,10 @@ mod tests {
         let c = Mesh::capsule(0.5, 1.0, 16, 32);
         let v = signed_volume(&c);
         let exact = 4.0 / 3.0 * std::f32::consts::PI * 0.125 + std::f32::consts::PI * 0.25 * 2.0;
-        assert!(v > 0.97 * exact && v < exact, "capsule volume {v} vs {exact}");
+        assert!(
+            v > 0.97 * exact && v < exact,
+            "capsule volume {v} vs {exact}"
+        );
 
         let b = Mesh::cuboid(Vec3::new(1.0, 2.0, 3.0));
         assert!((signed_volume(&b) - 48.0).abs() < 1e-4);

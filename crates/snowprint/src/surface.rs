@@ -161,16 +161,25 @@ mod tests {
     fn talk_resolution_rule() {
         assert_eq!(
             SurfaceLayout::for_size(Vec2::new(8.0, 6.0)),
-            SurfaceLayout { width: 200, height: 150 }
+            SurfaceLayout {
+                width: 200,
+                height: 150
+            }
         );
         assert_eq!(
             SurfaceLayout::for_size(Vec2::new(30.0, 10.0)),
-            SurfaceLayout { width: 512, height: 171 }
+            SurfaceLayout {
+                width: 512,
+                height: 171
+            }
         );
         // Small: 4 cm texels.
         assert_eq!(
             SurfaceLayout::for_size(Vec2::new(1.0, 0.5)),
-            SurfaceLayout { width: 25, height: 13 }
+            SurfaceLayout {
+                width: 25,
+                height: 13
+            }
         );
         // Very long: capped at 512, texels stay square.
         let l = SurfaceLayout::for_size(Vec2::new(100.0, 3.0));

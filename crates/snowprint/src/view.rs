@@ -4,7 +4,9 @@
 use glam::{Mat4, Vec3};
 
 /// What lies under the snow of a surface, shown where the snow is pressed down to the ground.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum GroundMaterial {
     /// Clay roof tiles (rooftops).
@@ -33,6 +35,11 @@ impl Camera {
 
     /// View-to-clip transform for an aspect ratio, with wgpu's 0..1 depth.
     pub fn projection(&self, aspect: f32, near: f32, far: f32) -> Mat4 {
-        glam::camera::rh::proj::directx::perspective(self.fov_y_degrees.to_radians(), aspect, near, far)
+        glam::camera::rh::proj::directx::perspective(
+            self.fov_y_degrees.to_radians(),
+            aspect,
+            near,
+            far,
+        )
     }
 }

@@ -11,7 +11,9 @@ use std::time::Instant;
 use glam::{Mat4, Vec2};
 
 use crate::accumulate::{self, AccumulatePipelines, BlurParams, WORKGROUP};
-use crate::capture::{self, AtlasPlacement, CaptureView, CaptureVolume, CapturePipelines, GpuPrimitive, MeshDraw};
+use crate::capture::{
+    self, AtlasPlacement, CapturePipelines, CaptureView, CaptureVolume, GpuPrimitive, MeshDraw,
+};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::gpu::{Capabilities, GpuContext};
@@ -172,14 +174,23 @@ struct Growable {
 }
 
 impl Growable {
-    fn new(device: &wgpu::Device, label: &'static str, usage: wgpu::BufferUsages, size: u64) -> Self {
+    fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        usage: wgpu::BufferUsages,
+        size: u64,
+    ) -> Self {
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size,
             usage,
             mapped_at_creation: false,
         });
-        Self { buffer, usage, label }
+        Self {
+            buffer,
+            usage,
+            label,
+        }
     }
 
     fn ensure(&mut self, device: &wgpu::Device, size: u64) {
@@ -277,7 +288,12 @@ impl SnowWorld {
                 c.mask_depth
             )));
         }
-        let max_pool = gpu.caps.max_storage_binding.min(device.limits().max_buffer_size) / 256 * 256;
+        let max_pool = gpu
+            .caps
+            .max_storage_binding
+            .min(device.limits().max_buffer_size)
+            / 256
+            * 256;
         if config.pool_bytes > max_pool {
             tracing::warn!(
                 "heightmap pool of {} bytes exceeds this device's largest storage binding; using {} bytes",
@@ -291,7 +307,9 @@ impl SnowWorld {
         let pool = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("heightmap pool"),
             size: alloc.budget().max(256),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         use wgpu::BufferUsages as U;
@@ -322,11 +340,36 @@ impl SnowWorld {
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
             acc: AccumulatePipelines::new(&device),
-            records: Growable::new(&device, "surface records", U::STORAGE | U::COPY_DST, 64 * 64),
-            views: Growable::new(&device, "capture views", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 16),
-            prims: Growable::new(&device, "capture primitives", U::STORAGE | U::COPY_DST, 80 * 64),
-            draws: Growable::new(&device, "capture mesh draws", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 16),
-            blur_params: Growable::new(&device, "blur params", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 4),
+            records: Growable::new(
+                &device,
+                "surface records",
+                U::STORAGE | U::COPY_DST,
+                64 * 64,
+            ),
+            views: Growable::new(
+                &device,
+                "capture views",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 16,
+            ),
+            prims: Growable::new(
+                &device,
+                "capture primitives",
+                U::STORAGE | U::COPY_DST,
+                80 * 64,
+            ),
+            draws: Growable::new(
+                &device,
+                "capture mesh draws",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 16,
+            ),
+            blur_params: Growable::new(
+                &device,
+                "blur params",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 4,
+            ),
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
             queue: gpu.queue.clone(),
             caps: gpu.caps.clone(),
@@ -364,12 +407,15 @@ impl SnowWorld {
     pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
         desc.validate()?;
         let layout = desc.layout();
-        let slot = self.alloc.alloc(layout.texels()).ok_or_else(|| SnowError::PoolExhausted {
-            name: desc.name.clone(),
-            needed: crate::pool::slot_bytes(layout.texels()),
-            free: self.alloc.largest_free(),
-            budget: self.alloc.budget(),
-        })?;
+        let slot = self
+            .alloc
+            .alloc(layout.texels())
+            .ok_or_else(|| SnowError::PoolExhausted {
+                name: desc.name.clone(),
+                needed: crate::pool::slot_bytes(layout.texels()),
+                free: self.alloc.largest_free(),
+                budget: self.alloc.budget(),
+            })?;
         let mut enc = self.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
         self.queue.submit([enc.finish()]);
@@ -399,7 +445,10 @@ impl SnowWorld {
             .surfaces
             .get_mut(id.0 as usize)
             .and_then(Option::take)
-            .ok_or(SnowError::StaleHandle { what: "surface", index: id.0 })?;
+            .ok_or(SnowError::StaleHandle {
+                what: "surface",
+                index: id.0,
+            })?;
         self.alloc.free(state.slot);
         Ok(())
     }
@@ -426,23 +475,30 @@ impl SnowWorld {
         self.surfaces
             .get(id.0 as usize)
             .and_then(Option::as_ref)
-            .ok_or(SnowError::StaleHandle { what: "surface", index: id.0 })
+            .ok_or(SnowError::StaleHandle {
+                what: "surface",
+                index: id.0,
+            })
     }
 
     /// Register a closed triangle mesh as a deformer shape.
     pub fn add_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<MeshId> {
         mesh.validate(name)?;
         use wgpu::util::DeviceExt;
-        let vertices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("deformer mesh vertices"),
-            contents: bytemuck::cast_slice(&mesh.positions),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        });
-        let indices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("deformer mesh indices"),
-            contents: bytemuck::cast_slice(&mesh.indices),
-            usage: wgpu::BufferUsages::INDEX,
-        });
+        let vertices = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("deformer mesh vertices"),
+                contents: bytemuck::cast_slice(&mesh.positions),
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            });
+        let indices = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("deformer mesh indices"),
+                contents: bytemuck::cast_slice(&mesh.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
         self.meshes.push(Some(MeshGpu {
             vertices,
             indices,
@@ -460,7 +516,10 @@ impl SnowWorld {
             .meshes
             .get_mut(id.0 as usize)
             .and_then(Option::as_mut)
-            .ok_or(SnowError::StaleHandle { what: "mesh", index: id.0 })?;
+            .ok_or(SnowError::StaleHandle {
+                what: "mesh",
+                index: id.0,
+            })?;
         if positions.len() != mesh.vertex_count {
             return Err(SnowError::PoseMismatch {
                 mesh: id.0,
@@ -475,7 +534,8 @@ impl SnowWorld {
             });
         }
         mesh.radius = positions.iter().map(|p| p.length()).fold(0.0, f32::max);
-        self.queue.write_buffer(&mesh.vertices, 0, bytemuck::cast_slice(positions));
+        self.queue
+            .write_buffer(&mesh.vertices, 0, bytemuck::cast_slice(positions));
         Ok(())
     }
 
@@ -486,7 +546,11 @@ impl SnowWorld {
             pool_used: self.alloc.used(),
             pool_high_water: self.alloc.high_water(),
             scratch: self.scratch.buffer.size(),
-            capture_atlas: self.atlases.iter().map(|a| a.0 as u64 * a.0 as u64 * 4).sum(),
+            capture_atlas: self
+                .atlases
+                .iter()
+                .map(|a| a.0 as u64 * a.0 as u64 * 4)
+                .sum(),
             frame_tables: self.records.buffer.size()
                 + self.views.buffer.size()
                 + self.prims.buffer.size()
@@ -560,9 +624,16 @@ impl SnowWorld {
             for (i, d) in u.deformers.iter().enumerate() {
                 d.validate(&format!("#{i}"))?;
                 if let Shape::Mesh(id) = d.shape
-                    && self.meshes.get(id.0 as usize).and_then(Option::as_ref).is_none()
+                    && self
+                        .meshes
+                        .get(id.0 as usize)
+                        .and_then(Option::as_ref)
+                        .is_none()
                 {
-                    return Err(SnowError::StaleHandle { what: "mesh", index: id.0 });
+                    return Err(SnowError::StaleHandle {
+                        what: "mesh",
+                        index: id.0,
+                    });
                 }
             }
         }
@@ -573,8 +644,11 @@ impl SnowWorld {
         for u in updates {
             let index = u.surface.0 as usize;
             let (dt, deformers) = (u.elapsed, u.deformers);
-            let Some(state) = self.surfaces[index].as_mut() else { continue };
-            state.carry += state.desc.replenish_rate as f64 * dt as f64 * accumulate::cpu::UNITS as f64;
+            let Some(state) = self.surfaces[index].as_mut() else {
+                continue;
+            };
+            state.carry +=
+                state.desc.replenish_rate as f64 * dt as f64 * accumulate::cpu::UNITS as f64;
             let units = state.carry.floor().min(u32::MAX as f64);
             state.carry -= units;
             let units = units as u32;
@@ -589,9 +663,12 @@ impl SnowWorld {
             for d in deformers {
                 match d.shape {
                     Shape::Mesh(id) => {
-                        let Some(Some(mesh)) = self.meshes.get(id.0 as usize) else { continue };
+                        let Some(Some(mesh)) = self.meshes.get(id.0 as usize) else {
+                            continue;
+                        };
                         if volume.overlaps_ball(d.pose.position, mesh.radius) {
-                            let model = Mat4::from_rotation_translation(d.pose.rotation, d.pose.position);
+                            let model =
+                                Mat4::from_rotation_translation(d.pose.rotation, d.pose.position);
                             draws.push((
                                 MeshDraw {
                                     to_local: (volume.world_to_local * model).to_cols_array_2d(),
@@ -681,12 +758,16 @@ impl SnowWorld {
 
         // Upload the frame's tables.
         let records: Vec<SurfaceRecord> = jobs.iter().map(|j| j.record).collect();
-        self.records.ensure(&self.device, (records.len() * 64) as u64);
-        self.queue.write_buffer(&self.records.buffer, 0, bytemuck::cast_slice(&records));
+        self.records
+            .ensure(&self.device, (records.len() * 64) as u64);
+        self.queue
+            .write_buffer(&self.records.buffer, 0, bytemuck::cast_slice(&records));
         let mut view_bytes = vec![0u8; captured.len().max(1) * UNIFORM_STRIDE as usize];
         for (k, &j) in captured.iter().enumerate() {
             let r = &jobs[j].record;
-            let state = self.surfaces[jobs[j].surface].as_ref().expect("job of a live surface");
+            let state = self.surfaces[jobs[j].surface]
+                .as_ref()
+                .expect("job of a live surface");
             let v = CaptureView {
                 half_size: (state.desc.size * 0.5).to_array(),
                 frustum_height: r.frustum_height,
@@ -699,7 +780,8 @@ impl SnowWorld {
         self.queue.write_buffer(&self.views.buffer, 0, &view_bytes);
         if !prims.is_empty() {
             self.prims.ensure(&self.device, (prims.len() * 80) as u64);
-            self.queue.write_buffer(&self.prims.buffer, 0, bytemuck::cast_slice(&prims));
+            self.queue
+                .write_buffer(&self.prims.buffer, 0, bytemuck::cast_slice(&prims));
         }
         if !draws.is_empty() {
             let mut bytes = vec![0u8; draws.len() * UNIFORM_STRIDE as usize];
@@ -713,17 +795,26 @@ impl SnowWorld {
         let mut params = vec![0u8; batches.max(1) as usize * UNIFORM_STRIDE as usize];
         for b in 0..batches {
             let o = (b as u64 * UNIFORM_STRIDE) as usize;
-            params[o..o + 16].copy_from_slice(bytemuck::bytes_of(&BlurParams { batch: b, _pad: [0; 3] }));
+            params[o..o + 16].copy_from_slice(bytemuck::bytes_of(&BlurParams {
+                batch: b,
+                _pad: [0; 3],
+            }));
         }
         self.blur_params.ensure(&self.device, params.len() as u64);
-        self.queue.write_buffer(&self.blur_params.buffer, 0, &params);
-        self.scratch.ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        self.queue
+            .write_buffer(&self.blur_params.buffer, 0, &params);
+        self.scratch
+            .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
 
         let atlas_index = self.atlas(atlas_side);
         let atlas_view = &self.atlases[atlas_index].2;
         let max_w = jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         let max_h = jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
-        let groups = (max_w.div_ceil(WORKGROUP), max_h.div_ceil(WORKGROUP), jobs.len() as u32);
+        let groups = (
+            max_w.div_ceil(WORKGROUP),
+            max_h.div_ceil(WORKGROUP),
+            jobs.len() as u32,
+        );
 
         let view_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("capture view"),
@@ -814,7 +905,11 @@ impl SnowWorld {
             ],
         });
 
-        let ts = if self.profiling { self.timestamps.as_ref() } else { None };
+        let ts = if self.profiling {
+            self.timestamps.as_ref()
+        } else {
+            None
+        };
         let mut stages: Vec<Stage> = Vec::new();
         let next_query = |stage: Stage, stages: &mut Vec<Stage>| -> Option<u32> {
             let ts = ts?;
@@ -826,9 +921,11 @@ impl SnowWorld {
             Some(q)
         };
 
-        let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("snow update"),
-        });
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("snow update"),
+            });
         for batch in 0..batches {
             let q = next_query(Stage::Capture, &mut stages);
             {
@@ -857,7 +954,14 @@ impl SnowWorld {
                     if r.batch != batch {
                         continue;
                     }
-                    pass.set_viewport(r.atlas_x as f32, r.atlas_y as f32, r.width as f32, r.height as f32, 0.0, 1.0);
+                    pass.set_viewport(
+                        r.atlas_x as f32,
+                        r.atlas_y as f32,
+                        r.width as f32,
+                        r.height as f32,
+                        0.0,
+                        1.0,
+                    );
                     pass.set_scissor_rect(r.atlas_x, r.atlas_y, r.width, r.height);
                     pass.set_bind_group(0, &view_bg, &[(k as u64 * UNIFORM_STRIDE) as u32]);
                     if !job.prims.is_empty() {
@@ -872,7 +976,10 @@ impl SnowWorld {
                                 .expect("mesh checked at the start of the step");
                             pass.set_bind_group(1, &draw_bg, &[(d as u64 * UNIFORM_STRIDE) as u32]);
                             pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                            pass.set_index_buffer(
+                                mesh.indices.slice(..),
+                                wgpu::IndexFormat::Uint32,
+                            );
                             pass.draw_indexed(0..mesh.index_count, 0, 0..1);
                         }
                     }
@@ -939,7 +1046,9 @@ impl SnowWorld {
             let ticks: &[u64] = bytemuck::cast_slice(&bytes);
             let mut t = StageTimes::default();
             for (i, stage) in stages.iter().enumerate() {
-                let ms = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * ts.period_ns as f64 * 1e-6;
+                let ms = ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64
+                    * ts.period_ns as f64
+                    * 1e-6;
                 match stage {
                     Stage::Capture => t.capture_ms += ms,
                     Stage::Blur => t.blur_ms += ms,
@@ -990,7 +1099,11 @@ impl SnowWorld {
     /// The packed texels of a surface's current heightmap (depression low 16 bits, displaced high).
     pub fn read_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
         let s = self.state(id)?;
-        let bytes = self.download(&self.pool, s.slot.region_bytes(s.parity as u64), s.layout.texels() * 4)?;
+        let bytes = self.download(
+            &self.pool,
+            s.slot.region_bytes(s.parity as u64),
+            s.layout.texels() * 4,
+        )?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
@@ -998,7 +1111,11 @@ impl SnowWorld {
     pub fn read_heightmap(&self, id: SurfaceId) -> Result<Heightmap> {
         let s = self.state(id)?;
         let packed = self.read_packed(id)?;
-        Ok(Heightmap::from_packed(s.layout.width, s.layout.height, &packed))
+        Ok(Heightmap::from_packed(
+            s.layout.width,
+            s.layout.height,
+            &packed,
+        ))
     }
 
     /// Read a surface's packed normals (see [`crate::accumulate::cpu::unpack_normal`]).
@@ -1020,13 +1137,15 @@ impl SnowWorld {
     /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing), when
     /// it was captured in that step's last atlas batch; `None` otherwise.
     pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
-        let Some(&(_, r, placement)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
+        let Some(&(_, r, placement)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize)
+        else {
             return Ok(None);
         };
         if placement.batch != self.last.last_batch {
             return Ok(None);
         }
-        let Some((_, texture, _)) = self.atlases.iter().find(|a| a.0 == self.last.atlas_side) else {
+        let Some((_, texture, _)) = self.atlases.iter().find(|a| a.0 == self.last.atlas_side)
+        else {
             return Ok(None);
         };
         // Depth textures can only be copied whole.
@@ -1055,7 +1174,11 @@ impl SnowWorld {
                     rows_per_image: Some(side),
                 },
             },
-            wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
         );
         self.queue.submit([enc.finish()]);
         let bytes = self.read_buffer(&staging, 0, size)?;
@@ -1074,7 +1197,11 @@ impl SnowWorld {
         let Some(&(_, r, _)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
             return Ok(None);
         };
-        let bytes = self.download(&self.scratch.buffer, r.scratch as u64 * 4, (r.width * r.height) as u64 * 4)?;
+        let bytes = self.download(
+            &self.scratch.buffer,
+            r.scratch as u64 * 4,
+            (r.width * r.height) as u64 * 4,
+        )?;
         Ok(Some(bytemuck::cast_slice(&bytes).to_vec()))
     }
 

@@ -52,37 +52,56 @@ fn blur_input(desc: &SurfaceDesc, mode: CaptureMode) -> BlurInput {
 /// A mixed set of analytic deformers over a surface centred at `c` (ground height c.y).
 fn crowd(c: Vec3) -> Vec<Deformer> {
     vec![
-        Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at((c + Vec3::new(-0.8, 0.2, 0.3)).into())),
+        Deformer::new(
+            Shape::Sphere { radius: 0.3 },
+            Pose::at((c + Vec3::new(-0.8, 0.2, 0.3)).into()),
+        ),
         Deformer::moving(
             Shape::Sphere { radius: 0.15 },
             Pose::at((c + Vec3::new(0.2, 0.1, -0.9)).into()),
             Pose::at((c + Vec3::new(1.3, 0.05, -0.4)).into()),
         ),
         Deformer::new(
-            Shape::Capsule { radius: 0.1, half_height: 0.4 },
+            Shape::Capsule {
+                radius: 0.1,
+                half_height: 0.4,
+            },
             Pose {
                 position: c + Vec3::new(0.6, 0.12, 0.7),
                 rotation: Quat::from_euler(glam::EulerRot::YXZ, 0.5, 0.3, 1.2),
             },
         ),
         Deformer::new(
-            Shape::Box { half_extents: Vec3::new(0.3, 0.1, 0.15) },
+            Shape::Box {
+                half_extents: Vec3::new(0.3, 0.1, 0.15),
+            },
             Pose {
                 position: c + Vec3::new(-1.2, 0.15, -0.8),
                 rotation: Quat::from_euler(glam::EulerRot::YXZ, 0.7, 0.2, -0.3),
             },
         ),
         // Sunk into the ground.
-        Deformer::new(Shape::Sphere { radius: 0.4 }, Pose::at((c + Vec3::new(1.4, -0.25, 0.9)).into())),
+        Deformer::new(
+            Shape::Sphere { radius: 0.4 },
+            Pose::at((c + Vec3::new(1.4, -0.25, 0.9)).into()),
+        ),
         // Above the frustum: leaves nothing.
-        Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at((c + Vec3::new(0.0, 0.3 + ANKLE + 0.21, 0.0)).into())),
+        Deformer::new(
+            Shape::Sphere { radius: 0.2 },
+            Pose::at((c + Vec3::new(0.0, 0.3 + ANKLE + 0.21, 0.0)).into()),
+        ),
     ]
 }
 
 /// Every stage of one update against its CPU reference, on several sizes, non-square and yawed.
 #[test]
 fn every_stage_matches_its_cpu_reference() {
-    for (size, yaw) in [([4.0, 3.0], 0.0), ([3.3, 2.1], 30.0), ([1.0, 4.5], -75.0), ([6.0, 6.0], 0.0)] {
+    for (size, yaw) in [
+        ([4.0, 3.0], 0.0),
+        ([3.3, 2.1], 30.0),
+        ([1.0, 4.5], -75.0),
+        ([6.0, 6.0], 0.0),
+    ] {
         let mut w = world(CaptureMode::Depth);
         let mut desc = SurfaceDesc::new("s", [2.0, 1.0, -3.0], size, 0.3);
         desc.yaw_degrees = yaw;
@@ -102,8 +121,18 @@ fn every_stage_matches_its_cpu_reference() {
                 capture::push_primitives(d, &vol, &mut prims);
             }
             // Capture.
-            let gpu_cap = w.read_last_capture(id).unwrap().expect("captured in the last batch");
-            let cpu_cap = cap_cpu::capture(l.width, l.height, vol.half_size, vol.frustum_height, &prims, &[]);
+            let gpu_cap = w
+                .read_last_capture(id)
+                .unwrap()
+                .expect("captured in the last batch");
+            let cpu_cap = cap_cpu::capture(
+                l.width,
+                l.height,
+                vol.half_size,
+                vol.frustum_height,
+                &prims,
+                &[],
+            );
             let mut coverage_mismatch = 0;
             for (g, c) in gpu_cap.iter().zip(&cpu_cap) {
                 if (*g < 1.0) != (*c < 1.0) {
@@ -112,7 +141,10 @@ fn every_stage_matches_its_cpu_reference() {
                     assert!((g - c).abs() < 2e-5, "capture {g} vs cpu {c} ({size:?})");
                 }
             }
-            assert!(coverage_mismatch * 1000 <= gpu_cap.len(), "{coverage_mismatch} texels differ in coverage");
+            assert!(
+                coverage_mismatch * 1000 <= gpu_cap.len(),
+                "{coverage_mismatch} texels differ in coverage"
+            );
             assert!(gpu_cap.iter().any(|&d| d < 1.0), "something was captured");
             // Stage 1.
             let inp = blur_input(&desc, CaptureMode::Depth);
@@ -132,12 +164,22 @@ fn every_stage_matches_its_cpu_reference() {
             }
             // Normals.
             let texel = desc.size / Vec2::new(l.width as f32, l.height as f32);
-            let cpu_n = acc_cpu::normals(&gpu_heights, l.width, l.height, desc.snow_depth, texel.x, texel.y);
+            let cpu_n = acc_cpu::normals(
+                &gpu_heights,
+                l.width,
+                l.height,
+                desc.snow_depth,
+                texel.x,
+                texel.y,
+            );
             let gpu_n = w.read_normals_packed(id).unwrap();
             for (g, c) in gpu_n.iter().zip(&cpu_n) {
                 let (gx, gz) = acc_cpu::unpack2x16snorm(*g);
                 let (cx, cz) = acc_cpu::unpack2x16snorm(*c);
-                assert!((gx - cx).abs() < 1e-3 && (gz - cz).abs() < 1e-3, "normal {gx},{gz} vs {cx},{cz}");
+                assert!(
+                    (gx - cx).abs() < 1e-3 && (gz - cz).abs() < 1e-3,
+                    "normal {gx},{gz} vs {cx},{cz}"
+                );
             }
             before = gpu_heights;
         }
@@ -158,22 +200,44 @@ fn mesh_capture_matches_cpu_and_clamps_to_the_ground() {
     let mb = w.add_mesh("box", &boxy).unwrap();
     let poses = [
         (ms, &sphere, Pose::at([-0.7, -0.2, 0.0])),
-        (mb, &boxy, Pose { position: Vec3::new(0.7, 0.1, 0.2), rotation: Quat::from_rotation_y(0.6) * Quat::from_rotation_x(0.4) }),
+        (
+            mb,
+            &boxy,
+            Pose {
+                position: Vec3::new(0.7, 0.1, 0.2),
+                rotation: Quat::from_rotation_y(0.6) * Quat::from_rotation_x(0.4),
+            },
+        ),
     ];
-    let deformers: Vec<Deformer> = poses.iter().map(|(m, _, p)| Deformer::new(Shape::Mesh(*m), *p)).collect();
+    let deformers: Vec<Deformer> = poses
+        .iter()
+        .map(|(m, _, p)| Deformer::new(Shape::Mesh(*m), *p))
+        .collect();
     w.step(1.0 / 60.0, &deformers).unwrap();
     let l = desc.layout();
     let vol = volume(&desc);
     let mut tris = vec![];
     for (_, mesh, pose) in &poses {
-        let m = vol.world_to_local * glam::Mat4::from_rotation_translation(pose.rotation, pose.position);
+        let m = vol.world_to_local
+            * glam::Mat4::from_rotation_translation(pose.rotation, pose.position);
         let t = mesh.transformed(m);
         for i in t.indices.chunks(3) {
-            tris.push([t.positions[i[0] as usize], t.positions[i[1] as usize], t.positions[i[2] as usize]]);
+            tris.push([
+                t.positions[i[0] as usize],
+                t.positions[i[1] as usize],
+                t.positions[i[2] as usize],
+            ]);
         }
     }
     let gpu_cap = w.read_last_capture(id).unwrap().unwrap();
-    let cpu_cap = cap_cpu::capture(l.width, l.height, vol.half_size, vol.frustum_height, &[], &tris);
+    let cpu_cap = cap_cpu::capture(
+        l.width,
+        l.height,
+        vol.half_size,
+        vol.frustum_height,
+        &[],
+        &tris,
+    );
     let mut mismatch = 0;
     for (g, c) in gpu_cap.iter().zip(&cpu_cap) {
         if (*g < 1.0) != (*c < 1.0) || (g - c).abs() > 1e-4 {
@@ -181,7 +245,11 @@ fn mesh_capture_matches_cpu_and_clamps_to_the_ground() {
         }
     }
     // Only texels whose centre lies on a triangle edge may differ.
-    assert!(mismatch * 100 <= gpu_cap.len(), "{mismatch} of {} texels differ", gpu_cap.len());
+    assert!(
+        mismatch * 100 <= gpu_cap.len(),
+        "{mismatch} of {} texels differ",
+        gpu_cap.len()
+    );
     // The sunk sphere (centre 0.2 below the ground, radius 0.4) fills a disc of radius
     // sqrt(0.16 - 0.04) = 0.346 at ground level with depth 0, and nothing outside it.
     let texel = 3.0 / l.width as f32;
@@ -211,7 +279,11 @@ fn sphere_depression(top: f32, c: f32, r: f32, d: f32, depth: f32) -> f32 {
 /// centres, the blur mixes the 3x3 centres around a texel), give or take one unit of quantization.
 /// Each centre is also probed 0.5 mm away, so that a centre lying exactly on a rim (where the
 /// depression jumps) may fall on either side of it, as it may on the GPU.
-fn assert_within_blur_spread(map: &snowprint::Heightmap, half: Vec2, analytic: impl Fn(Vec2) -> f32) {
+fn assert_within_blur_spread(
+    map: &snowprint::Heightmap,
+    half: Vec2,
+    analytic: impl Fn(Vec2) -> f32,
+) {
     let (w, h) = (map.width, map.height);
     let mut checked = 0;
     let probes = [Vec2::ZERO, Vec2::X, -Vec2::X, Vec2::Y, -Vec2::Y].map(|v| v * 5e-4);
@@ -221,7 +293,10 @@ fn assert_within_blur_spread(map: &snowprint::Heightmap, half: Vec2, analytic: i
             let mut hi = f32::MIN;
             for dy in -1i32..=1 {
                 for dx in -1i32..=1 {
-                    let (x, y) = ((col as i32 + dx).clamp(0, w as i32 - 1), (row as i32 + dy).clamp(0, h as i32 - 1));
+                    let (x, y) = (
+                        (col as i32 + dx).clamp(0, w as i32 - 1),
+                        (row as i32 + dy).clamp(0, h as i32 - 1),
+                    );
                     let n = cap_cpu::texel_center(x as u32, y as u32, w, h, half);
                     for p in probes {
                         let v = analytic(n + p);
@@ -232,7 +307,10 @@ fn assert_within_blur_spread(map: &snowprint::Heightmap, half: Vec2, analytic: i
             }
             let got = map.fraction(col, row);
             let unit = 1.5 / 65535.0;
-            assert!(got >= lo - unit && got <= hi + unit, "texel ({col},{row}): {got} not in [{lo}, {hi}]");
+            assert!(
+                got >= lo - unit && got <= hi + unit,
+                "texel ({col},{row}): {got} not in [{lo}, {hi}]"
+            );
             if hi > 0.0 {
                 checked += 1;
             }
@@ -251,14 +329,27 @@ fn sphere_leaves_the_analytic_depression() {
     for (r, c) in [(r, c), (0.25, 0.3), (0.5, 0.62)] {
         let mut w2 = world(CaptureMode::Depth);
         let id2 = w2.add_surface(desc.clone()).unwrap();
-        w2.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: r }, Pose::at([0.1, 5.0 + c, -0.2]))]).unwrap();
+        w2.step(
+            1.0 / 60.0,
+            &[Deformer::new(
+                Shape::Sphere { radius: r },
+                Pose::at([0.1, 5.0 + c, -0.2]),
+            )],
+        )
+        .unwrap();
         let map = w2.read_heightmap(id2).unwrap();
         assert_within_blur_spread(&map, Vec2::ONE, |p| {
             sphere_depression(depth, c, r, (p - Vec2::new(0.1, -0.2)).length(), depth)
         });
     }
     // Untouched surface reads all zero.
-    assert!(w.read_heightmap(id).unwrap().depression.iter().all(|&v| v == 0));
+    assert!(
+        w.read_heightmap(id)
+            .unwrap()
+            .depression
+            .iter()
+            .all(|&v| v == 0)
+    );
 }
 
 #[test]
@@ -271,7 +362,15 @@ fn dragged_sphere_leaves_a_trench_with_the_same_cross_section() {
     let frames = 40;
     let pos = |f: u32| Pose::at([-1.5 + 3.0 * f as f32 / frames as f32, c, z0]);
     for f in 1..=frames {
-        w.step(1.0 / 60.0, &[Deformer::moving(Shape::Sphere { radius: r }, pos(f - 1), pos(f))]).unwrap();
+        w.step(
+            1.0 / 60.0,
+            &[Deformer::moving(
+                Shape::Sphere { radius: r },
+                pos(f - 1),
+                pos(f),
+            )],
+        )
+        .unwrap();
     }
     let map = w.read_heightmap(id).unwrap();
     // Distance from the segment the centre travelled.
@@ -288,7 +387,14 @@ fn replenishment_refills_at_the_given_rate() {
     desc.replenish_rate = 0.05;
     let id = w.add_surface(desc).unwrap();
     // Press the middle fully to the ground with a sunk sphere, in a step of dt = 0.
-    w.step(0.0, &[Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, -0.1, 0.0]))]).unwrap();
+    w.step(
+        0.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.3 },
+            Pose::at([0.0, -0.1, 0.0]),
+        )],
+    )
+    .unwrap();
     let centre = |w: &SnowWorld| {
         let m = w.read_heightmap(id).unwrap();
         m.depression[(m.height / 2 * m.width + m.width / 2) as usize]
@@ -301,7 +407,10 @@ fn replenishment_refills_at_the_given_rate() {
             let t = n as f64 * dt as f64;
             let expect = (1.0 - 0.05 * t).max(0.0) * 65535.0;
             let got = centre(&w) as f64;
-            assert!((got - expect).abs() <= 1.0, "after {t} s: {got} vs {expect}");
+            assert!(
+                (got - expect).abs() <= 1.0,
+                "after {t} s: {got} vs {expect}"
+            );
         }
     }
     // After 20 s at 5 %/s it is untouched again; 600 frames = 10 s, half refilled.
@@ -318,13 +427,30 @@ fn deformer_above_the_ankle_zone_leaves_nothing() {
     let id = w.add_surface(desc).unwrap();
     let top_of_frustum = 2.0 + 0.3 + ANKLE;
     let d = [
-        Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([0.0, top_of_frustum + 0.2 + 1e-3, 0.0])),
+        Deformer::new(
+            Shape::Sphere { radius: 0.2 },
+            Pose::at([0.0, top_of_frustum + 0.2 + 1e-3, 0.0]),
+        ),
         // Inside the ankle zone but above the snow: captured, yet it presses nothing.
-        Deformer::new(Shape::Box { half_extents: Vec3::splat(0.1) }, Pose::at([0.5, 2.3 + 0.11, 0.5])),
+        Deformer::new(
+            Shape::Box {
+                half_extents: Vec3::splat(0.1),
+            },
+            Pose::at([0.5, 2.3 + 0.11, 0.5]),
+        ),
     ];
     let stats = w.step(1.0 / 60.0, &d).unwrap();
-    assert_eq!(stats.primitives, 1, "the sphere above the frustum is culled");
-    assert!(w.read_heightmap(id).unwrap().depression.iter().all(|&v| v == 0));
+    assert_eq!(
+        stats.primitives, 1,
+        "the sphere above the frustum is culled"
+    );
+    assert!(
+        w.read_heightmap(id)
+            .unwrap()
+            .depression
+            .iter()
+            .all(|&v| v == 0)
+    );
 }
 
 #[test]
@@ -333,7 +459,14 @@ fn sunk_sphere_flattens_exactly_its_ground_cross_section() {
     let desc = SurfaceDesc::new("g", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
     let id = w.add_surface(desc.clone()).unwrap();
     // Centre 0.3 below the ground, radius 0.5: cross-section radius 0.4 at the ground.
-    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, -0.3, 0.0]))]).unwrap();
+    w.step(
+        1.0 / 60.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, -0.3, 0.0]),
+        )],
+    )
+    .unwrap();
     let map = w.read_heightmap(id).unwrap();
     let l = desc.layout();
     let texel = 2.0 / l.width as f32;
@@ -358,22 +491,60 @@ fn sunk_sphere_flattens_exactly_its_ground_cross_section() {
 #[test]
 fn surfaces_side_by_side_each_see_only_what_is_over_them() {
     let mut w = world(CaptureMode::Depth);
-    let a = w.add_surface(SurfaceDesc::new("a", [-1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
-    let b = w.add_surface(SurfaceDesc::new("b", [1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    let a = w
+        .add_surface(SurfaceDesc::new("a", [-1.0, 0.0, 0.0], [2.0, 2.0], 0.3))
+        .unwrap();
+    let b = w
+        .add_surface(SurfaceDesc::new("b", [1.0, 0.0, 0.0], [2.0, 2.0], 0.3))
+        .unwrap();
     // Only over a:
-    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([-1.0, 0.1, 0.0]))]).unwrap();
-    assert!(w.read_heightmap(a).unwrap().depression.iter().any(|&v| v > 0));
-    assert!(w.read_heightmap(b).unwrap().depression.iter().all(|&v| v == 0));
+    w.step(
+        1.0 / 60.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.2 },
+            Pose::at([-1.0, 0.1, 0.0]),
+        )],
+    )
+    .unwrap();
+    assert!(
+        w.read_heightmap(a)
+            .unwrap()
+            .depression
+            .iter()
+            .any(|&v| v > 0)
+    );
+    assert!(
+        w.read_heightmap(b)
+            .unwrap()
+            .depression
+            .iter()
+            .all(|&v| v == 0)
+    );
     // On a fresh pair, a box straddling the seam at x = 0: a sees its right edge, b its left edge,
     // nothing else.
     let mut w = world(CaptureMode::Depth);
-    let a = w.add_surface(SurfaceDesc::new("a", [-1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
-    let b = w.add_surface(SurfaceDesc::new("b", [1.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
-    w.step(1.0 / 60.0, &[Deformer::new(Shape::Box { half_extents: Vec3::new(0.3, 0.5, 0.3) }, Pose::at([0.0, 0.0, 0.5]))]).unwrap();
+    let a = w
+        .add_surface(SurfaceDesc::new("a", [-1.0, 0.0, 0.0], [2.0, 2.0], 0.3))
+        .unwrap();
+    let b = w
+        .add_surface(SurfaceDesc::new("b", [1.0, 0.0, 0.0], [2.0, 2.0], 0.3))
+        .unwrap();
+    w.step(
+        1.0 / 60.0,
+        &[Deformer::new(
+            Shape::Box {
+                half_extents: Vec3::new(0.3, 0.5, 0.3),
+            },
+            Pose::at([0.0, 0.0, 0.5]),
+        )],
+    )
+    .unwrap();
     let (ma, mb) = (w.read_heightmap(a).unwrap(), w.read_heightmap(b).unwrap());
     let l = ma.width;
     let pressed_cols = |m: &snowprint::Heightmap| {
-        (0..m.width).filter(|&c| (0..m.height).any(|r| m.depression[(r * m.width + c) as usize] == 65535)).collect::<Vec<_>>()
+        (0..m.width)
+            .filter(|&c| (0..m.height).any(|r| m.depression[(r * m.width + c) as usize] == 65535))
+            .collect::<Vec<_>>()
     };
     let ca = pressed_cols(&ma);
     let cb = pressed_cols(&mb);
@@ -388,21 +559,40 @@ fn mask_capture_presses_a_fixed_imprint() {
     let desc = SurfaceDesc::new("k", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
     let id = w.add_surface(desc.clone()).unwrap();
     // A sphere that barely dips into the snow still presses the full mask depth.
-    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, 0.55, 0.0]))]).unwrap();
+    w.step(
+        1.0 / 60.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.3 },
+            Pose::at([0.0, 0.55, 0.0]),
+        )],
+    )
+    .unwrap();
     let map = w.read_heightmap(id).unwrap();
     let centre = map.depression[(map.height / 2 * map.width + map.width / 2) as usize];
     assert_eq!(centre as u32, acc_cpu::to_units(0.6));
-    assert_eq!(*map.depression.iter().max().unwrap() as u32, acc_cpu::to_units(0.6));
+    assert_eq!(
+        *map.depression.iter().max().unwrap() as u32,
+        acc_cpu::to_units(0.6)
+    );
     assert_eq!(map.depression[0], 0);
 }
 
 #[test]
 fn displaced_snow_accounts_for_what_was_pressed() {
     let mut w = world(CaptureMode::Depth);
-    let id = w.add_surface(SurfaceDesc::new("v", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3)).unwrap();
+    let id = w
+        .add_surface(SurfaceDesc::new("v", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3))
+        .unwrap();
     for k in 0..10 {
         let x = -0.5 + 0.1 * k as f32;
-        w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([x, 0.2, 0.0]))]).unwrap();
+        w.step(
+            1.0 / 60.0,
+            &[Deformer::new(
+                Shape::Sphere { radius: 0.2 },
+                Pose::at([x, 0.2, 0.0]),
+            )],
+        )
+        .unwrap();
     }
     // With no snowfall, every unit pressed out of a texel is counted once in the displaced channel.
     let map = w.read_heightmap(id).unwrap();
@@ -412,18 +602,54 @@ fn displaced_snow_accounts_for_what_was_pressed() {
 
 #[test]
 fn pool_exhaustion_is_an_error_not_a_panic() {
-    let mut w = SnowWorld::new(common::gpu(), WorldConfig { pool_bytes: 1 << 20, ..Default::default() }).unwrap();
+    let mut w = SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            pool_bytes: 1 << 20,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     // 8 m x 6 m = 200 x 150 texels = 360,192 bytes a slot: two fit in 1 MiB, the third does not.
-    let a = w.add_surface(SurfaceDesc::new("a", [0.0; 3], [8.0, 6.0], 0.3)).unwrap();
-    w.add_surface(SurfaceDesc::new("b", [10.0, 0.0, 0.0], [8.0, 6.0], 0.3)).unwrap();
-    let e = w.add_surface(SurfaceDesc::new("c", [20.0, 0.0, 0.0], [8.0, 6.0], 0.3)).unwrap_err();
-    assert!(matches!(e, SnowError::PoolExhausted { needed: 360_192, .. }), "{e}");
+    let a = w
+        .add_surface(SurfaceDesc::new("a", [0.0; 3], [8.0, 6.0], 0.3))
+        .unwrap();
+    w.add_surface(SurfaceDesc::new("b", [10.0, 0.0, 0.0], [8.0, 6.0], 0.3))
+        .unwrap();
+    let e = w
+        .add_surface(SurfaceDesc::new("c", [20.0, 0.0, 0.0], [8.0, 6.0], 0.3))
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SnowError::PoolExhausted {
+                needed: 360_192,
+                ..
+            }
+        ),
+        "{e}"
+    );
     assert_eq!(w.memory().pool_used, 2 * 360_192);
     // Freed memory is reused, and a reused slot starts untouched.
-    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, 0.1, 0.0]))]).unwrap();
+    w.step(
+        1.0 / 60.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.3 },
+            Pose::at([0.0, 0.1, 0.0]),
+        )],
+    )
+    .unwrap();
     w.remove_surface(a).unwrap();
-    let c = w.add_surface(SurfaceDesc::new("c", [20.0, 0.0, 0.0], [8.0, 6.0], 0.3)).unwrap();
-    assert!(w.read_heightmap(c).unwrap().depression.iter().all(|&v| v == 0));
+    let c = w
+        .add_surface(SurfaceDesc::new("c", [20.0, 0.0, 0.0], [8.0, 6.0], 0.3))
+        .unwrap();
+    assert!(
+        w.read_heightmap(c)
+            .unwrap()
+            .depression
+            .iter()
+            .all(|&v| v == 0)
+    );
     assert!(matches!(w.read_heightmap(a), Err(SnowError::StaleHandle { .. })) || a == c);
 }
 
@@ -438,23 +664,61 @@ fn yawed_surface_maps_world_to_its_texels() {
     let local = Vec3::new(1.5, 0.0, -0.5);
     let world_p = desc.center + Quat::from_rotation_y(90f32.to_radians()) * local;
     assert!((world_p - Vec3::new(2.5, 0.0, 1.5)).length() < 1e-5);
-    w.step(1.0 / 60.0, &[Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([world_p.x, 0.0, world_p.z]))]).unwrap();
+    w.step(
+        1.0 / 60.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.1 },
+            Pose::at([world_p.x, 0.0, world_p.z]),
+        )],
+    )
+    .unwrap();
     let map = w.read_heightmap(id).unwrap();
-    let (col, row) = ((1.5 + 2.0) / 4.0 * map.width as f32, (-0.5 + 1.0) / 2.0 * map.height as f32);
-    let (imax, _) = map.depression.iter().enumerate().max_by_key(|(_, v)| **v).unwrap();
-    let (mc, mr) = ((imax as u32 % map.width) as f32, (imax as u32 / map.width) as f32);
-    assert!((mc + 0.5 - col).abs() <= 1.5 && (mr + 0.5 - row).abs() <= 1.5, "peak at {mc},{mr}, expected {col},{row}");
+    let (col, row) = (
+        (1.5 + 2.0) / 4.0 * map.width as f32,
+        (-0.5 + 1.0) / 2.0 * map.height as f32,
+    );
+    let (imax, _) = map
+        .depression
+        .iter()
+        .enumerate()
+        .max_by_key(|(_, v)| **v)
+        .unwrap();
+    let (mc, mr) = (
+        (imax as u32 % map.width) as f32,
+        (imax as u32 / map.width) as f32,
+    );
+    assert!(
+        (mc + 0.5 - col).abs() <= 1.5 && (mr + 0.5 - row).abs() <= 1.5,
+        "peak at {mc},{mr}, expected {col},{row}"
+    );
 }
 
 #[test]
 fn bad_input_is_an_error() {
     let mut w = world(CaptureMode::Depth);
-    assert!(matches!(w.step(f32::NAN, &[]), Err(SnowError::InvalidTimeStep { .. })));
-    let e = w.step(0.1, &[Deformer::new(Shape::Sphere { radius: -1.0 }, Pose::at([0.0; 3]))]).unwrap_err();
+    assert!(matches!(
+        w.step(f32::NAN, &[]),
+        Err(SnowError::InvalidTimeStep { .. })
+    ));
+    let e = w
+        .step(
+            0.1,
+            &[Deformer::new(
+                Shape::Sphere { radius: -1.0 },
+                Pose::at([0.0; 3]),
+            )],
+        )
+        .unwrap_err();
     assert!(e.to_string().contains("radius"), "{e}");
-    assert!(w.add_surface(SurfaceDesc::new("z", [0.0; 3], [0.0, 1.0], 0.3)).is_err());
+    assert!(
+        w.add_surface(SurfaceDesc::new("z", [0.0; 3], [0.0, 1.0], 0.3))
+            .is_err()
+    );
     let m = w.add_mesh("cube", &Mesh::cuboid(Vec3::ONE)).unwrap();
-    assert!(matches!(w.pose_mesh(m, &[Vec3::ZERO; 3]), Err(SnowError::PoseMismatch { .. })));
+    assert!(matches!(
+        w.pose_mesh(m, &[Vec3::ZERO; 3]),
+        Err(SnowError::PoseMismatch { .. })
+    ));
 }
 
 #[test]
@@ -465,17 +729,56 @@ fn update_touches_only_the_listed_surfaces() {
     let a = w.add_surface(desc.clone()).unwrap();
     desc.name = "u2".into();
     let b = w.add_surface(desc).unwrap();
-    let sphere = [Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, -0.1, 0.0]))];
-    let stats = w.update(&[snowprint::SurfaceUpdate { surface: a, elapsed: 0.0, deformers: &sphere }]).unwrap();
+    let sphere = [Deformer::new(
+        Shape::Sphere { radius: 0.3 },
+        Pose::at([0.0, -0.1, 0.0]),
+    )];
+    let stats = w
+        .update(&[snowprint::SurfaceUpdate {
+            surface: a,
+            elapsed: 0.0,
+            deformers: &sphere,
+        }])
+        .unwrap();
     assert_eq!(stats.updated, 1);
     assert!(w.read_heightmap(a).unwrap().depression.contains(&65535));
-    assert!(w.read_heightmap(b).unwrap().depression.iter().all(|&v| v == 0));
+    assert!(
+        w.read_heightmap(b)
+            .unwrap()
+            .depression
+            .iter()
+            .all(|&v| v == 0)
+    );
     // A surface updated late replenishes by all the time it waited: 2 s at 10 %/s.
-    w.update(&[snowprint::SurfaceUpdate { surface: a, elapsed: 2.0, deformers: &[] }]).unwrap();
-    assert_eq!(*w.read_heightmap(a).unwrap().depression.iter().max().unwrap(), 65535 - 13107);
+    w.update(&[snowprint::SurfaceUpdate {
+        surface: a,
+        elapsed: 2.0,
+        deformers: &[],
+    }])
+    .unwrap();
+    assert_eq!(
+        *w.read_heightmap(a)
+            .unwrap()
+            .depression
+            .iter()
+            .max()
+            .unwrap(),
+        65535 - 13107
+    );
     let twice = [
-        snowprint::SurfaceUpdate { surface: b, elapsed: 0.0, deformers: &[] },
-        snowprint::SurfaceUpdate { surface: b, elapsed: 0.0, deformers: &[] },
+        snowprint::SurfaceUpdate {
+            surface: b,
+            elapsed: 0.0,
+            deformers: &[],
+        },
+        snowprint::SurfaceUpdate {
+            surface: b,
+            elapsed: 0.0,
+            deformers: &[],
+        },
     ];
-    assert!(matches!(w.update(&twice), Err(SnowError::DuplicateUpdate { .. })));
+    assert!(matches!(
+        w.update(&twice),
+        Err(SnowError::DuplicateUpdate { .. })
+    ));
 }

@@ -117,7 +117,14 @@ pub fn unpack_normal(v: u32) -> Vec3 {
 }
 
 /// Normals of the snow top of packed heights, packed as `normals.wgsl` packs them.
-pub fn normals(heights: &[u32], width: u32, height: u32, snow_depth: f32, texel_x: f32, texel_z: f32) -> Vec<u32> {
+pub fn normals(
+    heights: &[u32],
+    width: u32,
+    height: u32,
+    snow_depth: f32,
+    texel_x: f32,
+    texel_z: f32,
+) -> Vec<u32> {
     let h = |x: i32, y: i32| {
         let cx = x.clamp(0, width as i32 - 1) as usize;
         let cy = y.clamp(0, height as i32 - 1) as usize;

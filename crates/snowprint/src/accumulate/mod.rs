@@ -153,9 +153,12 @@ mod tests {
         ] {
             let module = naga::front::wgsl::parse_str(&src)
                 .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
-            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-                .validate(&module)
-                .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {e:?}"));
         }
     }
 
@@ -171,13 +174,34 @@ mod tests {
             .iter()
             .find(|(_, t)| t.name.as_deref() == Some("SurfaceRecord"))
             .unwrap();
-        let naga::TypeInner::Struct { members, .. } = &ty.inner else { panic!() };
-        assert_eq!(layouter[handle].size as usize, std::mem::size_of::<crate::pool::SurfaceRecord>());
-        let names: Vec<_> = members.iter().map(|m| (m.name.clone().unwrap(), m.offset)).collect();
+        let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+            panic!()
+        };
+        assert_eq!(
+            layouter[handle].size as usize,
+            std::mem::size_of::<crate::pool::SurfaceRecord>()
+        );
+        let names: Vec<_> = members
+            .iter()
+            .map(|m| (m.name.clone().unwrap(), m.offset))
+            .collect();
         let expect = [
-            "heights_read", "heights_write", "normals", "scratch", "width", "height", "atlas_x",
-            "atlas_y", "mode", "replenish_units", "batch", "mask_fraction", "snow_depth",
-            "frustum_height", "texel_x", "texel_z",
+            "heights_read",
+            "heights_write",
+            "normals",
+            "scratch",
+            "width",
+            "height",
+            "atlas_x",
+            "atlas_y",
+            "mode",
+            "replenish_units",
+            "batch",
+            "mask_fraction",
+            "snow_depth",
+            "frustum_height",
+            "texel_x",
+            "texel_z",
         ];
         for (i, (name, offset)) in names.iter().enumerate() {
             assert_eq!(name, expect[i]);

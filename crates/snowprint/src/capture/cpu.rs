@@ -128,7 +128,11 @@ pub fn triangle_depth(t: &LocalTriangle, x: f32, z: f32, frustum_height: f32) ->
         return None;
     }
     let normal_y = (b - a).cross(c - a).y;
-    Some(if normal_y < 0.0 { y / frustum_height } else { 0.0 })
+    Some(if normal_y < 0.0 {
+        y / frustum_height
+    } else {
+        0.0
+    })
 }
 
 /// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen.
@@ -177,14 +181,29 @@ mod tests {
     fn horizontal_capsule_bottom_is_analytic() {
         // Capsule along x from -1 to 1 at height 0.4, radius 0.3: at x = 0.5, z = 0.1 the lowest
         // point is 0.4 - sqrt(0.09 - 0.01).
-        let (lo, _) = capsule_interval(Vec3::new(-1.0, 0.4, 0.0), Vec3::new(1.0, 0.4, 0.0), 0.3, 0.5, 0.1);
+        let (lo, _) = capsule_interval(
+            Vec3::new(-1.0, 0.4, 0.0),
+            Vec3::new(1.0, 0.4, 0.0),
+            0.3,
+            0.5,
+            0.1,
+        );
         assert!((lo - (0.4 - 0.08f32.sqrt())).abs() < 1e-6, "{lo}");
         // Slanted capsule, vertical line through its middle: the cylinder part.
-        let (lo, hi) = capsule_interval(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), 0.2, 0.0, 0.0);
+        let (lo, hi) = capsule_interval(
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            0.2,
+            0.0,
+            0.0,
+        );
         // Distance from (0, y, 0) to the axis line through (0, 0.5, 0) with direction (2, 1)/sqrt5
         // is |y - 0.5| * 2 / sqrt5, equal to 0.2 at |y - 0.5| = 0.1 * sqrt5.
         let d = 0.1 * 5f32.sqrt();
-        assert!((lo - (0.5 - d)).abs() < 1e-5 && (hi - (0.5 + d)).abs() < 1e-5, "{lo} {hi}");
+        assert!(
+            (lo - (0.5 - d)).abs() < 1e-5 && (hi - (0.5 + d)).abs() < 1e-5,
+            "{lo} {hi}"
+        );
     }
 
     #[test]
@@ -192,10 +211,17 @@ mod tests {
         // A cube of half side 0.5 turned 45 degrees about z: a vertical line through x = 0 meets it
         // from -sqrt(0.5) to +sqrt(0.5) around the centre height.
         let r = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_4);
-        let p = GpuPrimitive::oriented_box(Vec3::new(0.0, 1.0, 0.0), [r * Vec3::X, r * Vec3::Y, r * Vec3::Z], Vec3::splat(0.5));
+        let p = GpuPrimitive::oriented_box(
+            Vec3::new(0.0, 1.0, 0.0),
+            [r * Vec3::X, r * Vec3::Y, r * Vec3::Z],
+            Vec3::splat(0.5),
+        );
         let (lo, hi) = box_interval(&p, 0.0, 0.2);
         let s = 0.5f32.sqrt();
-        assert!((lo - (1.0 - s)).abs() < 1e-5 && (hi - (1.0 + s)).abs() < 1e-5, "{lo} {hi}");
+        assert!(
+            (lo - (1.0 - s)).abs() < 1e-5 && (hi - (1.0 + s)).abs() < 1e-5,
+            "{lo} {hi}"
+        );
     }
 
     #[test]

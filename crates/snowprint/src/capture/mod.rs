@@ -361,7 +361,14 @@ pub struct AtlasPlacement {
 pub fn pack_atlas(rects: &[(u32, u32)], side: u32) -> Vec<AtlasPlacement> {
     let mut order: Vec<usize> = (0..rects.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse((rects[i].1, rects[i].0)));
-    let mut out = vec![AtlasPlacement { batch: 0, x: 0, y: 0 }; rects.len()];
+    let mut out = vec![
+        AtlasPlacement {
+            batch: 0,
+            x: 0,
+            y: 0
+        };
+        rects.len()
+    ];
     let (mut batch, mut x, mut y, mut shelf) = (0u32, 0u32, 0u32, 0u32);
     for i in order {
         let (w, h) = rects[i];
@@ -389,7 +396,9 @@ mod tests {
 
     #[test]
     fn atlas_packing_never_overlaps() {
-        let rects: Vec<(u32, u32)> = (0..300).map(|i| (17 + (i * 37) % 500, 9 + (i * 53) % 400)).collect();
+        let rects: Vec<(u32, u32)> = (0..300)
+            .map(|i| (17 + (i * 37) % 500, 9 + (i * 53) % 400))
+            .collect();
         let side = 1024;
         let p = pack_atlas(&rects, side);
         for (i, a) in p.iter().enumerate() {
@@ -421,7 +430,14 @@ mod tests {
         );
         let mut out = vec![];
         push_primitives(&d, &vol, &mut out);
-        assert_eq!(out, vec![GpuPrimitive::capsule(Vec3::new(-1.0, 0.1, 0.0), Vec3::new(1.0, 0.1, 0.0), 0.2)]);
+        assert_eq!(
+            out,
+            vec![GpuPrimitive::capsule(
+                Vec3::new(-1.0, 0.1, 0.0),
+                Vec3::new(1.0, 0.1, 0.0),
+                0.2
+            )]
+        );
         // Above the frustum: culled.
         let high = Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([0.0, 0.71, 0.0]));
         out.clear();

@@ -194,7 +194,7 @@ impl GpuContext {
         }
         let caps = Capabilities {
             timestamps,
-            max_storage_binding: limits.max_storage_buffer_binding_size as u64,
+            max_storage_binding: limits.max_storage_buffer_binding_size,
             max_texture_side: limits.max_texture_dimension_2d,
             filterable_rgba16f,
             warnings,

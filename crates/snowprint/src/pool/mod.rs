@@ -102,7 +102,11 @@ impl SlotAllocator {
         let budget = budget / SLOT_ALIGN * SLOT_ALIGN;
         Self {
             budget,
-            free: if budget > 0 { vec![(0, budget)] } else { vec![] },
+            free: if budget > 0 {
+                vec![(0, budget)]
+            } else {
+                vec![]
+            },
             used: 0,
             high_water: 0,
         }
