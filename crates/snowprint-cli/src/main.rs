@@ -3,6 +3,7 @@
 //! Each subcommand lives in its own module with its own arguments; this file only dispatches and
 //! turns errors into one sentence and a non-zero exit.
 
+mod bench;
 mod demo;
 mod simulate;
 
@@ -27,6 +28,8 @@ enum Command {
     Simulate(simulate::Args),
     /// Run the built-in demo and write its outputs.
     Demo(demo::Args),
+    /// Measure the deformation update per stage on the GPU, against a copy of the same bytes.
+    Bench(bench::Args),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(args) => simulate::run(&gpu, &args),
         Command::Demo(args) => demo::run(&gpu, &args),
+        Command::Bench(args) => bench::run(&gpu, &args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -122,9 +122,15 @@ impl SurfaceLayout {
     /// axis = ceil(side / texel size). An 8 m x 6 m roof gets 200 x 150, a 30 m x 10 m street
     /// 512 x 171.
     pub fn for_size(size: Vec2) -> Self {
-        let texel = Self::nominal_texel_size(size);
+        Self::for_size_capped(size, MAX_RESOLUTION)
+    }
+
+    /// The same rule with another cap than 512 texels a side (benchmarks sweep up to 1024).
+    pub fn for_size_capped(size: Vec2, max_resolution: u32) -> Self {
+        let max_resolution = max_resolution.max(1);
+        let texel = (size.x.max(size.y) / max_resolution as f32).max(MIN_TEXEL_SIZE);
         // A tiny relative slack keeps exact multiples (8 m / 4 cm) from rounding up to 201.
-        let count = |side: f32| (((side / texel) - 1e-4).ceil() as u32).clamp(1, MAX_RESOLUTION);
+        let count = |side: f32| (((side / texel) - 1e-4).ceil() as u32).clamp(1, max_resolution);
         Self {
             width: count(size.x),
             height: count(size.y),

@@ -63,6 +63,8 @@ pub struct WorldConfig {
     pub pool_bytes: u64,
     /// Largest side of the capture atlas, texels (clamped to the device's limit).
     pub atlas_side: u32,
+    /// Largest heightmap side, texels: 512 as in the talk; benchmarks raise it.
+    pub max_resolution: u32,
 }
 
 impl Default for WorldConfig {
@@ -71,6 +73,7 @@ impl Default for WorldConfig {
             capture: CaptureConfig::default(),
             pool_bytes: 32 << 20,
             atlas_side: 2048,
+            max_resolution: crate::surface::MAX_RESOLUTION,
         }
     }
 }
@@ -303,6 +306,7 @@ impl SnowWorld {
             config.pool_bytes = max_pool;
         }
         config.atlas_side = config.atlas_side.clamp(64, gpu.caps.max_texture_side);
+        config.max_resolution = config.max_resolution.clamp(1, config.atlas_side);
         let alloc = SlotAllocator::new(config.pool_bytes);
         let pool = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("heightmap pool"),
@@ -406,7 +410,7 @@ impl SnowWorld {
     /// the pool has no room (a normal state: remove a surface or give the pool more bytes).
     pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
         desc.validate()?;
-        let layout = desc.layout();
+        let layout = SurfaceLayout::for_size_capped(desc.size, self.config.max_resolution);
         let slot = self
             .alloc
             .alloc(layout.texels())

@@ -36,15 +36,7 @@ fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     return clamp((rec.snow_depth - h) / rec.snow_depth, 0.0, 1.0);
 }
 
-fn bilinear(rec: SurfaceRecord, p: vec2<f32>) -> f32 {
-    let q = p - vec2<f32>(0.5);
-    let base = floor(q);
-    let f = q - base;
-    let i = vec2<i32>(base);
-    let a = depression(rec, i.x, i.y);
-    let b = depression(rec, i.x + 1, i.y);
-    let c = depression(rec, i.x, i.y + 1);
-    let d = depression(rec, i.x + 1, i.y + 1);
+fn lerp2(a: f32, b: f32, c: f32, d: f32, f: vec2<f32>) -> f32 {
     let top = a * (1.0 - f.x) + b * f.x;
     let bottom = c * (1.0 - f.x) + d * f.x;
     return top * (1.0 - f.y) + bottom * f.y;
@@ -56,10 +48,23 @@ fn blur(@builtin(global_invocation_id) gid: vec3<u32>) {
     if rec.batch != params.batch || gid.x >= rec.width || gid.y >= rec.height {
         return;
     }
-    let p = vec2<f32>(gid.xy) + vec2<f32>(0.5);
-    var sum = 0.0;
-    for (var t = 0; t < 4; t++) {
-        sum += bilinear(rec, p + TAPS[t]);
-    }
-    scratch[rec.scratch + gid.y * rec.width + gid.x] = sum * 0.25;
+    // The four taps (TAPS) each mix a 2x2 block of the 3x3 texels around this one: load the nine
+    // once. vXY is the texel at offset (X - 1, Y - 1). A tap at offset o from the texel centre
+    // interpolates from texel floor(o) with weights fract(o), exactly as the CPU reference does.
+    let x = i32(gid.x);
+    let y = i32(gid.y);
+    let v00 = depression(rec, x - 1, y - 1);
+    let v10 = depression(rec, x, y - 1);
+    let v20 = depression(rec, x + 1, y - 1);
+    let v01 = depression(rec, x - 1, y);
+    let v11 = depression(rec, x, y);
+    let v21 = depression(rec, x + 1, y);
+    let v02 = depression(rec, x - 1, y + 1);
+    let v12 = depression(rec, x, y + 1);
+    let v22 = depression(rec, x + 1, y + 1);
+    let t0 = lerp2(v00, v10, v01, v11, fract(TAPS[0])); // (-0.25, -0.75): from (-1, -1)
+    let t1 = lerp2(v10, v20, v11, v21, fract(TAPS[1])); // ( 0.75, -0.25): from ( 0, -1)
+    let t2 = lerp2(v11, v21, v12, v22, fract(TAPS[2])); // ( 0.25,  0.75): from ( 0,  0)
+    let t3 = lerp2(v01, v11, v02, v12, fract(TAPS[3])); // (-0.75,  0.25): from (-1,  0)
+    scratch[rec.scratch + gid.y * rec.width + gid.x] = (t0 + t1 + t2 + t3) * 0.25;
 }

@@ -1,0 +1,548 @@
+//! `snowprint bench`: GPU time of the deformation update per stage, swept over surfaces per frame,
+//! resolution and deformers per surface, against a plain copy of the same bytes measured in the
+//! same run.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use snowprint::{
+    Deformer, GpuContext, GpuOptions, Pose, Shape, SnowWorld, StageTimes, SurfaceDesc, WorldConfig,
+};
+
+/// Arguments of `snowprint bench`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Folder for `bench.json` and the SVG plots.
+    #[arg(long, default_value = "out/bench")]
+    pub out: PathBuf,
+    /// Frames measured per configuration (after the warm-up).
+    #[arg(long, default_value_t = 60)]
+    pub frames: u32,
+    /// Frames run before measuring.
+    #[arg(long, default_value_t = 10)]
+    pub warmup: u32,
+    /// Small sweeps only (what a software adapter can run in seconds).
+    #[arg(long)]
+    pub quick: bool,
+}
+
+/// One measured configuration.
+#[derive(Serialize, Debug, Clone)]
+pub struct Row {
+    /// Which sweep it belongs to.
+    pub sweep: &'static str,
+    /// Surfaces updated per frame.
+    pub surfaces: u32,
+    /// Heightmap side, texels.
+    pub resolution: u32,
+    /// Deformers over each surface.
+    pub deformers_per_surface: u32,
+    /// Median GPU time of the whole update, microseconds (or whole frames timed on the CPU).
+    pub update_us: f64,
+    /// Median GPU time per stage, microseconds.
+    pub stages_us: Option<StageTimesUs>,
+    /// Median CPU time to build and encode the frame, microseconds.
+    pub cpu_encode_us: f64,
+    /// Bytes of heightmap history the update rewrites (texels x 4).
+    pub heightmap_bytes: u64,
+    /// Median GPU time of a plain buffer copy of `heightmap_bytes`, microseconds.
+    pub copy_us: f64,
+    /// `update_us / copy_us`.
+    pub ratio_to_copy: f64,
+    /// Pool bytes of the surfaces.
+    pub pool_bytes: u64,
+}
+
+/// Per-stage medians, microseconds.
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct StageTimesUs {
+    /// Capture render passes.
+    pub capture: f64,
+    /// Blur.
+    pub blur: f64,
+    /// Merge.
+    pub merge: f64,
+    /// Normals.
+    pub normals: f64,
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Timing of a plain `copy_buffer_to_buffer`, with encoder timestamps when the device has them,
+/// else whole submissions timed on the CPU.
+struct CopyTimer {
+    src: wgpu::Buffer,
+    dst: wgpu::Buffer,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer, f32)>,
+}
+
+impl CopyTimer {
+    fn new(gpu: &GpuContext, bytes: u64) -> Self {
+        let make = |label, usage| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(4),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        let queries = gpu
+            .device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+            .then(|| {
+                (
+                    gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                        label: Some("copy timestamps"),
+                        ty: wgpu::QueryType::Timestamp,
+                        count: 2,
+                    }),
+                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("copy resolve"),
+                        size: 16,
+                        usage: U::QUERY_RESOLVE | U::COPY_SRC,
+                        mapped_at_creation: false,
+                    }),
+                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("copy readback"),
+                        size: 16,
+                        usage: U::MAP_READ | U::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                    gpu.queue.get_timestamp_period(),
+                )
+            });
+        Self {
+            src: make("copy source", U::COPY_SRC | U::STORAGE),
+            dst: make("copy destination", U::COPY_DST | U::STORAGE),
+            queries,
+        }
+    }
+
+    /// One copy, microseconds.
+    fn time(&self, gpu: &GpuContext) -> Result<f64, String> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        if let Some((set, _, _, _)) = &self.queries {
+            enc.write_timestamp(set, 0);
+        }
+        enc.copy_buffer_to_buffer(&self.src, 0, &self.dst, 0, self.src.size());
+        if let Some((set, resolve, readback, _)) = &self.queries {
+            enc.write_timestamp(set, 1);
+            enc.resolve_query_set(set, 0..2, resolve, 0);
+            enc.copy_buffer_to_buffer(resolve, 0, readback, 0, 16);
+        }
+        let start = Instant::now();
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait_idle().map_err(|e| e.to_string())?;
+        let wall = start.elapsed().as_secs_f64() * 1e6;
+        let Some((_, _, readback, period)) = &self.queries else {
+            return Ok(wall);
+        };
+        let slice = readback.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        gpu.wait_idle().map_err(|e| e.to_string())?;
+        rx.recv()
+            .map_err(|e| e.to_string())?
+            .map_err(|e| e.to_string())?;
+        let ticks: Vec<u64> =
+            bytemuck_cast(&slice.get_mapped_range().map_err(|e| format!("{e:?}"))?);
+        readback.unmap();
+        Ok(ticks[1].saturating_sub(ticks[0]) as f64 * *period as f64 * 1e-3)
+    }
+}
+
+fn bytemuck_cast(bytes: &[u8]) -> Vec<u64> {
+    bytes
+        .chunks_exact(8)
+        .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
+        .collect()
+}
+
+/// A deterministic scatter of moving spheres over a surface of side `side` metres at ground 0.
+fn deformers_over(center: Vec3, side: f32, count: u32, frame: u32) -> Vec<Deformer> {
+    let mut out = Vec::with_capacity(count as usize);
+    let mut seed = 0x9e37_79b9u32 ^ count;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed as f32 / u32::MAX as f32
+    };
+    for _ in 0..count {
+        let (x, z) = ((next() - 0.5) * side * 0.9, (next() - 0.5) * side * 0.9);
+        let dir = Vec3::new(next() - 0.5, 0.0, next() - 0.5).normalize_or_zero() * 0.02;
+        let p = center + Vec3::new(x, 0.12, z) + dir * frame as f32;
+        out.push(Deformer::moving(
+            Shape::Sphere { radius: 0.15 },
+            Pose::at((p - dir).into()),
+            Pose::at(p.into()),
+        ));
+    }
+    out
+}
+
+struct Config {
+    sweep: &'static str,
+    surfaces: u32,
+    resolution: u32,
+    deformers: u32,
+}
+
+fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
+    // Square surfaces at 4 cm texels have exactly `resolution` texels a side.
+    let side = c.resolution as f32 * 0.04;
+    let slot = snowprint::pool::slot_bytes(c.resolution as u64 * c.resolution as u64);
+    let mut world = SnowWorld::new(
+        gpu,
+        WorldConfig {
+            pool_bytes: slot * c.surfaces as u64,
+            max_resolution: c.resolution,
+            atlas_side: 8192.min(gpu.caps.max_texture_side),
+            ..Default::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let mut centers = Vec::new();
+    for i in 0..c.surfaces {
+        let center = Vec3::new(
+            (i % 64) as f32 * (side + 1.0),
+            0.0,
+            (i / 64) as f32 * (side + 1.0),
+        );
+        world
+            .add_surface(SurfaceDesc::new(
+                &format!("s{i}"),
+                center.into(),
+                [side, side],
+                0.3,
+            ))
+            .map_err(|e| e.to_string())?;
+        centers.push(center);
+    }
+    world.set_profiling(true);
+    let timestamps = world.has_timestamps();
+    let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals) =
+        (vec![], vec![], vec![], vec![], vec![], vec![]);
+    for f in 0..args.warmup + args.frames {
+        let deformers: Vec<Deformer> = centers
+            .iter()
+            .flat_map(|&ctr| deformers_over(ctr, side, c.deformers, f))
+            .collect();
+        let start = Instant::now();
+        let stats = world
+            .step(1.0 / 60.0, &deformers)
+            .map_err(|e| e.to_string())?;
+        if !timestamps {
+            gpu.wait_idle().map_err(|e| e.to_string())?;
+        }
+        let wall = start.elapsed().as_secs_f64() * 1e6;
+        if f < args.warmup {
+            continue;
+        }
+        cpu.push(stats.cpu_encode_ms * 1e3);
+        match stats.gpu {
+            Some(StageTimes {
+                capture_ms,
+                blur_ms,
+                merge_ms,
+                normals_ms,
+            }) => {
+                cap.push(capture_ms * 1e3);
+                blur.push(blur_ms * 1e3);
+                merge.push(merge_ms * 1e3);
+                normals.push(normals_ms * 1e3);
+                total.push((capture_ms + blur_ms + merge_ms + normals_ms) * 1e3);
+            }
+            None => total.push(wall),
+        }
+    }
+    let bytes = c.surfaces as u64 * c.resolution as u64 * c.resolution as u64 * 4;
+    let copy = CopyTimer::new(gpu, bytes);
+    let mut copies = Vec::new();
+    for i in 0..args.warmup + args.frames {
+        let t = copy.time(gpu)?;
+        if i >= args.warmup {
+            copies.push(t);
+        }
+    }
+    let update_us = median(&mut total);
+    let copy_us = median(&mut copies);
+    Ok(Row {
+        sweep: c.sweep,
+        surfaces: c.surfaces,
+        resolution: c.resolution,
+        deformers_per_surface: c.deformers,
+        update_us,
+        stages_us: timestamps.then(|| StageTimesUs {
+            capture: median(&mut cap),
+            blur: median(&mut blur),
+            merge: median(&mut merge),
+            normals: median(&mut normals),
+        }),
+        cpu_encode_us: median(&mut cpu),
+        heightmap_bytes: bytes,
+        copy_us,
+        ratio_to_copy: update_us / copy_us,
+        pool_bytes: world.memory().pool_used,
+    })
+}
+
+/// Run the sweeps and write the report.
+pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
+    let gpu = GpuContext::new(gpu_options).map_err(|e| e.to_string())?;
+    let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
+    let quick = args.quick || software;
+    if software && !args.quick {
+        eprintln!(
+            "snowprint: {} is a software adapter: running the quick sweeps only",
+            gpu.info.name
+        );
+    }
+    let timestamps = gpu.caps.timestamps;
+    if !timestamps {
+        eprintln!(
+            "snowprint: {} has no GPU timestamp queries: whole frames are timed on the CPU (submit to finish), not per stage",
+            gpu.info.name
+        );
+    }
+    let mut configs = vec![Config {
+        sweep: "talk_budget",
+        surfaces: 2,
+        resolution: 512,
+        deformers: 10,
+    }];
+    let (counts, resolutions, deformers): (&[u32], &[u32], &[u32]) = if quick {
+        (&[1, 4, 16], &[64, 128, 256], &[1, 10, 100])
+    } else {
+        (
+            &[1, 4, 16, 64, 256, 1024, 4096],
+            &[64, 128, 256, 512, 1024],
+            &[1, 10, 100, 1000],
+        )
+    };
+    for &n in counts {
+        configs.push(Config {
+            sweep: "surfaces",
+            surfaces: n,
+            resolution: 256,
+            deformers: 10,
+        });
+    }
+    for &r in resolutions {
+        configs.push(Config {
+            sweep: "resolution",
+            surfaces: 16,
+            resolution: r,
+            deformers: 10,
+        });
+    }
+    for &d in deformers {
+        configs.push(Config {
+            sweep: "deformers",
+            surfaces: 2,
+            resolution: 512,
+            deformers: d,
+        });
+    }
+    if !quick {
+        configs.push(Config {
+            sweep: "goal_1024x512",
+            surfaces: 1024,
+            resolution: 512,
+            deformers: 1,
+        });
+    }
+    let bar = ProgressBar::new(configs.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} bench [{bar:30}] {pos}/{len} {msg}")
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+    );
+    let mut rows = Vec::new();
+    for c in &configs {
+        bar.set_message(format!(
+            "{} x {}^2, {} deformers",
+            c.surfaces, c.resolution, c.deformers
+        ));
+        rows.push(measure(&gpu, c, args)?);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    println!(
+        "adapter: {}\ntimestamps: {}\n",
+        snowprint::gpu::describe(&gpu.info),
+        if timestamps {
+            "per-pass GPU timestamps"
+        } else {
+            "none: whole frames timed on the CPU"
+        }
+    );
+    println!(
+        "{:<14} {:>8} {:>6} {:>6} {:>11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>8}",
+        "sweep",
+        "surfaces",
+        "res",
+        "defs",
+        "update_us",
+        "capture",
+        "blur",
+        "merge",
+        "normals",
+        "cpu_us",
+        "copy_us",
+        "x_copy"
+    );
+    for r in &rows {
+        let s = r.stages_us;
+        let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+        println!(
+            "{:<14} {:>8} {:>6} {:>6} {:>11.1} {:>9} {:>9} {:>9} {:>9} {:>9.1} {:>10.1} {:>8.2}",
+            r.sweep,
+            r.surfaces,
+            r.resolution,
+            r.deformers_per_surface,
+            r.update_us,
+            f(s.map(|s| s.capture)),
+            f(s.map(|s| s.blur)),
+            f(s.map(|s| s.merge)),
+            f(s.map(|s| s.normals)),
+            r.cpu_encode_us,
+            r.copy_us,
+            r.ratio_to_copy
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let report = serde_json::json!({
+        "adapter": snowprint::gpu::describe(&gpu.info),
+        "timestamps": timestamps,
+        "frames": args.frames,
+        "warmup": args.warmup,
+        "statistic": "median",
+        "rows": rows,
+    });
+    write(
+        &args.out.join("bench.json"),
+        &serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
+    )?;
+    for sweep in ["surfaces", "resolution", "deformers"] {
+        let pts: Vec<&Row> = rows.iter().filter(|r| r.sweep == sweep).collect();
+        let x = |r: &Row| match sweep {
+            "surfaces" => r.surfaces as f64,
+            "resolution" => r.resolution as f64,
+            _ => r.deformers_per_surface as f64,
+        };
+        let svg = plot_svg(
+            &format!("update time vs {sweep} ({})", gpu.info.name),
+            sweep,
+            &[
+                ("update", pts.iter().map(|r| (x(r), r.update_us)).collect()),
+                (
+                    "copy of the same bytes",
+                    pts.iter().map(|r| (x(r), r.copy_us)).collect(),
+                ),
+            ],
+        );
+        write(&args.out.join(format!("bench_{sweep}.svg")), &svg)?;
+    }
+    eprintln!("snowprint: wrote {}", args.out.display());
+    Ok(())
+}
+
+fn write(path: &Path, text: &str) -> Result<(), String> {
+    let tmp = path.with_extension("partial");
+    std::fs::write(&tmp, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// A log-log line plot as SVG.
+pub fn plot_svg(title: &str, x_label: &str, series: &[(&str, Vec<(f64, f64)>)]) -> String {
+    let (w, h, m) = (640.0, 400.0, 60.0);
+    let all: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.1.iter().copied())
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+        .collect();
+    let lx = |v: f64| v.log10();
+    let (x0, x1) = all.iter().fold((f64::MAX, f64::MIN), |a, p| {
+        (a.0.min(lx(p.0)), a.1.max(lx(p.0)))
+    });
+    let (y0, y1) = all.iter().fold((f64::MAX, f64::MIN), |a, p| {
+        (a.0.min(lx(p.1)), a.1.max(lx(p.1)))
+    });
+    let (x0, x1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0));
+    let (y0, y1) = (y0.floor(), y1.ceil().max(y0.floor() + 1.0));
+    let px = |v: f64| m + (lx(v) - x0) / (x1 - x0) * (w - 2.0 * m);
+    let py = |v: f64| h - m - (lx(v) - y0) / (y1 - y0) * (h - 2.0 * m);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{}\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">{title}</text>\n",
+        w / 2.0
+    );
+    for d in (x0 as i32)..=(x1 as i32) {
+        let x = m + (d as f64 - x0) / (x1 - x0) * (w - 2.0 * m);
+        s += &format!(
+            "<line x1=\"{x}\" y1=\"{m}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{d}</text>\n",
+            h - m,
+            h - m + 16.0
+        );
+    }
+    for d in (y0 as i32)..=(y1 as i32) {
+        let y = h - m - (d as f64 - y0) / (y1 - y0) * (h - 2.0 * m);
+        s += &format!(
+            "<line x1=\"{m}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{d} us</text>\n",
+            w - m,
+            m - 4.0,
+            y + 4.0
+        );
+    }
+    s += &format!(
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n",
+        w / 2.0,
+        h - 12.0
+    );
+    let colors = ["#1f77b4", "#d62728", "#2ca02c"];
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let c = colors[i % colors.len()];
+        let path: Vec<String> = pts
+            .iter()
+            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+            .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
+            .collect();
+        s += &format!(
+            "<polyline fill=\"none\" stroke=\"{c}\" stroke-width=\"2\" points=\"{}\"/>\n",
+            path.join(" ")
+        );
+        for p in pts.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0) {
+            s += &format!(
+                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3\" fill=\"{c}\"/>\n",
+                px(p.0),
+                py(p.1)
+            );
+        }
+        s += &format!(
+            "<text x=\"{}\" y=\"{}\" fill=\"{c}\">{name}</text>\n",
+            m + 10.0,
+            m + 16.0 + 16.0 * i as f64
+        );
+    }
+    s + "</svg>\n"
+}
