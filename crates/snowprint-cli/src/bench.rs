@@ -9,7 +9,8 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use snowprint::{
-    Deformer, GpuContext, GpuOptions, Pose, Shape, SnowWorld, StageTimes, SurfaceDesc, WorldConfig,
+    Deformer, GpuContext, GpuOptions, Pose, Shape, SnowWorld, StageTimes, SurfaceDesc,
+    SurfaceUpdate, WorldConfig,
 };
 
 /// Arguments of `snowprint bench`.
@@ -221,13 +222,14 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     )
     .map_err(|e| e.to_string())?;
     let mut centers = Vec::new();
+    let mut ids = Vec::new();
     for i in 0..c.surfaces {
         let center = Vec3::new(
             (i % 64) as f32 * (side + 1.0),
             0.0,
             (i / 64) as f32 * (side + 1.0),
         );
-        world
+        let id = world
             .add_surface(SurfaceDesc::new(
                 &format!("s{i}"),
                 center.into(),
@@ -235,6 +237,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
                 0.3,
             ))
             .map_err(|e| e.to_string())?;
+        ids.push(id);
         centers.push(center);
     }
     world.set_profiling(true);
@@ -242,14 +245,22 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals) =
         (vec![], vec![], vec![], vec![], vec![], vec![]);
     for f in 0..args.warmup + args.frames {
-        let deformers: Vec<Deformer> = centers
+        // Each surface is given the deformers over it, as a manager's spatial lookup would.
+        let deformers: Vec<Vec<Deformer>> = centers
             .iter()
-            .flat_map(|&ctr| deformers_over(ctr, side, c.deformers, f))
+            .map(|&ctr| deformers_over(ctr, side, c.deformers, f))
+            .collect();
+        let updates: Vec<SurfaceUpdate<'_>> = ids
+            .iter()
+            .zip(&deformers)
+            .map(|(&surface, d)| SurfaceUpdate {
+                surface,
+                elapsed: 1.0 / 60.0,
+                deformers: d,
+            })
             .collect();
         let start = Instant::now();
-        let stats = world
-            .step(1.0 / 60.0, &deformers)
-            .map_err(|e| e.to_string())?;
+        let stats = world.update(&updates).map_err(|e| e.to_string())?;
         if !timestamps {
             gpu.wait_idle().map_err(|e| e.to_string())?;
         }

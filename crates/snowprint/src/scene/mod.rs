@@ -1,0 +1,307 @@
+//! Scene files: snow surfaces, capture settings and keyframed deformers in one TOML file.
+//!
+//! A scene is what `snowprint simulate --scene FILE` runs. The format (version 1, metres, `+Y` up)
+//! is documented in `docs/SCENES.md`; in short:
+//!
+//! ```toml
+//! version = 1
+//!
+//! [[surface]]
+//! name = "roof"
+//! center = [0.0, 10.0, 0.0]
+//! size = [8.0, 6.0]
+//! snow_depth = 0.3
+//!
+//! [[deformer]]
+//! name = "ball"
+//! shape = "sphere"
+//! radius = 0.2
+//! keys = [ { t = 0.0, position = [-3.0, 10.1, 0.0] }, { t = 4.0, position = [3.0, 10.1, 0.0] } ]
+//! ```
+//!
+//! Every problem in a file is reported as one [`SnowError::Scene`] sentence of the form
+//! `<file>:<line>: <what is wrong, quoting the value>; <what to do>`.
+//!
+//! [`SnowError::Scene`]: crate::error::SnowError::Scene
+
+mod convert;
+mod diagnose;
+mod raw;
+
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Quat, Vec3};
+
+use crate::deformer::Pose;
+use crate::error::{Result, SnowError};
+use crate::mesh::Mesh;
+use crate::surface::SurfaceDesc;
+use crate::world::CaptureConfig;
+
+/// The only scene file version this library reads (the file's `version` key).
+pub const SCENE_VERSION: u32 = 1;
+
+/// A loaded scene: everything a simulation needs, checked and with meshes loaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The file the scene was read from (as given to [`Scene::load`] or [`Scene::parse`]).
+    pub path: PathBuf,
+    /// Capture settings (`[capture]`; defaults when the table is absent).
+    pub capture: CaptureConfig,
+    /// The snow surfaces, in file order (`[[surface]]`).
+    pub surfaces: Vec<SurfaceDesc>,
+    /// The deformers, in file order (`[[deformer]]`).
+    pub deformers: Vec<SceneDeformer>,
+}
+
+/// One keyframed deformer of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneDeformer {
+    /// Its name, unique among the scene's deformers.
+    pub name: String,
+    /// Its geometry.
+    pub shape: SceneShape,
+    /// Its keys: at least one, times strictly increasing.
+    pub keys: Vec<Key>,
+}
+
+/// The geometry of a scene deformer, in its own frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneShape {
+    /// A ball.
+    Sphere {
+        /// Radius, metres (above 0).
+        radius: f32,
+    },
+    /// A capsule along its local `Y` axis (see [`crate::Shape::Capsule`]).
+    Capsule {
+        /// Radius, metres (above 0).
+        radius: f32,
+        /// Half the length of the inner segment, metres (0 or more).
+        half_height: f32,
+    },
+    /// A box.
+    Box {
+        /// Half of each side, metres (each above 0).
+        half_extents: Vec3,
+    },
+    /// A triangle mesh loaded from a glTF or GLB file.
+    Mesh {
+        /// The file, resolved against the scene file's folder.
+        path: PathBuf,
+        /// The loaded mesh, in the file's frame.
+        mesh: Mesh,
+    },
+}
+
+/// One key of a deformer's motion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Key {
+    /// Time, seconds from the start of the scene.
+    pub t: f32,
+    /// World position of the deformer's origin, metres.
+    pub position: Vec3,
+    /// Rotation as `[x, y, z]` Euler angles in degrees (see [`Key::rotation`]).
+    pub rotation_degrees: Vec3,
+}
+
+impl Key {
+    /// The rotation of the key: `Quat::from_euler(EulerRot::YXZ, y, x, z)` with the angles of
+    /// [`Key::rotation_degrees`] in radians, i.e. the rotation about `Y` applied last (outermost),
+    /// then `X`, then `Z` applied first to the shape.
+    pub fn rotation(&self) -> Quat {
+        let r = self.rotation_degrees;
+        Quat::from_euler(
+            EulerRot::YXZ,
+            r.y.to_radians(),
+            r.x.to_radians(),
+            r.z.to_radians(),
+        )
+    }
+
+    /// The key as a pose.
+    pub fn pose(&self) -> Pose {
+        Pose {
+            position: self.position,
+            rotation: self.rotation(),
+        }
+    }
+}
+
+impl SceneDeformer {
+    /// The pose at time `t` (seconds): position and the degree triples interpolated linearly
+    /// between the keys around `t`; the first key before it, the last key after it. A deformer
+    /// without keys (only possible when built by hand) sits at the origin.
+    pub fn pose_at(&self, t: f32) -> Pose {
+        let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else {
+            return Pose::at([0.0; 3]);
+        };
+        if t.is_nan() || t <= first.t {
+            return first.pose();
+        }
+        if t >= last.t {
+            return last.pose();
+        }
+        // keys[i - 1].t <= t < keys[i].t, with 1 <= i < len.
+        let i = self.keys.partition_point(|k| k.t <= t);
+        let (a, b) = (&self.keys[i - 1], &self.keys[i]);
+        let f = (t - a.t) / (b.t - a.t);
+        Key {
+            t,
+            position: a.position.lerp(b.position, f),
+            rotation_degrees: a.rotation_degrees.lerp(b.rotation_degrees, f),
+        }
+        .pose()
+    }
+
+    /// True when the deformer never moves: a single key, or every key at the first key's position
+    /// and rotation.
+    pub fn is_static(&self) -> bool {
+        match self.keys.split_first() {
+            None => true,
+            Some((first, rest)) => rest.iter().all(|k| {
+                k.position == first.position && k.rotation_degrees == first.rotation_degrees
+            }),
+        }
+    }
+
+    /// Time of the last key, seconds.
+    pub fn end_time(&self) -> f32 {
+        self.keys.last().map_or(0.0, |k| k.t)
+    }
+}
+
+impl Scene {
+    /// Read, check and load a scene file, with its mesh files (relative to the file's folder).
+    ///
+    /// # Errors
+    ///
+    /// [`SnowError::Scene`] with one sentence `<file>:<line>: <what is wrong>; <what to do>` when
+    /// the file cannot be read, is not valid TOML, breaks a rule of the format, or names a mesh
+    /// file that is missing or unusable.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            SnowError::Scene(format!(
+                "{}: the scene file cannot be read ({e}); check the path and that it is a UTF-8 text file",
+                path.display()
+            ))
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Check a scene given as text. `path` names the file in messages, and mesh paths are
+    /// resolved against its folder (mesh files are loaded here).
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::load`], except for reading the scene file itself.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene> {
+        let src = diagnose::Source::new(text, path);
+        let raw: raw::RawScene =
+            toml::from_str(text).map_err(|e| diagnose::toml_error(&src, &e))?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        convert::convert(raw, &src, dir, path)
+    }
+
+    /// Length of the scene's motion, seconds: the latest last-key time over the deformers that
+    /// move (0 when all are static, and never below 0).
+    pub fn duration(&self) -> f32 {
+        self.deformers
+            .iter()
+            .filter(|d| !d.is_static())
+            .map(SceneDeformer::end_time)
+            .fold(0.0, f32::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(t: f32, p: [f32; 3], r: [f32; 3]) -> Key {
+        Key {
+            t,
+            position: Vec3::from(p),
+            rotation_degrees: Vec3::from(r),
+        }
+    }
+
+    fn deformer(keys: Vec<Key>) -> SceneDeformer {
+        SceneDeformer {
+            name: "d".into(),
+            shape: SceneShape::Sphere { radius: 0.1 },
+            keys,
+        }
+    }
+
+    fn close(a: Vec3, b: Vec3) -> bool {
+        (a - b).abs().max_element() < 1e-5
+    }
+
+    #[test]
+    fn pose_between_before_and_after() {
+        let d = deformer(vec![
+            key(1.0, [0.0, 10.0, 0.0], [0.0; 3]),
+            key(3.0, [2.0, 10.0, -4.0], [0.0; 3]),
+            key(4.0, [2.0, 11.0, -4.0], [0.0; 3]),
+        ]);
+        assert!(close(d.pose_at(2.0).position, Vec3::new(1.0, 10.0, -2.0)));
+        assert!(close(d.pose_at(2.5).position, Vec3::new(1.5, 10.0, -3.0)));
+        assert!(close(d.pose_at(3.0).position, Vec3::new(2.0, 10.0, -4.0)));
+        assert!(close(d.pose_at(3.25).position, Vec3::new(2.0, 10.25, -4.0)));
+        assert!(close(d.pose_at(0.0).position, Vec3::new(0.0, 10.0, 0.0)));
+        assert!(close(d.pose_at(-5.0).position, Vec3::new(0.0, 10.0, 0.0)));
+        assert!(close(d.pose_at(9.0).position, Vec3::new(2.0, 11.0, -4.0)));
+        assert!(close(
+            d.pose_at(f32::NAN).position,
+            Vec3::new(0.0, 10.0, 0.0)
+        ));
+        assert!(!d.is_static());
+        assert_eq!(d.end_time(), 4.0);
+    }
+
+    #[test]
+    fn rotation_convention_and_interpolated_degrees() {
+        // [90, 0, 0]: a quarter turn about +X takes local +Y to +Z.
+        let k = key(0.0, [0.0; 3], [90.0, 0.0, 0.0]);
+        assert!(close(k.rotation() * Vec3::Y, Vec3::Z));
+        // [0, 0, 90]: about +Z takes +Y to -X.
+        let k = key(0.0, [0.0; 3], [0.0, 0.0, 90.0]);
+        assert!(close(k.rotation() * Vec3::Y, -Vec3::X));
+        // Halfway between [0, 0, 0] and [0, 90, 0] is 45 degrees about Y:
+        // (cos 22.5, 0, sin 22.5 about y) = (x 0, y 0.382683, z 0, w 0.923880).
+        let d = deformer(vec![
+            key(0.0, [0.0; 3], [0.0; 3]),
+            key(2.0, [0.0; 3], [0.0, 90.0, 0.0]),
+        ]);
+        let q = d.pose_at(1.0).rotation;
+        let want = Quat::from_xyzw(0.0, 0.382_683_43, 0.0, 0.923_879_5);
+        assert!((q.x - want.x).abs() < 1e-5, "{q:?}");
+        assert!((q.y - want.y).abs() < 1e-5, "{q:?}");
+        assert!((q.z - want.z).abs() < 1e-5, "{q:?}");
+        assert!((q.w - want.w).abs() < 1e-5, "{q:?}");
+    }
+
+    #[test]
+    fn static_deformers_and_empty_keys() {
+        let d = deformer(vec![key(2.0, [1.0, 2.0, 3.0], [0.0; 3])]);
+        assert!(d.is_static());
+        assert_eq!(d.pose_at(0.0).position, Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(d.pose_at(5.0).position, Vec3::new(1.0, 2.0, 3.0));
+        let d = deformer(vec![
+            key(0.0, [1.0, 2.0, 3.0], [0.0; 3]),
+            key(5.0, [1.0, 2.0, 3.0], [0.0; 3]),
+        ]);
+        assert!(d.is_static());
+        let scene = Scene {
+            path: PathBuf::from("x.toml"),
+            capture: CaptureConfig::default(),
+            surfaces: vec![],
+            deformers: vec![d],
+        };
+        assert_eq!(scene.duration(), 0.0);
+        let empty = deformer(vec![]);
+        assert!(empty.is_static());
+        assert_eq!(empty.pose_at(1.0), Pose::at([0.0; 3]));
+    }
+}

@@ -1,0 +1,102 @@
+//! The scene file exactly as written: every field optional and spanned, so that the checks in
+//! `convert` can say which line is wrong and quote what is there. Unknown keys are refused by serde
+//! (`deny_unknown_fields`) and reported through `diagnose::toml_error`.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A spanned number (TOML integers are accepted where floats are expected).
+pub(super) type Num = Spanned<f64>;
+/// A spanned array of numbers (its length is checked later).
+pub(super) type Nums = Spanned<Vec<f64>>;
+/// A spanned string.
+pub(super) type Str = Spanned<String>;
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawScene {
+    pub version: Option<Spanned<i64>>,
+    pub capture: Option<Spanned<RawCapture>>,
+    #[serde(default)]
+    pub surface: Vec<Spanned<RawSurface>>,
+    #[serde(default)]
+    pub deformer: Vec<Spanned<RawDeformer>>,
+}
+
+/// `[capture]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCapture {
+    pub mode: Option<Str>,
+    pub ankle_height: Option<Num>,
+    pub mask_depth: Option<Num>,
+}
+
+/// One `[[surface]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSurface {
+    pub name: Option<Str>,
+    pub center: Option<Nums>,
+    pub size: Option<Nums>,
+    pub yaw_degrees: Option<Num>,
+    pub snow_depth: Option<Num>,
+    pub replenish_rate: Option<Num>,
+}
+
+/// One `[[deformer]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawDeformer {
+    pub name: Option<Str>,
+    pub shape: Option<Str>,
+    pub radius: Option<Num>,
+    pub half_height: Option<Num>,
+    pub half_extents: Option<Nums>,
+    pub path: Option<Str>,
+    pub keys: Option<Spanned<Vec<Spanned<RawKey>>>>,
+}
+
+/// One key of a deformer, inline (`keys = [{ ... }]`) or as `[[deformer.keys]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawKey {
+    pub t: Option<Num>,
+    pub position: Option<Nums>,
+    pub rotation_degrees: Option<Nums>,
+}
+
+/// The keys each table accepts, for messages about unknown keys. The first entry says where the
+/// table is, as a user would look for it.
+pub(super) const TABLES: &[(&str, &[&str])] = &[
+    (
+        "at the top level",
+        &["version", "capture", "surface", "deformer"],
+    ),
+    ("in [capture]", &["mode", "ankle_height", "mask_depth"]),
+    (
+        "in a [[surface]] table",
+        &[
+            "name",
+            "center",
+            "size",
+            "yaw_degrees",
+            "snow_depth",
+            "replenish_rate",
+        ],
+    ),
+    (
+        "in a [[deformer]] table",
+        &[
+            "name",
+            "shape",
+            "radius",
+            "half_height",
+            "half_extents",
+            "path",
+            "keys",
+        ],
+    ),
+    ("in a deformer key", &["t", "position", "rotation_degrees"]),
+];
