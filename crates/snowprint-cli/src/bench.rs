@@ -353,7 +353,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         configs.push(Config {
             sweep: "surfaces",
             surfaces: n,
-            resolution: 256,
+            resolution: 128,
             deformers: 10,
         });
     }
@@ -375,8 +375,8 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
     }
     if !quick {
         configs.push(Config {
-            sweep: "goal_1024x512",
-            surfaces: 1024,
+            sweep: "goal_512x512",
+            surfaces: 512,
             resolution: 512,
             deformers: 1,
         });

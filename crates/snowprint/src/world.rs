@@ -735,19 +735,10 @@ impl SnowWorld {
             .iter()
             .map(|&j| (jobs[j].record.width, jobs[j].record.height))
             .collect();
-        let placements = capture::pack_atlas(&rects, self.config.atlas_side);
+        // The atlas is cleared whole every pass, so keep it as small as the frame allows: the
+        // smallest power-of-two side that holds every rectangle in one batch, up to the limit.
+        let (placements, atlas_side) = capture::pack_atlas_compact(&rects, self.config.atlas_side);
         let batches = placements.iter().map(|p| p.batch + 1).max().unwrap_or(0);
-        let atlas_side = if batches > 1 {
-            self.config.atlas_side
-        } else {
-            let extent = placements
-                .iter()
-                .zip(&rects)
-                .map(|(p, r)| (p.x + r.0).max(p.y + r.1))
-                .max()
-                .unwrap_or(1);
-            extent.next_power_of_two().clamp(64, self.config.atlas_side)
-        };
         let mut scratch_len = 0u32;
         for (k, &j) in captured.iter().enumerate() {
             let r = &mut jobs[j].record;
@@ -776,9 +767,11 @@ impl SnowWorld {
                 half_size: (state.desc.size * 0.5).to_array(),
                 frustum_height: r.frustum_height,
                 _pad: 0.0,
+                origin: [r.atlas_x as f32, r.atlas_y as f32],
+                texels: [r.width as f32, r.height as f32],
             };
             let o = k * UNIFORM_STRIDE as usize;
-            view_bytes[o..o + 16].copy_from_slice(bytemuck::bytes_of(&v));
+            view_bytes[o..o + 32].copy_from_slice(bytemuck::bytes_of(&v));
         }
         self.views.ensure(&self.device, view_bytes.len() as u64);
         self.queue.write_buffer(&self.views.buffer, 0, &view_bytes);
@@ -829,7 +822,7 @@ impl SnowWorld {
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &self.views.buffer,
                         offset: 0,
-                        size: std::num::NonZeroU64::new(16),
+                        size: std::num::NonZeroU64::new(32),
                     }),
                 },
                 wgpu::BindGroupEntry {

@@ -173,8 +173,24 @@ mod tests {
                 }
             }
         }
-        // Centre keeps 4 taps x 9/16 / 4 = 9/16.
-        assert!((b[3 * 9 + 4] - 9.0 / 16.0).abs() < 1e-6);
+        // Summing the bilinear weights of the four taps (each divided by 4) gives the kernel, in
+        // 64ths: corners 3, edges 10, centre 12 (3 x 4 + 10 x 4 + 12 = 64).
+        let at = |x: usize, y: usize| b[y * 9 + x] * 64.0;
+        for (x, y, w) in [
+            (4, 3, 12.0),
+            (5, 3, 10.0),
+            (4, 2, 10.0),
+            (3, 3, 10.0),
+            (4, 4, 10.0),
+            (5, 4, 3.0),
+            (3, 2, 3.0),
+        ] {
+            assert!(
+                (at(x, y) - w).abs() < 1e-4,
+                "({x},{y}): {} / 64, expected {w}",
+                at(x, y)
+            );
+        }
     }
 
     #[test]

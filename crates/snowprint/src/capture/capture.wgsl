@@ -10,6 +10,8 @@ struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
     frustum_height: f32,    // metres
     _pad: f32,
+    origin: vec2<f32>,      // the surface's top-left texel in the atlas
+    texels: vec2<f32>,      // the surface's heightmap width and height
 }
 // Must match `CaptureView` in capture/mod.rs.
 
@@ -98,9 +100,14 @@ fn capsule_interval(a: vec3<f32>, b: vec3<f32>, r: f32, x: f32, z: f32) -> vec2<
             let qc = dot(w_perp, w_perp) - r * r;
             let disc = qb * qb - qa * qc;
             if disc >= 0.0 {
+                // The numerically stable pair of roots of qa y^2 + 2 qb y + qc = 0: no
+                // cancellation when the capsule stands nearly upright (qa small).
                 let sq = sqrt(disc);
-                var y0 = (-qb - sq) / qa;
-                var y1 = (-qb + sq) / qa;
+                let q = -(qb + select(-sq, sq, qb >= 0.0));
+                let r0 = q / qa;
+                let r1 = select(qc / q, r0, q == 0.0);
+                var y0 = min(r0, r1);
+                var y1 = max(r0, r1);
                 if abs(u.y) > 1e-6 {
                     let ya = -wu / u.y;
                     let yb = (len - wu) / u.y;
@@ -147,14 +154,23 @@ struct DepthOut {
     @builtin(frag_depth) depth: f32,
 }
 
+// The local (x, z) of the texel centre under a fragment, computed from the fragment's position
+// (exactly k + 0.5) the same way the CPU reference computes texel centres, rather than from an
+// interpolated varying, whose rounding a ray cast near a silhouette would amplify.
+fn texel_center(frag: vec2<f32>) -> vec2<f32> {
+    let cell = frag - view.origin;
+    return -view.half_size + cell / view.texels * 2.0 * view.half_size;
+}
+
 @fragment
 fn fs_prim(in: PrimOut) -> DepthOut {
     let p = prims[in.index];
+    let c = texel_center(in.clip.xy);
     var iv: vec2<f32>;
     if p.kind.x == 0u {
-        iv = capsule_interval(p.p0.xyz, p.p1.xyz, p.p0.w, in.local_xz.x, in.local_xz.y);
+        iv = capsule_interval(p.p0.xyz, p.p1.xyz, p.p0.w, c.x, c.y);
     } else {
-        iv = box_interval(p.p0.xyz, p.p1, p.p2, p.p3, in.local_xz.x, in.local_xz.y);
+        iv = box_interval(p.p0.xyz, p.p1, p.p2, p.p3, c.x, c.y);
     }
     // Keep only the part inside the frustum: a solid reaching below the ground is clamped to the
     // ground, one entirely below it or above the frustum leaves nothing.

@@ -9,10 +9,9 @@ const BIG: f32 = 1e30;
 
 /// Local `(x, z)` of the centre of texel `(column, row)`.
 pub fn texel_center(column: u32, row: u32, width: u32, height: u32, half_size: Vec2) -> Vec2 {
-    Vec2::new(
-        -half_size.x + (column as f32 + 0.5) / width as f32 * 2.0 * half_size.x,
-        -half_size.y + (row as f32 + 0.5) / height as f32 * 2.0 * half_size.y,
-    )
+    // Same operations, in the same order, as `texel_center` in capture.wgsl.
+    let cell = Vec2::new(column as f32 + 0.5, row as f32 + 0.5);
+    -half_size + cell / Vec2::new(width as f32, height as f32) * 2.0 * half_size
 }
 
 fn sphere_interval(c: Vec3, r: f32, x: f32, z: f32) -> (f32, f32) {
@@ -44,8 +43,12 @@ pub fn capsule_interval(a: Vec3, b: Vec3, r: f32, x: f32, z: f32) -> (f32, f32) 
             let qc = w_perp.dot(w_perp) - r * r;
             let disc = qb * qb - qa * qc;
             if disc >= 0.0 {
+                // Same stable form as capture.wgsl.
                 let sq = disc.sqrt();
-                let (mut y0, mut y1) = ((-qb - sq) / qa, (-qb + sq) / qa);
+                let q = -(qb + if qb >= 0.0 { sq } else { -sq });
+                let r0 = q / qa;
+                let r1 = if q == 0.0 { r0 } else { qc / q };
+                let (mut y0, mut y1) = (r0.min(r1), r0.max(r1));
                 if u.y.abs() > 1e-6 {
                     let ya = -wu / u.y;
                     let yb = (len - wu) / u.y;

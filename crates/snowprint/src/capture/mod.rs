@@ -40,6 +40,10 @@ pub struct CaptureView {
     pub frustum_height: f32,
     /// Padding.
     pub _pad: f32,
+    /// The surface's top-left texel in the atlas.
+    pub origin: [f32; 2],
+    /// The surface's heightmap width and height, texels.
+    pub texels: [f32; 2],
 }
 
 /// An analytic deformer in surface-local coordinates. Must match `Primitive` in `capture.wgsl`.
@@ -390,9 +394,40 @@ pub fn pack_atlas(rects: &[(u32, u32)], side: u32) -> Vec<AtlasPlacement> {
     out
 }
 
+/// Pack into the smallest power-of-two square (at least 64, at most `max_side`) that holds every
+/// rectangle in one batch; at `max_side`, several batches. Returns the placements and the side.
+pub fn pack_atlas_compact(rects: &[(u32, u32)], max_side: u32) -> (Vec<AtlasPlacement>, u32) {
+    let area: u64 = rects.iter().map(|r| r.0 as u64 * r.1 as u64).sum();
+    let widest = rects.iter().map(|r| r.0.max(r.1)).max().unwrap_or(1);
+    let mut side = ((area as f64).sqrt().ceil() as u32)
+        .max(widest)
+        .next_power_of_two()
+        .clamp(64, max_side.max(64));
+    loop {
+        let placements = pack_atlas(rects, side);
+        if side >= max_side || placements.iter().all(|p| p.batch == 0) {
+            return (placements, side);
+        }
+        side *= 2;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn compact_packing_stays_near_the_area() {
+        // 64 squares of 128: 1024 x 1024 holds them exactly.
+        let rects = vec![(128, 128); 64];
+        let (p, side) = pack_atlas_compact(&rects, 8192);
+        assert_eq!(side, 1024);
+        assert!(p.iter().all(|p| p.batch == 0));
+        // Too many for the limit: several batches at the limit.
+        let (p, side) = pack_atlas_compact(&vec![(512, 512); 20], 1024);
+        assert_eq!(side, 1024);
+        assert_eq!(p.iter().map(|p| p.batch).max(), Some(4));
+    }
 
     #[test]
     fn atlas_packing_never_overlaps() {
