@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use glam::{Mat4, Vec2};
 
-use crate::accumulate::{self, AccumulatePipelines, BlurParams, WORKGROUP};
+use crate::accumulate::{self, AccumulatePipelines, WORKGROUP};
 use crate::capture::{
     self, AtlasPlacement, CapturePipelines, CaptureView, CaptureVolume, GpuPrimitive, MeshDraw,
 };
@@ -219,8 +219,6 @@ struct Job {
 struct LastFrame {
     /// (surface index, record, placement) of every captured job.
     captured: Vec<(usize, SurfaceRecord, AtlasPlacement)>,
-    last_batch: u32,
-    atlas_side: u32,
 }
 
 struct Timestamps {
@@ -257,7 +255,7 @@ pub struct SnowWorld {
     views: Growable,
     prims: Growable,
     draws: Growable,
-    blur_params: Growable,
+    capture: Growable,
     scratch: Growable,
     last: LastFrame,
     profiling: bool,
@@ -368,11 +366,11 @@ impl SnowWorld {
                 U::UNIFORM | U::COPY_DST,
                 UNIFORM_STRIDE * 16,
             ),
-            blur_params: Growable::new(
+            capture: Growable::new(
                 &device,
-                "blur params",
-                U::UNIFORM | U::COPY_DST,
-                UNIFORM_STRIDE * 4,
+                "capture",
+                U::STORAGE | U::COPY_DST | U::COPY_SRC,
+                4 * 4096,
             ),
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
             queue: gpu.queue.clone(),
@@ -553,13 +551,13 @@ impl SnowWorld {
             capture_atlas: self
                 .atlases
                 .iter()
-                .map(|a| a.0 as u64 * a.0 as u64 * 4)
+                .map(|a| a.0 as u64 * a.0 as u64 * 2)
                 .sum(),
             frame_tables: self.records.buffer.size()
                 + self.views.buffer.size()
                 + self.prims.buffer.size()
                 + self.draws.buffer.size()
-                + self.blur_params.buffer.size(),
+                + self.capture.buffer.size(),
         }
     }
 
@@ -766,7 +764,7 @@ impl SnowWorld {
             let v = CaptureView {
                 half_size: (state.desc.size * 0.5).to_array(),
                 frustum_height: r.frustum_height,
-                _pad: 0.0,
+                offset: r.scratch,
                 origin: [r.atlas_x as f32, r.atlas_y as f32],
                 texels: [r.width as f32, r.height as f32],
             };
@@ -789,18 +787,9 @@ impl SnowWorld {
             self.draws.ensure(&self.device, bytes.len() as u64);
             self.queue.write_buffer(&self.draws.buffer, 0, &bytes);
         }
-        let mut params = vec![0u8; batches.max(1) as usize * UNIFORM_STRIDE as usize];
-        for b in 0..batches {
-            let o = (b as u64 * UNIFORM_STRIDE) as usize;
-            params[o..o + 16].copy_from_slice(bytemuck::bytes_of(&BlurParams {
-                batch: b,
-                _pad: [0; 3],
-            }));
-        }
-        self.blur_params.ensure(&self.device, params.len() as u64);
-        self.queue
-            .write_buffer(&self.blur_params.buffer, 0, &params);
         self.scratch
+            .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        self.capture
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
 
         let atlas_index = self.atlas(atlas_side);
@@ -829,6 +818,10 @@ impl SnowWorld {
                     binding: 1,
                     resource: self.prims.buffer.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.capture.buffer.as_entire_binding(),
+                },
             ],
         });
         let draw_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -853,19 +846,11 @@ impl SnowWorld {
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
-                    resource: wgpu::BindingResource::TextureView(atlas_view),
+                    resource: self.capture.buffer.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: self.scratch.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.blur_params.buffer,
-                        offset: 0,
-                        size: std::num::NonZeroU64::new(16),
-                    }),
                 },
             ],
         });
@@ -923,6 +908,8 @@ impl SnowWorld {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("snow update"),
             });
+        // Nothing captured yet: 0 is the code of "no deformer over this texel".
+        enc.clear_buffer(&self.capture.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
         for batch in 0..batches {
             let q = next_query(Stage::Capture, &mut stages);
             {
@@ -931,8 +918,9 @@ impl SnowWorld {
                     color_attachments: &[],
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                         view: atlas_view,
+                        // Only places the viewports: never cleared, read or written.
                         depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
+                            load: wgpu::LoadOp::Load,
                             store: wgpu::StoreOp::Store,
                         }),
                         stencil_ops: None,
@@ -982,26 +970,16 @@ impl SnowWorld {
                     }
                 }
             }
-            let q = next_query(Stage::Blur, &mut stages);
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("blur"),
-                timestamp_writes: q.map(|q| wgpu::ComputePassTimestampWrites {
-                    query_set: &ts.expect("query implies timestamps").set,
-                    beginning_of_pass_write_index: Some(q),
-                    end_of_pass_write_index: Some(q + 1),
-                }),
-            });
-            pass.set_pipeline(&self.acc.blur);
-            pass.set_bind_group(0, &blur_bg, &[(batch as u64 * UNIFORM_STRIDE) as u32]);
-            pass.dispatch_workgroups(groups.0, groups.1, groups.2);
         }
         for (stage, pipeline, bg) in [
+            (Stage::Blur, &self.acc.blur, &blur_bg),
             (Stage::Merge, &self.acc.merge, &merge_bg),
             (Stage::Normals, &self.acc.normals, &normals_bg),
         ] {
             let q = next_query(stage, &mut stages);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(match stage {
+                    Stage::Blur => "blur",
                     Stage::Merge => "merge",
                     _ => "normals",
                 }),
@@ -1035,8 +1013,6 @@ impl SnowWorld {
                 .enumerate()
                 .map(|(k, &j)| (jobs[j].surface, jobs[j].record, placements[k]))
                 .collect(),
-            last_batch: batches.saturating_sub(1),
-            atlas_side,
         };
         if let (Some(ts), false) = (ts, stages.is_empty()) {
             let bytes = self.read_buffer(&ts.readback, 0, stages.len() as u64 * 16)?;
@@ -1132,60 +1108,20 @@ impl SnowWorld {
     }
 
     /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing), when
-    /// it was captured in that step's last atlas batch; `None` otherwise.
+    /// it was captured in that step; `None` otherwise.
     pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
-        let Some(&(_, r, placement)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize)
-        else {
+        let Some(&(_, r, _)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
             return Ok(None);
         };
-        if placement.batch != self.last.last_batch {
-            return Ok(None);
-        }
-        let Some((_, texture, _)) = self.atlases.iter().find(|a| a.0 == self.last.atlas_side)
-        else {
-            return Ok(None);
-        };
-        // Depth textures can only be copied whole.
-        let side = self.last.atlas_side;
-        let row_bytes = side * 4;
-        let size = row_bytes as u64 * side as u64;
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("capture readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::DepthOnly,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row_bytes),
-                    rows_per_image: Some(side),
-                },
-            },
-            wgpu::Extent3d {
-                width: side,
-                height: side,
-                depth_or_array_layers: 1,
-            },
-        );
-        self.queue.submit([enc.finish()]);
-        let bytes = self.read_buffer(&staging, 0, size)?;
-        let mut out = Vec::with_capacity((r.width * r.height) as usize);
-        for row in 0..r.height as usize {
-            let start = (r.atlas_y as usize + row) * row_bytes as usize + r.atlas_x as usize * 4;
-            let line: &[f32] = bytemuck::cast_slice(&bytes[start..start + r.width as usize * 4]);
-            out.extend_from_slice(line);
-        }
-        Ok(Some(out))
+        let bytes = self.download(
+            &self.capture.buffer,
+            r.scratch as u64 * 4,
+            (r.width * r.height) as u64 * 4,
+        )?;
+        let codes: &[u32] = bytemuck::cast_slice(&bytes);
+        Ok(Some(
+            codes.iter().map(|&v| capture::decode_depth(v)).collect(),
+        ))
     }
 
     /// Debug readback of the last step: the blurred capture (stage 1 output) of a surface, when it

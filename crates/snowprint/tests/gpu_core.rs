@@ -13,6 +13,13 @@ use snowprint::{
 
 const ANKLE: f32 = 0.25;
 
+/// Largest difference in captured height between GPU and CPU, metres (a 1/800 of a 4 cm texel).
+/// GPU compilers contract `a * b + c` into fused multiply-adds and use approximate square roots
+/// and divisions; where a vertical ray grazes a silhouette, the root of a nearly-zero discriminant
+/// amplifies those last-bit differences (seen on an H100: 14 um). Software Vulkan matches the CPU
+/// to about 1e-7.
+const CAPTURE_HEIGHT_TOLERANCE: f32 = 5e-5;
+
 fn world(mode: CaptureMode) -> SnowWorld {
     SnowWorld::new(
         common::gpu(),
@@ -138,7 +145,11 @@ fn every_stage_matches_its_cpu_reference() {
                 if (*g < 1.0) != (*c < 1.0) {
                     coverage_mismatch += 1;
                 } else {
-                    assert!((g - c).abs() < 2e-5, "capture {g} vs cpu {c} ({size:?})");
+                    let dh = (g - c).abs() * vol.frustum_height;
+                    assert!(
+                        dh <= CAPTURE_HEIGHT_TOLERANCE,
+                        "capture {g} vs cpu {c}: {dh} m apart ({size:?})"
+                    );
                 }
             }
             assert!(

@@ -1,20 +1,16 @@
 // Stage 1: turn the capture into a depression (0 = untouched, 1 = pressed to the ground) and
 // soften it with a 4-tap bilinear Poisson blur.
-// Reads: `capture` (the atlas rectangles of batch `params.batch`), `records`.
+// Reads: `capture` (encoded depths written by the capture pass at each record's `scratch`
+// offset), `records`.
 // Writes: `scratch` (one f32 per texel of each captured surface).
 // CPU reference: accumulate::cpu::blur.
 
-struct BlurParams {
-    batch: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
-@group(0) @binding(1) var capture: texture_depth_2d;
+@group(0) @binding(1) var<storage, read> capture: array<u32>;
 @group(0) @binding(2) var<storage, read_write> scratch: array<f32>;
-@group(0) @binding(3) var<uniform> params: BlurParams;
+
+// Must match `ONE_BITS` in capture.wgsl: a stored value v is the depth bitcast(ONE_BITS - v).
+const ONE_BITS: u32 = 0x3f800000u;
 
 // Tap offsets in texels: a rotated grid, so each bilinear tap mixes four texels with weights of
 // 1/16, 3/16 and 9/16 and the four taps together spread over one texel in every direction.
@@ -28,7 +24,7 @@ const TAPS = array<vec2<f32>, 4>(
 fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     let cx = clamp(x, 0, i32(rec.width) - 1);
     let cy = clamp(y, 0, i32(rec.height) - 1);
-    let z = textureLoad(capture, vec2<i32>(i32(rec.atlas_x) + cx, i32(rec.atlas_y) + cy), 0);
+    let z = bitcast<f32>(ONE_BITS - capture[rec.scratch + u32(cy) * rec.width + u32(cx)]);
     if rec.mode == MODE_MASK {
         return select(0.0, rec.mask_fraction, z < 1.0);
     }
@@ -45,7 +41,7 @@ fn lerp2(a: f32, b: f32, c: f32, d: f32, f: vec2<f32>) -> f32 {
 @compute @workgroup_size(8, 8, 1)
 fn blur(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = records[gid.z];
-    if rec.batch != params.batch || gid.x >= rec.width || gid.y >= rec.height {
+    if rec.batch == NO_CAPTURE || gid.x >= rec.width || gid.y >= rec.height {
         return;
     }
     // The four taps (TAPS) each mix a 2x2 block of the 3x3 texels around this one: load the nine

@@ -2,7 +2,7 @@
 //! every surface updated in it (`z` of the dispatch is the surface's record):
 //!
 //! 1. [`blur.wgsl`](BLUR_SHADER): capture to depression, 4-tap bilinear Poisson blur
-//!    (reads the capture atlas, writes the scratch buffer);
+//!    (reads the capture buffer, writes the scratch buffer);
 //! 2. [`merge.wgsl`](MERGE_SHADER): replenish the history, then deepen it by the blurred capture
 //!    (reads one half of each slot's ping-pong pair and the scratch, writes the other half);
 //! 3. [`normals.wgsl`](NORMALS_SHADER): normals of the new snow top (reads the new half, writes
@@ -11,8 +11,6 @@
 //! CPU reference: [`cpu`].
 
 pub mod cpu;
-
-use bytemuck::{Pod, Zeroable};
 
 /// Record layout shared by every pass.
 pub const SHARED: &str = include_str!("../shared.wgsl");
@@ -25,16 +23,6 @@ pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
 
 /// Workgroup side of every accumulation pass.
 pub const WORKGROUP: u32 = 8;
-
-/// Uniform of the blur pass: which capture batch it reads. Must match `BlurParams` in `blur.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct BlurParams {
-    /// Capture batch.
-    pub batch: u32,
-    /// Padding.
-    pub _pad: [u32; 3],
-}
 
 /// The shader source of a stage with the shared prelude, as compiled.
 pub fn with_prelude(stage: &str) -> String {
@@ -75,30 +63,7 @@ impl AccumulatePipelines {
     pub fn new(device: &wgpu::Device) -> Self {
         let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blur"),
-            entries: &[
-                storage(0, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                storage(2, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
+            entries: &[storage(0, true), storage(1, true), storage(2, false)],
         });
         let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("merge"),

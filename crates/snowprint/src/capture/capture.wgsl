@@ -1,15 +1,17 @@
-// Capture from below: renders deformers into a depth target through an orthographic frustum whose
-// near plane is the ground under the snow and whose far plane is the snow top plus an ankle height.
-// Depth 0 = ground, 1 = top of the frustum; the depth test keeps the lowest point per texel.
+// Capture from below: renders deformers through an orthographic frustum whose near plane is the
+// ground under the snow and whose far plane is the snow top plus an ankle height. Depth 0 = ground,
+// 1 = top of the frustum. Each fragment keeps the lowest point per texel with an atomic max on an
+// encoded depth in a storage buffer, so no depth target has to be cleared or resolved: the render
+// target only places each surface's viewport and is never read or written.
 //
 // Reads: `view` (one per surface, dynamic offset), `prims` (analytic deformers in surface-local
 // coordinates), mesh vertex buffers and `draw` (mesh-to-surface-local transform, dynamic offset).
-// Writes: the capture atlas's depth, inside the viewport of the surface.
+// Writes: `capture`, the surface's texels at `view.offset` (cleared to 0 = nothing before the pass).
 
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
     frustum_height: f32,    // metres
-    _pad: f32,
+    offset: u32,            // first texel of the surface in `capture`
     origin: vec2<f32>,      // the surface's top-left texel in the atlas
     texels: vec2<f32>,      // the surface's heightmap width and height
 }
@@ -29,6 +31,18 @@ struct Primitive {
 
 @group(0) @binding(0) var<uniform> view: CaptureView;
 @group(0) @binding(1) var<storage, read> prims: array<Primitive>;
+@group(0) @binding(2) var<storage, read_write> capture: array<atomic<u32>>;
+
+// Depths in [0, 1] are stored as ONE_BITS - bits(depth): 0 (the cleared value) means nothing was
+// captured, and a larger value is a lower point, so atomicMax keeps the lowest. Non-negative
+// floats order like their bit patterns, so the code is exact and monotonic.
+const ONE_BITS: u32 = 0x3f800000u;
+
+fn keep_lowest(frag: vec2<f32>, depth: f32) {
+    let cell = vec2<u32>(frag - view.origin);
+    let index = view.offset + cell.y * u32(view.texels.x) + cell.x;
+    atomicMax(&capture[index], ONE_BITS - bitcast<u32>(clamp(depth, 0.0, 1.0)));
+}
 
 const BIG: f32 = 1e30;
 
@@ -150,10 +164,6 @@ fn box_interval(c: vec3<f32>, ax: vec4<f32>, ay: vec4<f32>, az: vec4<f32>, x: f3
     return vec2<f32>(lo, hi);
 }
 
-struct DepthOut {
-    @builtin(frag_depth) depth: f32,
-}
-
 // The local (x, z) of the texel centre under a fragment, computed from the fragment's position
 // (exactly k + 0.5) the same way the CPU reference computes texel centres, rather than from an
 // interpolated varying, whose rounding a ray cast near a silhouette would amplify.
@@ -163,7 +173,7 @@ fn texel_center(frag: vec2<f32>) -> vec2<f32> {
 }
 
 @fragment
-fn fs_prim(in: PrimOut) -> DepthOut {
+fn fs_prim(in: PrimOut) {
     let p = prims[in.index];
     let c = texel_center(in.clip.xy);
     var iv: vec2<f32>;
@@ -175,11 +185,9 @@ fn fs_prim(in: PrimOut) -> DepthOut {
     // Keep only the part inside the frustum: a solid reaching below the ground is clamped to the
     // ground, one entirely below it or above the frustum leaves nothing.
     if iv.x > iv.y || iv.y < 0.0 || iv.x >= view.frustum_height {
-        discard;
+        return;
     }
-    var out: DepthOut;
-    out.depth = max(iv.x, 0.0) / view.frustum_height;
-    return out;
+    keep_lowest(in.clip.xy, max(iv.x, 0.0) / view.frustum_height);
 }
 
 struct MeshDraw {
@@ -206,16 +214,14 @@ fn vs_mesh(@location(0) position: vec3<f32>) -> MeshOut {
 }
 
 @fragment
-fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) -> DepthOut {
-    var out: DepthOut;
+fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) {
     // Seen from below, the first surface of a closed solid is a face turned towards the camera.
     // Seeing a face turned away means the near plane cut the solid open: the solid fills the
     // ground here, so this texel is pressed to the ground (depth clamping; the far side of the
     // clipped mesh must never leak through).
     if front {
-        out.depth = clamp(in.height / view.frustum_height, 0.0, 1.0);
+        keep_lowest(in.clip.xy, in.height / view.frustum_height);
     } else {
-        out.depth = 0.0;
+        keep_lowest(in.clip.xy, 0.0);
     }
-    return out;
 }

@@ -24,8 +24,25 @@ use crate::deformer::{Deformer, Pose, Shape};
 /// WGSL of the capture pass.
 pub const SHADER: &str = include_str!("capture.wgsl");
 
-/// Format of the capture atlas.
-pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Format of the render target that places each surface's viewport. The capture itself goes to a
+/// storage buffer (atomic max of an encoded depth), so this target is never cleared, read or written:
+/// the smallest depth format keeps its memory small.
+pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
+
+/// Code of depth 1.0, the top of the frustum. Must match `ONE_BITS` in `capture.wgsl` and
+/// `blur.wgsl`.
+pub const ONE_BITS: u32 = 0x3f80_0000;
+
+/// Encode a depth in [0, 1] as the capture stores it: 0 means nothing was captured, larger values are
+/// lower points (so an atomic max keeps the lowest).
+pub fn encode_depth(depth: f32) -> u32 {
+    ONE_BITS - depth.clamp(0.0, 1.0).to_bits()
+}
+
+/// Decode a stored capture value to a depth in [0, 1] (1 = nothing captured).
+pub fn decode_depth(code: u32) -> f32 {
+    f32::from_bits(ONE_BITS.saturating_sub(code))
+}
 
 /// Most sub-steps an analytic deformer is split into along its motion in one update.
 pub const MAX_SUBSTEPS: u32 = 32;
@@ -38,8 +55,8 @@ pub struct CaptureView {
     pub half_size: [f32; 2],
     /// Snow depth plus ankle height, metres.
     pub frustum_height: f32,
-    /// Padding.
-    pub _pad: f32,
+    /// First texel of the surface in the capture buffer.
+    pub offset: u32,
     /// The surface's top-left texel in the atlas.
     pub origin: [f32; 2],
     /// The surface's heightmap width and height, texels.
@@ -265,6 +282,16 @@ impl CapturePipelines {
                     },
                     count: None,
                 },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -283,8 +310,8 @@ impl CapturePipelines {
         });
         let depth = Some(wgpu::DepthStencilState {
             format: ATLAS_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Always),
             stencil: wgpu::StencilState::default(),
             bias: wgpu::DepthBiasState::default(),
         });
