@@ -9,7 +9,7 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use snowprint::{
-    Deformer, GpuContext, GpuOptions, Pose, Shape, SnowWorld, StageTimes, SurfaceDesc,
+    Deformer, GpuContext, GpuOptions, PassMode, Pose, Shape, SnowWorld, StageTimes, SurfaceDesc,
     SurfaceUpdate, WorldConfig,
 };
 
@@ -41,6 +41,8 @@ pub struct Row {
     pub resolution: u32,
     /// Deformers over each surface.
     pub deformers_per_surface: u32,
+    /// Blur, merge and normals fused in one pass (else three passes).
+    pub fused: bool,
     /// Median GPU time of the whole update, microseconds (or whole frames timed on the CPU).
     pub update_us: f64,
     /// Median GPU time per stage, microseconds.
@@ -68,6 +70,8 @@ pub struct StageTimesUs {
     pub merge: f64,
     /// Normals.
     pub normals: f64,
+    /// Fused blur + merge + normals.
+    pub fused: f64,
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -205,6 +209,7 @@ struct Config {
     surfaces: u32,
     resolution: u32,
     deformers: u32,
+    passes: PassMode,
 }
 
 fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
@@ -216,6 +221,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         WorldConfig {
             pool_bytes: slot * c.surfaces as u64,
             max_resolution: c.resolution,
+            passes: c.passes,
             atlas_side: 8192.min(gpu.caps.max_texture_side),
             ..Default::default()
         },
@@ -242,8 +248,8 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     }
     world.set_profiling(true);
     let timestamps = world.has_timestamps();
-    let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals) =
-        (vec![], vec![], vec![], vec![], vec![], vec![]);
+    let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals, mut fused) =
+        (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
     for f in 0..args.warmup + args.frames {
         // Each surface is given the deformers over it, as a manager's spatial lookup would.
         let deformers: Vec<Vec<Deformer>> = centers
@@ -275,12 +281,14 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
                 blur_ms,
                 merge_ms,
                 normals_ms,
+                fused_ms,
             }) => {
                 cap.push(capture_ms * 1e3);
                 blur.push(blur_ms * 1e3);
                 merge.push(merge_ms * 1e3);
                 normals.push(normals_ms * 1e3);
-                total.push((capture_ms + blur_ms + merge_ms + normals_ms) * 1e3);
+                fused.push(fused_ms * 1e3);
+                total.push((capture_ms + blur_ms + merge_ms + normals_ms + fused_ms) * 1e3);
             }
             None => total.push(wall),
         }
@@ -301,12 +309,14 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         surfaces: c.surfaces,
         resolution: c.resolution,
         deformers_per_surface: c.deformers,
+        fused: world.config().passes == PassMode::Fused,
         update_us,
         stages_us: timestamps.then(|| StageTimesUs {
             capture: median(&mut cap),
             blur: median(&mut blur),
             merge: median(&mut merge),
             normals: median(&mut normals),
+            fused: median(&mut fused),
         }),
         cpu_encode_us: median(&mut cpu),
         heightmap_bytes: bytes,
@@ -334,12 +344,19 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             gpu.info.name
         );
     }
-    let mut configs = vec![Config {
-        sweep: "talk_budget",
-        surfaces: 2,
-        resolution: 512,
-        deformers: 10,
-    }];
+    let cfg = |sweep, surfaces, resolution, deformers, passes| Config {
+        sweep,
+        surfaces,
+        resolution,
+        deformers,
+        passes,
+    };
+    // The talk's frame, fused and as three separate passes; the sweeps use the device's default.
+    let (auto, fused, separate) = (PassMode::Auto, PassMode::Fused, PassMode::Separate);
+    let mut configs = vec![
+        cfg("talk_budget", 2, 512, 10, fused),
+        cfg("talk_budget", 2, 512, 10, separate),
+    ];
     let (counts, resolutions, deformers): (&[u32], &[u32], &[u32]) = if quick {
         (&[1, 4, 16], &[64, 128, 256], &[1, 10, 100])
     } else {
@@ -349,37 +366,17 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             &[1, 10, 100, 1000],
         )
     };
-    for &n in counts {
-        configs.push(Config {
-            sweep: "surfaces",
-            surfaces: n,
-            resolution: 128,
-            deformers: 10,
-        });
-    }
-    for &r in resolutions {
-        configs.push(Config {
-            sweep: "resolution",
-            surfaces: 16,
-            resolution: r,
-            deformers: 10,
-        });
-    }
-    for &d in deformers {
-        configs.push(Config {
-            sweep: "deformers",
-            surfaces: 2,
-            resolution: 512,
-            deformers: d,
-        });
-    }
+    configs.extend(counts.iter().map(|&n| cfg("surfaces", n, 128, 10, auto)));
+    configs.extend(
+        resolutions
+            .iter()
+            .map(|&r| cfg("resolution", 16, r, 10, auto)),
+    );
+    configs.extend(deformers.iter().map(|&d| cfg("deformers", 2, 512, d, auto)));
     if !quick {
-        configs.push(Config {
-            sweep: "goal_512x512",
-            surfaces: 512,
-            resolution: 512,
-            deformers: 1,
-        });
+        // The most 512^2 surfaces one storage binding of 2 GiB holds at 12 bytes a texel.
+        configs.push(cfg("many_512", 512, 512, 1, fused));
+        configs.push(cfg("many_512", 512, 512, 1, separate));
     }
     let bar = ProgressBar::new(configs.len() as u64);
     bar.set_style(
@@ -408,8 +405,9 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         }
     );
     println!(
-        "{:<14} {:>8} {:>6} {:>6} {:>11} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>8}",
+        "{:<12} {:>5} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}",
         "sweep",
+        "mode",
         "surfaces",
         "res",
         "defs",
@@ -418,6 +416,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         "blur",
         "merge",
         "normals",
+        "fused",
         "cpu_us",
         "copy_us",
         "x_copy"
@@ -426,8 +425,9 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<14} {:>8} {:>6} {:>6} {:>11.1} {:>9} {:>9} {:>9} {:>9} {:>9.1} {:>10.1} {:>8.2}",
+            "{:<12} {:>5} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2}",
             r.sweep,
+            if r.fused { "fused" } else { "3pass" },
             r.surfaces,
             r.resolution,
             r.deformers_per_surface,
@@ -436,6 +436,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             f(s.map(|s| s.blur)),
             f(s.map(|s| s.merge)),
             f(s.map(|s| s.normals)),
+            f(s.map(|s| s.fused)),
             r.cpu_encode_us,
             r.copy_us,
             r.ratio_to_copy

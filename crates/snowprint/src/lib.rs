@@ -42,6 +42,6 @@ pub use mesh::{Mesh, MeshId};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
-    CaptureConfig, CaptureMode, FrameStats, MemoryReport, SnowWorld, StageTimes, SurfaceUpdate,
-    WorldConfig,
+    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, SnowWorld, StageTimes,
+    SurfaceUpdate, WorldConfig,
 };

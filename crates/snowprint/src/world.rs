@@ -65,6 +65,23 @@ pub struct WorldConfig {
     pub atlas_side: u32,
     /// Largest heightmap side, texels: 512 as in the talk; benchmarks raise it.
     pub max_resolution: u32,
+    /// How blur, merge and normals are dispatched.
+    pub passes: PassMode,
+}
+
+/// How the accumulation chain is dispatched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum PassMode {
+    /// Fused on GPUs, separate on software adapters (the default).
+    #[default]
+    Auto,
+    /// Blur, merge and normals in one pass: one dispatch instead of three and no scratch round
+    /// trip, at the price of recomputing the neighbours' values (45 capture loads a texel instead of
+    /// 9), which suits GPUs, where a pass costs more than its memory traffic.
+    Fused,
+    /// Three passes; [`SnowWorld::read_last_blurred`] can then show stage 1's output. Cheaper on
+    /// software adapters, where every load counts and a pass costs little.
+    Separate,
 }
 
 impl Default for WorldConfig {
@@ -74,6 +91,7 @@ impl Default for WorldConfig {
             pool_bytes: 32 << 20,
             atlas_side: 2048,
             max_resolution: crate::surface::MAX_RESOLUTION,
+            passes: PassMode::Auto,
         }
     }
 }
@@ -89,12 +107,14 @@ pub struct StageTimes {
     pub merge_ms: f64,
     /// The normals dispatch.
     pub normals_ms: f64,
+    /// The fused blur + merge + normals dispatch (when [`PassMode::Fused`]).
+    pub fused_ms: f64,
 }
 
 impl StageTimes {
     /// Sum of the stages.
     pub fn total_ms(&self) -> f64 {
-        self.capture_ms + self.blur_ms + self.merge_ms + self.normals_ms
+        self.capture_ms + self.blur_ms + self.merge_ms + self.normals_ms + self.fused_ms
     }
 }
 
@@ -236,6 +256,7 @@ enum Stage {
     Blur,
     Merge,
     Normals,
+    Fused,
 }
 
 /// The snow world: every surface's heightmap in one GPU pool, updated by [`SnowWorld::step`].
@@ -304,6 +325,13 @@ impl SnowWorld {
             config.pool_bytes = max_pool;
         }
         config.atlas_side = config.atlas_side.clamp(64, gpu.caps.max_texture_side);
+        if config.passes == PassMode::Auto {
+            config.passes = if gpu.info.device_type == wgpu::DeviceType::Cpu {
+                PassMode::Separate
+            } else {
+                PassMode::Fused
+            };
+        }
         config.max_resolution = config.max_resolution.clamp(1, config.atlas_side);
         let alloc = SlotAllocator::new(config.pool_bytes);
         let pool = device.create_buffer(&wgpu::BufferDescriptor {
@@ -887,6 +915,24 @@ impl SnowWorld {
             ],
         });
 
+        let fused_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("fused"),
+            layout: &self.acc.fused_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.records.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.capture.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.pool.as_entire_binding(),
+                },
+            ],
+        });
         let ts = if self.profiling {
             self.timestamps.as_ref()
         } else {
@@ -971,17 +1017,25 @@ impl SnowWorld {
                 }
             }
         }
-        for (stage, pipeline, bg) in [
+        let separate = [
             (Stage::Blur, &self.acc.blur, &blur_bg),
             (Stage::Merge, &self.acc.merge, &merge_bg),
             (Stage::Normals, &self.acc.normals, &normals_bg),
-        ] {
+        ];
+        let fused = [(Stage::Fused, &self.acc.fused, &fused_bg)];
+        let passes: &[_] = if self.config.passes == PassMode::Fused {
+            &fused
+        } else {
+            &separate
+        };
+        for &(stage, pipeline, bg) in passes {
             let q = next_query(stage, &mut stages);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(match stage {
                     Stage::Blur => "blur",
                     Stage::Merge => "merge",
-                    _ => "normals",
+                    Stage::Normals => "normals",
+                    _ => "fused",
                 }),
                 timestamp_writes: q.map(|q| wgpu::ComputePassTimestampWrites {
                     query_set: &ts.expect("query implies timestamps").set,
@@ -1027,6 +1081,7 @@ impl SnowWorld {
                     Stage::Blur => t.blur_ms += ms,
                     Stage::Merge => t.merge_ms += ms,
                     Stage::Normals => t.normals_ms += ms,
+                    Stage::Fused => t.fused_ms += ms,
                 }
             }
             stats.gpu = Some(t);
@@ -1125,8 +1180,12 @@ impl SnowWorld {
     }
 
     /// Debug readback of the last step: the blurred capture (stage 1 output) of a surface, when it
-    /// was captured in that step.
+    /// was captured in that step by separate stages ([`PassMode::Separate`]; the fused pass keeps
+    /// stage 1's output in registers).
     pub fn read_last_blurred(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        if self.config.passes == PassMode::Fused {
+            return Ok(None);
+        }
         let Some(&(_, r, _)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
             return Ok(None);
         };

@@ -7,8 +7,8 @@ use glam::{Quat, Vec2, Vec3};
 use snowprint::accumulate::cpu::{self as acc_cpu, BlurInput};
 use snowprint::capture::{self, CaptureVolume, cpu as cap_cpu};
 use snowprint::{
-    CaptureConfig, CaptureMode, Deformer, Mesh, Pose, Shape, SnowError, SnowWorld, SurfaceDesc,
-    WorldConfig,
+    CaptureConfig, CaptureMode, Deformer, Mesh, PassMode, Pose, Shape, SnowError, SnowWorld,
+    SurfaceDesc, WorldConfig,
 };
 
 const ANKLE: f32 = 0.25;
@@ -21,6 +21,10 @@ const ANKLE: f32 = 0.25;
 const CAPTURE_HEIGHT_TOLERANCE: f32 = 5e-5;
 
 fn world(mode: CaptureMode) -> SnowWorld {
+    world_with(mode, true)
+}
+
+fn world_with(mode: CaptureMode, fused: bool) -> SnowWorld {
     SnowWorld::new(
         common::gpu(),
         WorldConfig {
@@ -30,6 +34,11 @@ fn world(mode: CaptureMode) -> SnowWorld {
                 mask_depth: 0.6,
             },
             pool_bytes: 16 << 20,
+            passes: if fused {
+                PassMode::Fused
+            } else {
+                PassMode::Separate
+            },
             ..Default::default()
         },
     )
@@ -109,7 +118,7 @@ fn every_stage_matches_its_cpu_reference() {
         ([1.0, 4.5], -75.0),
         ([6.0, 6.0], 0.0),
     ] {
-        let mut w = world(CaptureMode::Depth);
+        let mut w = world_with(CaptureMode::Depth, false);
         let mut desc = SurfaceDesc::new("s", [2.0, 1.0, -3.0], size, 0.3);
         desc.yaw_degrees = yaw;
         desc.replenish_rate = 0.5;
@@ -792,4 +801,76 @@ fn update_touches_only_the_listed_surfaces() {
         w.update(&twice),
         Err(SnowError::DuplicateUpdate { .. })
     ));
+}
+
+/// The fused pass (blur, merge and normals in one dispatch) gives what the CPU references give in
+/// sequence, and what the separate passes give.
+#[test]
+fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
+    for (size, yaw) in [([4.0, 3.0], 20.0), ([1.3, 2.7], 0.0)] {
+        let mut fused = world_with(CaptureMode::Depth, true);
+        let mut separate = world_with(CaptureMode::Depth, false);
+        let mut desc = SurfaceDesc::new("f", [0.5, 2.0, 1.0], size, 0.3);
+        desc.yaw_degrees = yaw;
+        desc.replenish_rate = 0.3;
+        let a = fused.add_surface(desc.clone()).unwrap();
+        let b = separate.add_surface(desc.clone()).unwrap();
+        let l = desc.layout();
+        let texel = desc.size / Vec2::new(l.width as f32, l.height as f32);
+        let deformers = crowd(desc.center);
+        let mut before = vec![0u32; l.texels() as usize];
+        for frame in 0..3 {
+            let d = &deformers[frame..];
+            let stats = fused.step(0.1, d).unwrap();
+            separate.step(0.1, d).unwrap();
+            assert_eq!(stats.updated, 1);
+            let capture = fused.read_last_capture(a).unwrap().expect("captured");
+            let inp = blur_input(&desc, CaptureMode::Depth);
+            let units = [1966, 1966, 1966][frame]; // 0.3/s x 0.1 s x 65535 = 1966.05
+            let cpu_heights = acc_cpu::merge(&before, Some(&acc_cpu::blur(&inp, &capture)), units);
+            let gpu_heights = fused.read_packed(a).unwrap();
+            let off_by = |x: &[u32], y: &[u32]| {
+                x.iter()
+                    .zip(y)
+                    .map(|(g, c)| {
+                        ((g & 0xffff) as i32 - (c & 0xffff) as i32)
+                            .abs()
+                            .max(((g >> 16) as i32 - (c >> 16) as i32).abs())
+                    })
+                    .max()
+                    .unwrap_or(0)
+            };
+            assert!(
+                off_by(&gpu_heights, &cpu_heights) <= 1,
+                "fused vs CPU, frame {frame}"
+            );
+            assert!(
+                off_by(&gpu_heights, &separate.read_packed(b).unwrap()) <= 1,
+                "fused vs separate"
+            );
+            assert!(gpu_heights.iter().any(|&v| v & 0xffff > 0));
+            // Normals of the fused pass against the CPU normals of the fused heights.
+            let cpu_n = acc_cpu::normals(
+                &gpu_heights,
+                l.width,
+                l.height,
+                desc.snow_depth,
+                texel.x,
+                texel.y,
+            );
+            for (g, c) in fused.read_normals_packed(a).unwrap().iter().zip(&cpu_n) {
+                let (gx, gz) = acc_cpu::unpack2x16snorm(*g);
+                let (cx, cz) = acc_cpu::unpack2x16snorm(*c);
+                assert!(
+                    (gx - cx).abs() < 1e-3 && (gz - cz).abs() < 1e-3,
+                    "normal {gx},{gz} vs {cx},{cz}"
+                );
+            }
+            before = gpu_heights;
+        }
+        assert!(
+            fused.read_last_blurred(a).unwrap().is_none(),
+            "the fused pass keeps stage 1 in registers"
+        );
+    }
 }

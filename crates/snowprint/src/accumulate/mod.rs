@@ -20,13 +20,17 @@ pub const BLUR_SHADER: &str = include_str!("blur.wgsl");
 pub const MERGE_SHADER: &str = include_str!("merge.wgsl");
 /// Normals (without the shared prelude).
 pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
+/// All three in one pass (without the shared prelude).
+pub const FUSED_SHADER: &str = include_str!("fused.wgsl");
+/// The arithmetic shared by every stage.
+pub const MATHS: &str = include_str!("maths.wgsl");
 
 /// Workgroup side of every accumulation pass.
 pub const WORKGROUP: u32 = 8;
 
 /// The shader source of a stage with the shared prelude, as compiled.
 pub fn with_prelude(stage: &str) -> String {
-    format!("{SHARED}\n{stage}")
+    format!("{SHARED}\n{MATHS}\n{stage}")
 }
 
 /// The three compute pipelines and their layouts.
@@ -37,12 +41,16 @@ pub struct AccumulatePipelines {
     pub merge: wgpu::ComputePipeline,
     /// Normals.
     pub normals: wgpu::ComputePipeline,
+    /// Blur, merge and normals fused.
+    pub fused: wgpu::ComputePipeline,
     /// Layout of the blur's group 0.
     pub blur_layout: wgpu::BindGroupLayout,
     /// Layout of the merge's group 0.
     pub merge_layout: wgpu::BindGroupLayout,
     /// Layout of the normals' group 0.
     pub normals_layout: wgpu::BindGroupLayout,
+    /// Layout of the fused pass's group 0: records, capture, pool.
+    pub fused_layout: wgpu::BindGroupLayout,
 }
 
 fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -67,6 +75,10 @@ impl AccumulatePipelines {
         });
         let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("merge"),
+            entries: &[storage(0, true), storage(1, true), storage(2, false)],
+        });
+        let fused_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("fused"),
             entries: &[storage(0, true), storage(1, true), storage(2, false)],
         });
         let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -96,9 +108,11 @@ impl AccumulatePipelines {
             blur: make("blur", BLUR_SHADER, &blur_layout),
             merge: make("merge", MERGE_SHADER, &merge_layout),
             normals: make("normals", NORMALS_SHADER, &normals_layout),
+            fused: make("fused", FUSED_SHADER, &fused_layout),
             blur_layout,
             merge_layout,
             normals_layout,
+            fused_layout,
         }
     }
 }
@@ -114,6 +128,7 @@ mod tests {
             ("blur", with_prelude(BLUR_SHADER)),
             ("merge", with_prelude(MERGE_SHADER)),
             ("normals", with_prelude(NORMALS_SHADER)),
+            ("fused", with_prelude(FUSED_SHADER)),
             ("capture", crate::capture::SHADER.to_owned()),
         ] {
             let module = naga::front::wgsl::parse_str(&src)

@@ -2,16 +2,15 @@
 // Reads: `records`, the `heights_write` half of each slot in `pool` (written by the merge).
 // Writes: the `normals` region: pack2x16snorm of the normal's local x and z (y is positive and
 // follows from unit length).
-// CPU reference: accumulate::cpu::normals.
+// CPU reference: accumulate::cpu::normals. Maths: maths.wgsl.
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read_write> pool: array<u32>;
 
-fn snow_height(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
+fn height_at(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     let cx = u32(clamp(x, 0, i32(rec.width) - 1));
     let cy = u32(clamp(y, 0, i32(rec.height) - 1));
-    let d = pool[rec.heights_write + cy * rec.width + cx] & 0xffffu;
-    return -f32(d) / UNITS * rec.snow_depth;
+    return snow_height(rec, pool[rec.heights_write + cy * rec.width + cx] & 0xffffu);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -22,8 +21,11 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = i32(gid.x);
     let y = i32(gid.y);
-    let dhdx = (snow_height(rec, x + 1, y) - snow_height(rec, x - 1, y)) / (2.0 * rec.texel_x);
-    let dhdz = (snow_height(rec, x, y + 1) - snow_height(rec, x, y - 1)) / (2.0 * rec.texel_z);
-    let n = normalize(vec3<f32>(-dhdx, 1.0, -dhdz));
-    pool[rec.normals + gid.y * rec.width + gid.x] = pack2x16snorm(n.xz);
+    pool[rec.normals + gid.y * rec.width + gid.x] = packed_normal(
+        rec,
+        height_at(rec, x - 1, y),
+        height_at(rec, x + 1, y),
+        height_at(rec, x, y - 1),
+        height_at(rec, x, y + 1),
+    );
 }

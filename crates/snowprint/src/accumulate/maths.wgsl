@@ -1,0 +1,77 @@
+// The arithmetic of the accumulation chain, as pure functions of loaded values, shared by the
+// separate passes (blur.wgsl, merge.wgsl, normals.wgsl) and the fused one (fused.wgsl) so that they
+// cannot drift apart. CPU reference: accumulate::cpu.
+
+// Must match `ONE_BITS` in capture.wgsl: a stored capture value v is the depth bitcast(ONE_BITS - v).
+const ONE_BITS: u32 = 0x3f800000u;
+
+// Tap offsets in texels: a rotated grid, so each bilinear tap mixes four texels and the four taps
+// together spread over one texel in every direction (kernel in 64ths: corners 3, edges 10,
+// centre 12).
+const TAPS = array<vec2<f32>, 4>(
+    vec2<f32>(-0.25, -0.75),
+    vec2<f32>(0.75, -0.25),
+    vec2<f32>(0.25, 0.75),
+    vec2<f32>(-0.75, 0.25),
+);
+
+// Depression (0 = untouched, 1 = pressed to the ground) of a stored capture value.
+fn capture_depression(rec: SurfaceRecord, code: u32) -> f32 {
+    let z = bitcast<f32>(ONE_BITS - code);
+    if rec.mode == MODE_MASK {
+        return select(0.0, rec.mask_fraction, z < 1.0);
+    }
+    let h = z * rec.frustum_height;
+    return clamp((rec.snow_depth - h) / rec.snow_depth, 0.0, 1.0);
+}
+
+fn lerp2(a: f32, b: f32, c: f32, d: f32, f: vec2<f32>) -> f32 {
+    let top = a * (1.0 - f.x) + b * f.x;
+    let bottom = c * (1.0 - f.x) + d * f.x;
+    return top * (1.0 - f.y) + bottom * f.y;
+}
+
+// The 4-tap bilinear Poisson blur from the 3x3 depressions around a texel; vXY is the texel at
+// offset (X - 1, Y - 1). A tap at offset o interpolates from texel floor(o) with weights fract(o).
+fn blur_taps(
+    v00: f32, v10: f32, v20: f32,
+    v01: f32, v11: f32, v21: f32,
+    v02: f32, v12: f32, v22: f32,
+) -> f32 {
+    let t0 = lerp2(v00, v10, v01, v11, fract(TAPS[0])); // (-0.25, -0.75): from (-1, -1)
+    let t1 = lerp2(v10, v20, v11, v21, fract(TAPS[1])); // ( 0.75, -0.25): from ( 0, -1)
+    let t2 = lerp2(v11, v21, v12, v22, fract(TAPS[2])); // ( 0.25,  0.75): from ( 0,  0)
+    let t3 = lerp2(v01, v11, v02, v12, fract(TAPS[3])); // (-0.75,  0.25): from (-1,  0)
+    return (t0 + t1 + t2 + t3) * 0.25;
+}
+
+// Replenish an old packed texel by `rep` units, then deepen it by a blurred capture (when there is
+// one). A capture never makes a depression shallower; what it deepens is added to the displaced
+// channel (high 16 bits).
+fn merge_texel(old: u32, blurred: f32, has_capture: bool, rep: u32) -> u32 {
+    // Saturating subtraction: snow refills up to the untouched top and no further.
+    let depressed = max(old & 0xffffu, rep) - rep;
+    let displaced = max(old >> 16u, rep) - rep;
+    var captured = 0u;
+    if has_capture {
+        captured = u32(floor(clamp(blurred, 0.0, 1.0) * UNITS + 0.5));
+    }
+    let new_depressed = max(depressed, captured);
+    let pushed = new_depressed - depressed;
+    let new_displaced = min(displaced + pushed, 0xffffu);
+    return new_depressed | (new_displaced << 16u);
+}
+
+// Height of the snow top (metres, 0 = untouched) of a depression in units.
+fn snow_height(rec: SurfaceRecord, units: u32) -> f32 {
+    return -f32(units) / UNITS * rec.snow_depth;
+}
+
+// Packed normal (pack2x16snorm of local x and z) from the heights left, right, below (-z) and
+// above (+z) a texel, by central differences.
+fn packed_normal(rec: SurfaceRecord, left: f32, right: f32, back: f32, front: f32) -> u32 {
+    let dhdx = (right - left) / (2.0 * rec.texel_x);
+    let dhdz = (front - back) / (2.0 * rec.texel_z);
+    let n = normalize(vec3<f32>(-dhdx, 1.0, -dhdz));
+    return pack2x16snorm(n.xz);
+}
