@@ -451,7 +451,7 @@ mod tests {
         assert_eq!(side, 1024);
         assert!(p.iter().all(|p| p.batch == 0));
         // Too many for the limit: several batches at the limit.
-        let (p, side) = pack_atlas_compact(&vec![(512, 512); 20], 1024);
+        let (p, side) = pack_atlas_compact(&[(512, 512); 20], 1024);
         assert_eq!(side, 1024);
         assert_eq!(p.iter().map(|p| p.batch).max(), Some(4));
     }
