@@ -225,6 +225,28 @@ impl Growable {
 
 const UNIFORM_STRIDE: u64 = 256;
 
+/// A bind group of whole buffers at bindings 0, 1, 2, ...
+fn buffers_bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
 /// One surface's work in a frame.
 struct Job {
     surface: usize,
@@ -864,75 +886,37 @@ impl SnowWorld {
                 }),
             }],
         });
-        let blur_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("blur"),
-            layout: &self.acc.blur_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.records.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.capture.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.scratch.buffer.as_entire_binding(),
-                },
-            ],
-        });
-        let merge_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("merge"),
-            layout: &self.acc.merge_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.records.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.scratch.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.pool.as_entire_binding(),
-                },
-            ],
-        });
-        let normals_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("normals"),
-            layout: &self.acc.normals_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.records.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.pool.as_entire_binding(),
-                },
-            ],
-        });
-
-        let fused_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fused"),
-            layout: &self.acc.fused_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.records.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.capture.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.pool.as_entire_binding(),
-                },
-            ],
-        });
+        // Each pass binds whole buffers in binding order; the layouts name what it reads and writes.
+        let (records, capture, scratch, pool) = (
+            &self.records.buffer,
+            &self.capture.buffer,
+            &self.scratch.buffer,
+            &self.pool,
+        );
+        let blur_bg = buffers_bind_group(
+            &self.device,
+            "blur",
+            &self.acc.blur_layout,
+            &[records, capture, scratch],
+        );
+        let merge_bg = buffers_bind_group(
+            &self.device,
+            "merge",
+            &self.acc.merge_layout,
+            &[records, scratch, pool],
+        );
+        let normals_bg = buffers_bind_group(
+            &self.device,
+            "normals",
+            &self.acc.normals_layout,
+            &[records, pool],
+        );
+        let fused_bg = buffers_bind_group(
+            &self.device,
+            "fused",
+            &self.acc.fused_layout,
+            &[records, capture, pool],
+        );
         let ts = if self.profiling {
             self.timestamps.as_ref()
         } else {

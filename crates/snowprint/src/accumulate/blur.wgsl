@@ -3,17 +3,11 @@
 // Reads: `capture` (encoded depths written by the capture pass at each record's `scratch`
 // offset), `records`.
 // Writes: `scratch` (one f32 per texel of each captured surface).
-// CPU reference: accumulate::cpu::blur. Maths: maths.wgsl.
+// CPU reference: accumulate::cpu::blur. Maths: maths.wgsl, capture_read.wgsl.
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
 @group(0) @binding(2) var<storage, read_write> scratch: array<f32>;
-
-fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
-    let cx = u32(clamp(x, 0, i32(rec.width) - 1));
-    let cy = u32(clamp(y, 0, i32(rec.height) - 1));
-    return capture_depression(rec, capture[rec.scratch + cy * rec.width + cx]);
-}
 
 @compute @workgroup_size(8, 8, 1)
 fn blur(@builtin(global_invocation_id) gid: vec3<u32>) {

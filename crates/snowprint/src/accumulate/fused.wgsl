@@ -5,17 +5,11 @@
 // not exchanged, and come out bit for bit as their own invocations compute them.
 // Reads: `records`, `capture`, the `heights_read` half of each slot in `pool`.
 // Writes: the `heights_write` half and the `normals` region.
-// CPU reference: accumulate::cpu::blur, merge and normals in sequence. Maths: maths.wgsl.
+// CPU reference: accumulate::cpu::blur, merge and normals in sequence. Maths: maths.wgsl, capture_read.wgsl.
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
 @group(0) @binding(2) var<storage, read_write> pool: array<u32>;
-
-fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
-    let cx = u32(clamp(x, 0, i32(rec.width) - 1));
-    let cy = u32(clamp(y, 0, i32(rec.height) - 1));
-    return capture_depression(rec, capture[rec.scratch + cy * rec.width + cx]);
-}
 
 // The new packed texel at (x, y), clamped to the surface.
 fn updated(rec: SurfaceRecord, x_in: i32, y_in: i32) -> u32 {

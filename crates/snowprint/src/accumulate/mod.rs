@@ -24,13 +24,20 @@ pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
 pub const FUSED_SHADER: &str = include_str!("fused.wgsl");
 /// The arithmetic shared by every stage.
 pub const MATHS: &str = include_str!("maths.wgsl");
+/// Reading the capture buffer (for the passes that bind it).
+pub const CAPTURE_READ: &str = include_str!("capture_read.wgsl");
 
 /// Workgroup side of every accumulation pass.
 pub const WORKGROUP: u32 = 8;
 
 /// The shader source of a stage with the shared prelude, as compiled.
 pub fn with_prelude(stage: &str) -> String {
-    format!("{SHARED}\n{MATHS}\n{stage}")
+    let capture = if stage.contains("var<storage, read> capture") {
+        CAPTURE_READ
+    } else {
+        ""
+    };
+    format!("{SHARED}\n{MATHS}\n{capture}\n{stage}")
 }
 
 /// The three compute pipelines and their layouts.
