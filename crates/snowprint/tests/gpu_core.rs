@@ -874,3 +874,29 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
         );
     }
 }
+
+/// An animated mesh is given as posed vertices each frame: the capture follows the new vertices.
+#[test]
+fn posed_mesh_vertices_move_the_imprint() {
+    let mut w = world(CaptureMode::Depth);
+    let id = w
+        .add_surface(SurfaceDesc::new("p", [0.0, 0.0, 0.0], [2.0, 1.0], 0.3))
+        .unwrap();
+    let cube = Mesh::cuboid(Vec3::new(0.1, 0.2, 0.1));
+    let m = w.add_mesh("cube", &cube).unwrap();
+    let at_origin = [Deformer::new(Shape::Mesh(m), Pose::at([0.0; 3]))];
+    w.step(1.0 / 60.0, &at_origin).unwrap();
+    // Pose the same mesh 0.6 m along +x by moving its vertices, not its pose.
+    let moved: Vec<Vec3> = cube
+        .positions
+        .iter()
+        .map(|p| *p + Vec3::new(0.6, 0.0, 0.0))
+        .collect();
+    w.pose_mesh(m, &moved).unwrap();
+    w.step(1.0 / 60.0, &at_origin).unwrap();
+    let map = w.read_heightmap(id).unwrap();
+    // 4 cm texels: the cube spans columns 22..27 at first (x in -0.1..0.1), then 37..42.
+    let pressed = |col: u32| map.depression[(12 * map.width + col) as usize] == 65535;
+    assert!(pressed(25) && pressed(40), "both imprints are there");
+    assert!(!pressed(32), "nothing between them");
+}
