@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use glam::{Mat4, Vec2};
 
-use crate::accumulate::{self, AccumulatePipelines, WORKGROUP};
+use crate::accumulate::{self, AccumulatePipelines, FUSED_WORKGROUP, WORKGROUP};
 use crate::capture::{
     self, AtlasPlacement, CapturePipelines, CaptureView, CaptureVolume, GpuPrimitive, MeshDraw,
 };
@@ -846,11 +846,6 @@ impl SnowWorld {
         let atlas_view = &self.atlases[atlas_index].2;
         let max_w = jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         let max_h = jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
-        let groups = (
-            max_w.div_ceil(WORKGROUP),
-            max_h.div_ceil(WORKGROUP),
-            jobs.len() as u32,
-        );
 
         let view_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("capture view"),
@@ -1029,7 +1024,16 @@ impl SnowWorld {
             });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, bg, &[]);
-            pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+            let side = if matches!(stage, Stage::Fused) {
+                FUSED_WORKGROUP
+            } else {
+                WORKGROUP
+            };
+            pass.dispatch_workgroups(
+                max_w.div_ceil(side),
+                max_h.div_ceil(side),
+                jobs.len() as u32,
+            );
         }
         if let (Some(ts), false) = (ts, stages.is_empty()) {
             let n = stages.len() as u32 * 2;

@@ -27,8 +27,10 @@ pub const MATHS: &str = include_str!("maths.wgsl");
 /// Reading the capture buffer (for the passes that bind it).
 pub const CAPTURE_READ: &str = include_str!("capture_read.wgsl");
 
-/// Workgroup side of every accumulation pass.
+/// Workgroup side of the separate accumulation passes.
 pub const WORKGROUP: u32 = 8;
+/// Workgroup side of the fused pass (its tile). Must match `SIDE` in `fused.wgsl`.
+pub const FUSED_WORKGROUP: u32 = 16;
 
 /// The shader source of a stage with the shared prelude, as compiled.
 pub fn with_prelude(stage: &str) -> String {
