@@ -299,6 +299,7 @@ pub struct SnowWorld {
     prims: Growable,
     draws: Growable,
     capture: Growable,
+    winding: Growable,
     scratch: Growable,
     last: LastFrame,
     profiling: bool,
@@ -419,6 +420,12 @@ impl SnowWorld {
             capture: Growable::new(
                 &device,
                 "capture",
+                U::STORAGE | U::COPY_DST | U::COPY_SRC,
+                4 * 4096,
+            ),
+            winding: Growable::new(
+                &device,
+                "capture winding",
                 U::STORAGE | U::COPY_DST | U::COPY_SRC,
                 4 * 4096,
             ),
@@ -607,7 +614,8 @@ impl SnowWorld {
                 + self.views.buffer.size()
                 + self.prims.buffer.size()
                 + self.draws.buffer.size()
-                + self.capture.buffer.size(),
+                + self.capture.buffer.size()
+                + self.winding.buffer.size(),
         }
     }
 
@@ -841,6 +849,8 @@ impl SnowWorld {
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
         self.capture
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        self.winding
+            .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
 
         let atlas_index = self.atlas(atlas_side);
         let atlas_view = &self.atlases[atlas_index].2;
@@ -867,6 +877,10 @@ impl SnowWorld {
                     binding: 2,
                     resource: self.capture.buffer.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: self.winding.buffer.as_entire_binding(),
+                },
             ],
         });
         let draw_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -882,9 +896,10 @@ impl SnowWorld {
             }],
         });
         // Each pass binds whole buffers in binding order; the layouts name what it reads and writes.
-        let (records, capture, scratch, pool) = (
+        let (records, capture, winding, scratch, pool) = (
             &self.records.buffer,
             &self.capture.buffer,
+            &self.winding.buffer,
             &self.scratch.buffer,
             &self.pool,
         );
@@ -892,7 +907,7 @@ impl SnowWorld {
             &self.device,
             "blur",
             &self.acc.blur_layout,
-            &[records, capture, scratch],
+            &[records, capture, winding, scratch],
         );
         let merge_bg = buffers_bind_group(
             &self.device,
@@ -910,7 +925,7 @@ impl SnowWorld {
             &self.device,
             "fused",
             &self.acc.fused_layout,
-            &[records, capture, pool],
+            &[records, capture, winding, pool],
         );
         let ts = if self.profiling {
             self.timestamps.as_ref()
@@ -935,6 +950,7 @@ impl SnowWorld {
             });
         // Nothing captured yet: 0 is the code of "no deformer over this texel".
         enc.clear_buffer(&self.capture.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
+        enc.clear_buffer(&self.winding.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
         for batch in 0..batches {
             let q = next_query(Stage::Capture, &mut stages);
             {
@@ -1161,9 +1177,20 @@ impl SnowWorld {
             r.scratch as u64 * 4,
             (r.width * r.height) as u64 * 4,
         )?;
+        let winding = self.download(
+            &self.winding.buffer,
+            r.scratch as u64 * 4,
+            (r.width * r.height) as u64 * 4,
+        )?;
         let codes: &[u32] = bytemuck::cast_slice(&bytes);
+        let winding: &[i32] = bytemuck::cast_slice(&winding);
+        // As capture_read.wgsl reads it: inside a mesh solid at the ground, depth 0.
         Ok(Some(
-            codes.iter().map(|&v| capture::decode_depth(v)).collect(),
+            codes
+                .iter()
+                .zip(winding)
+                .map(|(&v, &n)| if n > 0 { 0.0 } else { capture::decode_depth(v) })
+                .collect(),
         ))
     }
 

@@ -900,3 +900,56 @@ fn posed_mesh_vertices_move_the_imprint() {
     assert!(pressed(25) && pressed(40), "both imprints are there");
     assert!(!pressed(32), "nothing between them");
 }
+
+/// A closed mesh wholly inside the frustum presses the snow to its lowest point, not to the ground:
+/// its upper faces, seen from below behind the lower ones, must not count as a solid cut open by
+/// the ground. A mesh ball above the snow presses nothing; one dipping into the snow matches the
+/// analytic ball within the blur's spread and the mesh's faceting.
+#[test]
+fn mesh_inside_the_frustum_presses_to_its_lowest_point() {
+    let depth = 0.3;
+    let r = 0.2;
+    let ball = Mesh::uv_sphere(r, 48, 96);
+    for (c, expect_pressed) in [(depth + r + 0.02, false), (0.25, true)] {
+        let mut w = world(CaptureMode::Depth);
+        let id = w
+            .add_surface(SurfaceDesc::new("b", [0.0, 0.0, 0.0], [1.0, 1.0], depth))
+            .unwrap();
+        let m = w.add_mesh("ball", &ball).unwrap();
+        w.step(
+            1.0 / 60.0,
+            &[Deformer::new(Shape::Mesh(m), Pose::at([0.0, c, 0.0]))],
+        )
+        .unwrap();
+        let map = w.read_heightmap(id).unwrap();
+        let max = *map.depression.iter().max().unwrap() as f32 / 65535.0;
+        if !expect_pressed {
+            assert_eq!(max, 0.0, "a ball above the snow presses nothing");
+            continue;
+        }
+        // Bottom at 0.05 m above the ground in 0.3 m of snow: the deepest point is pressed to
+        // (0.3 - 0.05) / 0.3 = 0.833 of the depth, nowhere near the ground; the blur mixes in the
+        // neighbours 4 cm away, 4 mm higher up the ball (0.013 of the depth).
+        assert!(max <= 0.8334 && max > 0.8333 - 0.02, "deepest {max}");
+        // The uv sphere's facets lie inside the true ball by at most r(1 - cos(pi/48)) = 0.4 mm.
+        let facet = r * (1.0 - (std::f32::consts::PI / 48.0).cos()) / depth;
+        for row in 0..map.height {
+            for col in 0..map.width {
+                let p = cap_cpu::texel_center(col, row, map.width, map.height, Vec2::splat(0.5));
+                let d = p.length();
+                if d > r - 0.06 {
+                    continue; // the rim, where the blur and the facets both act
+                }
+                let got = map.fraction(col, row);
+                // The blur mixes the 3x3 texels around: up to one texel diagonal (5.7 cm) away.
+                let reach = 0.04 * std::f32::consts::SQRT_2;
+                let lo = sphere_depression(depth, c, r, d + reach, depth) - facet;
+                let hi = sphere_depression(depth, c, r, (d - reach).max(0.0), depth);
+                assert!(
+                    got >= lo - 1e-4 && got <= hi + 1e-4,
+                    "at {d}: {got} not in [{lo}, {hi}]"
+                );
+            }
+        }
+    }
+}

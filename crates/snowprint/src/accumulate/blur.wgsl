@@ -1,13 +1,14 @@
 // Stage 1: turn the capture into a depression (0 = untouched, 1 = pressed to the ground) and
 // soften it with a 4-tap bilinear Poisson blur.
-// Reads: `capture` (encoded depths written by the capture pass at each record's `scratch`
+// Reads: `capture` and `winding` (written by the capture pass at each record's `scratch`
 // offset), `records`.
 // Writes: `scratch` (one f32 per texel of each captured surface).
 // CPU reference: accumulate::cpu::blur. Maths: maths.wgsl, capture_read.wgsl.
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
-@group(0) @binding(2) var<storage, read_write> scratch: array<f32>;
+@group(0) @binding(2) var<storage, read> winding: array<i32>;
+@group(0) @binding(3) var<storage, read_write> scratch: array<f32>;
 
 @compute @workgroup_size(8, 8, 1)
 fn blur(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -1,8 +1,14 @@
-// Reading the capture buffer, shared by blur.wgsl and fused.wgsl (which bind it as `capture`).
+// Reading the capture, shared by blur.wgsl and fused.wgsl (which bind `capture` and `winding`).
 
-// Depression of the captured texel (x, y) of a surface, clamped to its edges.
+// Depression of the captured texel (x, y) of a surface, clamped to its edges. Where a mesh solid
+// contains the ground point (winding > 0), the texel is pressed to the ground.
 fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     let cx = u32(clamp(x, 0, i32(rec.width) - 1));
     let cy = u32(clamp(y, 0, i32(rec.height) - 1));
-    return capture_depression(rec, capture[rec.scratch + cy * rec.width + cx]);
+    let i = rec.scratch + cy * rec.width + cx;
+    var code = capture[i];
+    if winding[i] > 0 {
+        code = ONE_BITS; // depth 0: the ground
+    }
+    return capture_depression(rec, code);
 }

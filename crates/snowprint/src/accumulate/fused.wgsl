@@ -3,14 +3,15 @@
 // with a two-texel apron (20x20) in workgroup memory, then the new heightmap values of the tile with
 // a one-texel apron (18x18, which the normals need), so every capture and history texel is read
 // from memory about once.
-// Reads: `records`, `capture`, the `heights_read` half of each slot in `pool`.
+// Reads: `records`, `capture`, `winding`, the `heights_read` half of each slot in `pool`.
 // Writes: the `heights_write` half and the `normals` region.
 // CPU reference: accumulate::cpu::blur, merge and normals in sequence. Maths: maths.wgsl,
 // capture_read.wgsl.
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
-@group(0) @binding(2) var<storage, read_write> pool: array<u32>;
+@group(0) @binding(2) var<storage, read> winding: array<i32>;
+@group(0) @binding(3) var<storage, read_write> pool: array<u32>;
 
 const SIDE: i32 = 16;
 const DEP: i32 = 20;    // SIDE + 2 texels of apron on each side

@@ -58,7 +58,7 @@ pub struct AccumulatePipelines {
     pub merge_layout: wgpu::BindGroupLayout,
     /// Layout of the normals' group 0.
     pub normals_layout: wgpu::BindGroupLayout,
-    /// Layout of the fused pass's group 0: records, capture, pool.
+    /// Layout of the fused pass's group 0: records, capture, winding, pool.
     pub fused_layout: wgpu::BindGroupLayout,
 }
 
@@ -80,7 +80,12 @@ impl AccumulatePipelines {
     pub fn new(device: &wgpu::Device) -> Self {
         let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blur"),
-            entries: &[storage(0, true), storage(1, true), storage(2, false)],
+            entries: &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, true),
+                storage(3, false),
+            ],
         });
         let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("merge"),
@@ -88,7 +93,12 @@ impl AccumulatePipelines {
         });
         let fused_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("fused"),
-            entries: &[storage(0, true), storage(1, true), storage(2, false)],
+            entries: &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, true),
+                storage(3, false),
+            ],
         });
         let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("normals"),

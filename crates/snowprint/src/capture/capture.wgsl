@@ -6,7 +6,9 @@
 //
 // Reads: `view` (one per surface, dynamic offset), `prims` (analytic deformers in surface-local
 // coordinates), mesh vertex buffers and `draw` (mesh-to-surface-local transform, dynamic offset).
-// Writes: `capture`, the surface's texels at `view.offset` (cleared to 0 = nothing before the pass).
+// Writes: `capture`, the surface's texels at `view.offset` (cleared to 0 = nothing before the pass),
+// and `winding` at the same texels (cleared to 0): how many mesh solids contain the ground point
+// under each texel.
 
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
@@ -32,16 +34,20 @@ struct Primitive {
 @group(0) @binding(0) var<uniform> view: CaptureView;
 @group(0) @binding(1) var<storage, read> prims: array<Primitive>;
 @group(0) @binding(2) var<storage, read_write> capture: array<atomic<u32>>;
+@group(0) @binding(3) var<storage, read_write> winding: array<atomic<i32>>;
 
 // Depths in [0, 1] are stored as ONE_BITS - bits(depth): 0 (the cleared value) means nothing was
 // captured, and a larger value is a lower point, so atomicMax keeps the lowest. Non-negative
 // floats order like their bit patterns, so the code is exact and monotonic.
 const ONE_BITS: u32 = 0x3f800000u;
 
-fn keep_lowest(frag: vec2<f32>, depth: f32) {
+fn texel_index(frag: vec2<f32>) -> u32 {
     let cell = vec2<u32>(frag - view.origin);
-    let index = view.offset + cell.y * u32(view.texels.x) + cell.x;
-    atomicMax(&capture[index], ONE_BITS - bitcast<u32>(clamp(depth, 0.0, 1.0)));
+    return view.offset + cell.y * u32(view.texels.x) + cell.x;
+}
+
+fn keep_lowest(frag: vec2<f32>, depth: f32) {
+    atomicMax(&capture[texel_index(frag)], ONE_BITS - bitcast<u32>(clamp(depth, 0.0, 1.0)));
 }
 
 const BIG: f32 = 1e30;
@@ -206,22 +212,24 @@ struct MeshOut {
 fn vs_mesh(@location(0) position: vec3<f32>) -> MeshOut {
     let local = draw.to_local * vec4<f32>(position, 1.0);
     var out: MeshOut;
-    // Linear depth: the near plane (depth 0) is the ground, the far plane the frustum top. The
-    // rasterizer clips what lies outside.
-    out.clip = to_clip(local.xz, local.y / view.frustum_height);
+    // No near or far clipping: the parts below the ground are needed to tell whether the ground
+    // point lies inside the solid, and the fragment shader ignores what is above the frustum.
+    out.clip = to_clip(local.xz, 0.5);
     out.height = local.y;
     return out;
 }
 
 @fragment
 fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) {
-    // Seen from below, the first surface of a closed solid is a face turned towards the camera.
-    // Seeing a face turned away means the near plane cut the solid open: the solid fills the
-    // ground here, so this texel is pressed to the ground (depth clamping; the far side of the
-    // clipped mesh must never leak through).
-    if front {
+    // Meshes are closed and wound outward. Going up the vertical line under a texel, a face turned
+    // towards the camera (down) enters a solid and a face turned away leaves one; below the ground
+    // their signed count is the number of solids that contain the ground point, and where it is
+    // positive the snow is pressed to the ground (depth clamping), however high the rest of the
+    // solid reaches. Above the ground, the lowest entering face is the lowest point of the solids
+    // that start there. A solid wholly inside the frustum presses exactly to its lowest point.
+    if in.height < 0.0 {
+        atomicAdd(&winding[texel_index(in.clip.xy)], select(-1, 1, front));
+    } else if front && in.height <= view.frustum_height {
         keep_lowest(in.clip.xy, in.height / view.frustum_height);
-    } else {
-        keep_lowest(in.clip.xy, 0.0);
     }
 }

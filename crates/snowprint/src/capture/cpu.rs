@@ -109,10 +109,10 @@ pub fn primitive_depth(p: &GpuPrimitive, x: f32, z: f32, frustum_height: f32) ->
 /// A triangle in surface-local coordinates, counter-clockwise seen from outside its solid.
 pub type LocalTriangle = [Vec3; 3];
 
-/// Depth a triangle leaves at local `(x, z)`, as the rasterizer would: the part inside the frustum
-/// only; a face turned away from the camera (up) marks the inside of a solid cut open by the ground
-/// and gives depth 0.
-pub fn triangle_depth(t: &LocalTriangle, x: f32, z: f32, frustum_height: f32) -> Option<f32> {
+/// What a triangle contributes at local `(x, z)`, as the mesh capture does: `Some((height, enters))`
+/// where the vertical line through `(x, z)` crosses it, `enters` when the face is turned down (the
+/// line enters the solid there going up).
+pub fn triangle_crossing(t: &LocalTriangle, x: f32, z: f32) -> Option<(f32, bool)> {
     let [a, b, c] = *t;
     let p = Vec2::new(x, z);
     let (a2, b2, c2) = (a.xz(), b.xz(), c.xz());
@@ -127,15 +127,35 @@ pub fn triangle_depth(t: &LocalTriangle, x: f32, z: f32, frustum_height: f32) ->
         return None;
     }
     let y = w0 * a.y + w1 * b.y + w2 * c.y;
-    if !(0.0..=frustum_height).contains(&y) {
-        return None;
-    }
     let normal_y = (b - a).cross(c - a).y;
-    Some(if normal_y < 0.0 {
-        y / frustum_height
-    } else {
-        0.0
-    })
+    Some((y, normal_y < 0.0))
+}
+
+/// Depth closed meshes leave at local `(x, z)`: 0 where the ground point is inside a solid (the
+/// signed count of crossings below the ground is positive), else the lowest entering crossing in
+/// the frustum, or `None`.
+pub fn triangles_depth(
+    triangles: &[LocalTriangle],
+    x: f32,
+    z: f32,
+    frustum_height: f32,
+) -> Option<f32> {
+    let mut winding = 0i32;
+    let mut lowest: Option<f32> = None;
+    for t in triangles {
+        let Some((y, enters)) = triangle_crossing(t, x, z) else {
+            continue;
+        };
+        if y < 0.0 {
+            winding += if enters { 1 } else { -1 };
+        } else if enters && y <= frustum_height {
+            lowest = Some(lowest.map_or(y, |l: f32| l.min(y)));
+        }
+    }
+    if winding > 0 {
+        return Some(0.0);
+    }
+    lowest.map(|y| y / frustum_height)
 }
 
 /// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen.
@@ -157,10 +177,8 @@ pub fn capture(
                     d = d.min(v);
                 }
             }
-            for t in triangles {
-                if let Some(v) = triangle_depth(t, c.x, c.y, frustum_height) {
-                    d = d.min(v);
-                }
+            if let Some(v) = triangles_depth(triangles, c.x, c.y, frustum_height) {
+                d = d.min(v);
             }
             out[(row * width + col) as usize] = d;
         }

@@ -244,7 +244,7 @@ pub struct CapturePipelines {
     pub primitives: wgpu::RenderPipeline,
     /// Mesh deformers.
     pub meshes: wgpu::RenderPipeline,
-    /// Group 0: view (dynamic uniform) and primitives (storage).
+    /// Group 0: view (dynamic uniform), primitives (storage), capture and winding (storage).
     pub view_layout: wgpu::BindGroupLayout,
     /// Group 1: mesh draw (dynamic uniform).
     pub draw_layout: wgpu::BindGroupLayout,
@@ -268,6 +268,16 @@ impl CapturePipelines {
             count: None,
         };
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let fragment_storage = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
         let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("capture view"),
             entries: &[
@@ -282,16 +292,8 @@ impl CapturePipelines {
                     },
                     count: None,
                 },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                fragment_storage(2),
+                fragment_storage(3),
             ],
         });
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -354,6 +356,7 @@ impl CapturePipelines {
                 // (towards the camera) is wound clockwise; that is the front face.
                 front_face: wgpu::FrontFace::Cw,
                 cull_mode: None,
+                // Depth is not tested; clip z is constant so nothing is clipped (see vs_mesh).
                 ..Default::default()
             },
             depth_stencil: depth,
