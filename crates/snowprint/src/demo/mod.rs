@@ -1,0 +1,5 @@
+//! The demo world, built in code: procedural articulated people (and, later, the roofs they act
+//! on).
+
+pub mod anim;
+pub mod skeleton;
