@@ -726,15 +726,22 @@ impl SnowWorld {
                         let Some(Some(mesh)) = self.meshes.get(id.0 as usize) else {
                             continue;
                         };
-                        if volume.overlaps_ball(d.pose.position, mesh.radius) {
-                            let model =
-                                Mat4::from_rotation_translation(d.pose.rotation, d.pose.position);
-                            draws.push((
-                                MeshDraw {
-                                    to_local: (volume.world_to_local * model).to_cols_array_2d(),
-                                },
-                                id,
-                            ));
+                        // A moving mesh is drawn at sub-steps along its motion, so that a fast
+                        // hand or foot leaves a continuous sweep rather than a comb of copies.
+                        let prev = d.previous.unwrap_or(d.pose);
+                        let n = capture::mesh_substeps(&prev, &d.pose, mesh.radius);
+                        for k in 1..=n {
+                            let p = prev.lerp(&d.pose, k as f32 / n as f32);
+                            if volume.overlaps_ball(p.position, mesh.radius) {
+                                let model = Mat4::from_rotation_translation(p.rotation, p.position);
+                                draws.push((
+                                    MeshDraw {
+                                        to_local: (volume.world_to_local * model)
+                                            .to_cols_array_2d(),
+                                    },
+                                    id,
+                                ));
+                            }
                         }
                     }
                     _ => capture::push_primitives(d, &volume, &mut prims),

@@ -953,3 +953,38 @@ fn mesh_inside_the_frustum_presses_to_its_lowest_point() {
         }
     }
 }
+
+/// A mesh moving fast is drawn at sub-steps: a cube swept 0.5 m in one frame leaves a continuous
+/// trench, not two separate imprints.
+#[test]
+fn moving_mesh_is_swept_within_a_frame() {
+    let mut w = world(CaptureMode::Depth);
+    let id = w
+        .add_surface(SurfaceDesc::new("s", [0.0, 0.0, 0.0], [2.0, 1.0], 0.3))
+        .unwrap();
+    let m = w
+        .add_mesh("cube", &Mesh::cuboid(Vec3::new(0.05, 0.2, 0.05)))
+        .unwrap();
+    let stats = w
+        .step(
+            1.0 / 60.0,
+            &[Deformer::moving(
+                Shape::Mesh(m),
+                Pose::at([-0.25, 0.0, 0.0]),
+                Pose::at([0.25, 0.0, 0.0]),
+            )],
+        )
+        .unwrap();
+    // 0.5 m at most 3 cm a step: capped at 8 draws.
+    assert_eq!(stats.mesh_draws, snowprint::capture::MAX_MESH_SUBSTEPS);
+    let map = w.read_heightmap(id).unwrap();
+    let row = map.height / 2;
+    // 4 cm texels, x = -0.25 .. 0.25 is columns 19 .. 31: every column between is pressed.
+    for col in 20..=30 {
+        assert_eq!(
+            map.depression[(row * map.width + col) as usize],
+            65535,
+            "column {col}"
+        );
+    }
+}

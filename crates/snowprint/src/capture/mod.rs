@@ -171,6 +171,25 @@ pub fn substeps(distance: f32, feature: f32) -> u32 {
     ((distance / (0.5 * feature)).ceil() as u32).clamp(1, MAX_SUBSTEPS)
 }
 
+/// Most sub-steps a mesh deformer is drawn at along its motion in one update.
+pub const MAX_MESH_SUBSTEPS: u32 = 8;
+
+/// Longest step between two drawn poses of a moving mesh, metres, at the point of the mesh that
+/// moves most: under one 4 cm texel, so that the copies overlap into a continuous sweep.
+pub const MESH_STEP: f32 = 0.03;
+
+/// Sub-steps for a rigid mesh of bounding radius `radius` moving from `a` to `b`: how far its
+/// farthest point can travel (translation plus rotation angle times radius) over [`MESH_STEP`], at
+/// most [`MAX_MESH_SUBSTEPS`]. The pose at the end is always drawn; the start was the previous
+/// frame's end.
+pub fn mesh_substeps(a: &Pose, b: &Pose, radius: f32) -> u32 {
+    let travel = a.position.distance(b.position) + a.rotation.angle_between(b.rotation) * radius;
+    if !travel.is_finite() || travel <= MESH_STEP {
+        return 1;
+    }
+    ((travel / MESH_STEP).ceil() as u32).clamp(1, MAX_MESH_SUBSTEPS)
+}
+
 /// Append the analytic primitives of one deformer, in the local frame of `volume`, culled against
 /// it. Meshes append nothing (they are drawn separately).
 pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Vec<GpuPrimitive>) {
