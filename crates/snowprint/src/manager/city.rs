@@ -148,7 +148,10 @@ impl WalkerPath {
         if !(len > 0.0 && s.is_finite()) {
             return (first, Vec3::X);
         }
-        let (mut s, mut back) = (s.rem_euclid(if self.closed { len } else { 2.0 * len }), false);
+        let (mut s, mut back) = (
+            s.rem_euclid(if self.closed { len } else { 2.0 * len }),
+            false,
+        );
         if s > len {
             s = 2.0 * len - s;
             back = true;
@@ -172,7 +175,8 @@ impl WalkerPath {
     fn print(&self, foot: usize, k: i64) -> Vec3 {
         let a = (k as f32 + 0.5 * foot as f32) * self.step;
         let (p, dir) = self.point_at(a);
-        let side = Vec3::new(-dir.z, 0.0, dir.x) * (if foot == 0 { 0.5 } else { -0.5 } * self.stance_width);
+        let side = Vec3::new(-dir.z, 0.0, dir.x)
+            * (if foot == 0 { 0.5 } else { -0.5 } * self.stance_width);
         p + side + Vec3::Y * (self.foot_radius - self.press_depth)
     }
 
@@ -241,7 +245,10 @@ pub struct City {
 impl City {
     /// The feet of every walker at a frame (see [`WalkerPath::feet`]).
     pub fn deformers(&self, frame: u64, dt: f32) -> Vec<ManagedDeformer> {
-        self.walkers.iter().flat_map(|w| w.feet(frame, dt)).collect()
+        self.walkers
+            .iter()
+            .flat_map(|w| w.feet(frame, dt))
+            .collect()
     }
 
     /// A camera behind and above the player (or over the first block when there is no walker),
@@ -249,7 +256,10 @@ impl City {
     pub fn player_camera(&self, time: f32) -> Camera {
         let (target, dir) = match self.walkers.first() {
             Some(w) => w.body(time),
-            None => (Vec3::new(BLOCK_PITCH * 0.5, 0.0, BLOCK_PITCH * 0.5), Vec3::X),
+            None => (
+                Vec3::new(BLOCK_PITCH * 0.5, 0.0, BLOCK_PITCH * 0.5),
+                Vec3::X,
+            ),
         };
         Camera {
             eye: target - dir * 9.0 + Vec3::Y * 7.0,
@@ -292,52 +302,80 @@ pub fn generate(seed: u64, surfaces: usize, walkers: usize) -> City {
             material: GroundMaterial::Concrete,
         };
         let half = STREET_WIDTH * 0.5;
-        push(&mut out, street(format!("x{bx}_{bz}"), origin + Vec2::splat(half), street_depth));
+        push(
+            &mut out,
+            street(
+                format!("x{bx}_{bz}"),
+                origin + Vec2::splat(half),
+                street_depth,
+            ),
+        );
         for k in 0..4 {
             let along = STREET_WIDTH + half + k as f32 * STREET_WIDTH;
             push(
                 &mut out,
-                street(format!("n{bx}_{bz}_{k}"), origin + Vec2::new(along, half), street_depth),
+                street(
+                    format!("n{bx}_{bz}_{k}"),
+                    origin + Vec2::new(along, half),
+                    street_depth,
+                ),
             );
             push(
                 &mut out,
-                street(format!("w{bx}_{bz}_{k}"), origin + Vec2::new(half, along), street_depth),
+                street(
+                    format!("w{bx}_{bz}_{k}"),
+                    origin + Vec2::new(half, along),
+                    street_depth,
+                ),
             );
         }
         // Four lots of 12 m x 12 m in the 24 m x 24 m interior.
         for lot in 0..4 {
-            let lot_min = origin + Vec2::splat(STREET_WIDTH) + Vec2::new((lot % 2) as f32, (lot / 2) as f32) * 12.0;
+            let lot_min = origin
+                + Vec2::splat(STREET_WIDTH)
+                + Vec2::new((lot % 2) as f32, (lot / 2) as f32) * 12.0;
             let size = Vec2::new(rng.range(5.0, 10.0), rng.range(5.0, 10.0));
             let c = lot_min + Vec2::splat(6.0);
             let height = rng.range(6.0, 30.0);
-            let yaw = if rng.unit() < 0.3 { rng.range(-20.0, 20.0) } else { 0.0 };
+            let yaw = if rng.unit() < 0.3 {
+                rng.range(-20.0, 20.0)
+            } else {
+                0.0
+            };
             let material = if rng.unit() < 0.7 {
                 GroundMaterial::RoofTiles
             } else {
                 GroundMaterial::Concrete
             };
-            let roof = |name: String, c: Vec2, y: f32, size: Vec2, yaw: f32, depth: f32| CitySurface {
-                desc: SurfaceDesc {
-                    yaw_degrees: yaw,
-                    replenish_rate: 0.01,
-                    ..SurfaceDesc::new(&name, [c.x, y, c.y], size.to_array(), depth)
-                },
-                zone,
-                kind: SurfaceKind::Roof,
-                material,
-            };
+            let roof =
+                |name: String, c: Vec2, y: f32, size: Vec2, yaw: f32, depth: f32| CitySurface {
+                    desc: SurfaceDesc {
+                        yaw_degrees: yaw,
+                        replenish_rate: 0.01,
+                        ..SurfaceDesc::new(&name, [c.x, y, c.y], size.to_array(), depth)
+                    },
+                    zone,
+                    kind: SurfaceKind::Roof,
+                    material,
+                };
             let depth = rng.range(0.15, 0.3);
             if out.len() < surfaces {
                 roofs.push(out.len());
             }
-            push(&mut out, roof(format!("r{bx}_{bz}_{lot}"), c, height, size, yaw, depth));
+            push(
+                &mut out,
+                roof(format!("r{bx}_{bz}_{lot}"), c, height, size, yaw, depth),
+            );
             // A penthouse: a smaller roof stacked above this one.
             if rng.unit() < 0.25 {
                 if out.len() < surfaces {
                     roofs.push(out.len());
                 }
                 let top = height + rng.range(3.0, 6.0);
-                push(&mut out, roof(format!("p{bx}_{bz}_{lot}"), c, top, size * 0.5, yaw, depth));
+                push(
+                    &mut out,
+                    roof(format!("p{bx}_{bz}_{lot}"), c, top, size * 0.5, yaw, depth),
+                );
             }
         }
     }
@@ -347,7 +385,8 @@ pub fn generate(seed: u64, surfaces: usize, walkers: usize) -> City {
     // the loop). Streets of a block come first, so an existing block has all its bands.
     // The last block may lack some of its surfaces, so it does not count.
     let exists = |bx: u32, bz: u32| bx < per_row && bz * per_row + bx + 1 < blocks_made;
-    let full = |bx: u32, bz: u32| exists(bx + 1, bz) && exists(bx, bz + 1) && exists(bx + 1, bz + 1);
+    let full =
+        |bx: u32, bz: u32| exists(bx + 1, bz) && exists(bx, bz + 1) && exists(bx + 1, bz + 1);
     let loops: Vec<(u32, u32)> = (0..blocks_made)
         .map(|b| (b % per_row, b / per_row))
         .filter(|&(bx, bz)| full(bx, bz))
@@ -362,12 +401,18 @@ pub fn generate(seed: u64, surfaces: usize, walkers: usize) -> City {
             let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
             let points = corners
                 .iter()
-                .map(|&(x, z)| m.transform_point3(Vec3::new(x * inset.x, s.snow_depth, z * inset.y)))
+                .map(|&(x, z)| {
+                    m.transform_point3(Vec3::new(x * inset.x, s.snow_depth, z * inset.y))
+                })
                 .collect();
             WalkerPath::new(&name, points, true)
         } else if let Some(&(bx, bz)) = (!loops.is_empty()).then(|| {
             // The player walks around the middle block.
-            if w == 0 { &loops[loops.len() / 2] } else { &loops[rng.below(loops.len())] }
+            if w == 0 {
+                &loops[loops.len() / 2]
+            } else {
+                &loops[rng.below(loops.len())]
+            }
         }) {
             let o = Vec2::new(bx as f32, bz as f32) * BLOCK_PITCH + Vec2::splat(STREET_WIDTH * 0.5);
             let lane = rng.range(-1.5, 1.5);
@@ -409,8 +454,12 @@ mod tests {
         assert_eq!(a.surfaces.len(), 300);
         assert_eq!(a.walkers.len(), 20);
         assert_ne!(a, generate(8, 300, 20));
-        let roofs = a.surfaces.iter().filter(|s| s.kind == SurfaceKind::Roof).count();
-        assert!(roofs >= 80 && roofs < 300, "{roofs}");
+        let roofs = a
+            .surfaces
+            .iter()
+            .filter(|s| s.kind == SurfaceKind::Roof)
+            .count();
+        assert!((80..300).contains(&roofs), "{roofs}");
         let names: std::collections::HashSet<_> = a.surfaces.iter().map(|s| &s.desc.name).collect();
         assert_eq!(names.len(), 300, "names are unique");
         assert!(a.surfaces.iter().all(|s| s.desc.validate().is_ok()));
@@ -419,7 +468,11 @@ mod tests {
 
     #[test]
     fn feet_alternate_and_leave_separate_prints() {
-        let w = WalkerPath::new("w", vec![Vec3::new(0.0, 0.2, 0.0), Vec3::new(20.0, 0.2, 0.0)], false);
+        let w = WalkerPath::new(
+            "w",
+            vec![Vec3::new(0.0, 0.2, 0.0), Vec3::new(20.0, 0.2, 0.0)],
+            false,
+        );
         let dt = 1.0 / 30.0;
         let top = 0.2;
         let mut prints: Vec<Vec3> = Vec::new();
@@ -433,12 +486,18 @@ mod tests {
             assert!(!planted.is_empty(), "frame {f}");
             for d in &feet {
                 let y = d.deformer.pose.position.y - w.foot_radius;
-                assert!((y - (top - w.press_depth)).abs() < 1e-5 || y > top + 0.4, "frame {f}: {y}");
+                assert!(
+                    (y - (top - w.press_depth)).abs() < 1e-5 || y > top + 0.4,
+                    "frame {f}: {y}"
+                );
                 if let Some(prev) = d.deformer.previous {
                     let (a, b) = (prev.position, d.deformer.pose.position);
                     // Into or out of the snow only vertically.
                     if a.y.min(b.y) - w.foot_radius < top {
-                        assert!((a.x - b.x).abs() < 1e-6 && (a.z - b.z).abs() < 1e-6, "frame {f}: {a} -> {b}");
+                        assert!(
+                            (a.x - b.x).abs() < 1e-6 && (a.z - b.z).abs() < 1e-6,
+                            "frame {f}: {a} -> {b}"
+                        );
                     }
                 }
                 let p = d.deformer.pose.position;

@@ -63,11 +63,29 @@ impl ManagedId {
     pub fn index(self) -> u32 {
         self.0
     }
+
+    /// The handle of the surface registered `index`-th (a handle that names no surface is reported
+    /// as [`SnowError::StaleHandle`] where it is used).
+    pub fn from_index(index: u32) -> Self {
+        Self(index)
+    }
 }
 
 /// A streaming zone: surfaces are registered in one, and a zone can be unloaded (its surfaces give
 /// their memory up) and loaded again. The number is the caller's.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 pub struct ZoneId(pub u32);
 
 /// A deformer of one frame, and whether it belongs to the player (whose surfaces go first).
@@ -178,7 +196,11 @@ impl ManagerConfig {
         }
         let ankle = self.capture.ankle_height;
         if !(ankle.is_finite() && ankle > 0.0) {
-            return bad("ankle_height", ankle.to_string(), "a finite number of metres above 0");
+            return bad(
+                "ankle_height",
+                ankle.to_string(),
+                "a finite number of metres above 0",
+            );
         }
         Ok(())
     }
@@ -218,7 +240,9 @@ impl CameraView {
     /// The six planes of the view, checking every field.
     pub fn frustum(&self) -> Result<Frustum> {
         let bad = |what: &str, value: String, expected: &str| {
-            Err(SnowError::Scene(format!("camera {what} is {value}, but it must be {expected}")))
+            Err(SnowError::Scene(format!(
+                "camera {what} is {value}, but it must be {expected}"
+            )))
         };
         if !self.eye.is_finite() || !self.target.is_finite() {
             return bad(
@@ -235,13 +259,24 @@ impl CameraView {
                 "different from the eye",
             );
         }
-        if !(self.fov_y_degrees.is_finite() && self.fov_y_degrees > 0.0 && self.fov_y_degrees < 180.0) {
-            return bad("fov_y_degrees", self.fov_y_degrees.to_string(), "between 0 and 180");
+        if !(self.fov_y_degrees.is_finite()
+            && self.fov_y_degrees > 0.0
+            && self.fov_y_degrees < 180.0)
+        {
+            return bad(
+                "fov_y_degrees",
+                self.fov_y_degrees.to_string(),
+                "between 0 and 180",
+            );
         }
         if !(self.aspect.is_finite() && self.aspect > 0.0) {
             return bad("aspect", self.aspect.to_string(), "a finite number above 0");
         }
-        if !(self.near.is_finite() && self.far.is_finite() && self.near > 0.0 && self.far > self.near) {
+        if !(self.near.is_finite()
+            && self.far.is_finite()
+            && self.near > 0.0
+            && self.far > self.near)
+        {
             return bad(
                 "near / far",
                 format!("{} / {}", self.near, self.far),
@@ -249,7 +284,11 @@ impl CameraView {
             );
         }
         // Looking straight up or down: any horizontal axis serves as "up".
-        let up = if forward.cross(Vec3::Y).length_squared() < 1e-8 { Vec3::Z } else { Vec3::Y };
+        let up = if forward.cross(Vec3::Y).length_squared() < 1e-8 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
         let right = forward.cross(up).normalize();
         let up = right.cross(forward);
         let tan_v = (self.fov_y_degrees.to_radians() * 0.5).tan();
@@ -284,7 +323,9 @@ impl Frustum {
     /// usual plane test is).
     #[inline]
     pub fn sees(&self, center: Vec3, radius: f32) -> bool {
-        self.planes.iter().all(|p| p.truncate().dot(center) + p.w >= -radius)
+        self.planes
+            .iter()
+            .all(|p| p.truncate().dot(center) + p.w >= -radius)
     }
 }
 
@@ -419,7 +460,12 @@ impl SnowManager {
     /// Run one frame: decide (see [`Planner::tick`]), free and give heightmaps, then update at most
     /// `updates_per_frame` surfaces on the GPU with everything that touched them since their last
     /// update. Bad input is an error before anything changes.
-    pub fn tick(&mut self, dt: f32, camera: Option<&CameraView>, deformers: &[ManagedDeformer]) -> Result<TickStats> {
+    pub fn tick(
+        &mut self,
+        dt: f32,
+        camera: Option<&CameraView>,
+        deformers: &[ManagedDeformer],
+    ) -> Result<TickStats> {
         self.planner.tick(dt, camera, deformers)?;
         let plan = self.planner.last_plan();
         let mut failed = Vec::new();
@@ -435,7 +481,9 @@ impl SnowManager {
                     match self.world.add_surface(desc) {
                         Ok(w) => self.world_ids[id.0 as usize] = Some(w),
                         Err(SnowError::PoolExhausted { name, .. }) => {
-                            tracing::warn!("the pool refused surface {name:?} that the planner expected to fit");
+                            tracing::warn!(
+                                "the pool refused surface {name:?} that the planner expected to fit"
+                            );
                             failed.push(id);
                         }
                         Err(e) => return Err(e),

@@ -161,7 +161,10 @@ impl Managed {
     /// against the capture volume, in the surface's frame.
     #[inline]
     fn touched_by(&self, a: Vec3, b: Vec3, r: f32) -> bool {
-        let (la, lb) = (self.to_local.transform_point3(a), self.to_local.transform_point3(b));
+        let (la, lb) = (
+            self.to_local.transform_point3(a),
+            self.to_local.transform_point3(b),
+        );
         let e = Vec3::splat(r + TOUCH_MARGIN);
         let (lo, hi) = (la.min(lb) - e, la.max(lb) + e);
         hi.x >= -self.half.x
@@ -280,7 +283,9 @@ impl Planner {
         let top = desc.snow_depth + self.config.capture.ankle_height;
         let half = desc.size * 0.5;
         let rot = desc.rotation();
-        let ext = (rot * Vec3::new(half.x, 0.0, half.y)).abs().max((rot * Vec3::new(half.x, 0.0, -half.y)).abs());
+        let ext = (rot * Vec3::new(half.x, 0.0, half.y))
+            .abs()
+            .max((rot * Vec3::new(half.x, 0.0, -half.y)).abs());
         let bounds = Aabb::new(
             desc.center - Vec3::new(ext.x, 0.0, ext.z),
             desc.center + Vec3::new(ext.x, top, ext.z),
@@ -343,7 +348,9 @@ impl Planner {
     /// Free a surface's slot, if it has one. `between` = outside a tick (reported by the next).
     fn release(&mut self, index: u32, between: bool) -> bool {
         let s = &mut self.surfaces[index as usize];
-        let Some(slot) = s.slot.take() else { return false };
+        let Some(slot) = s.slot.take() else {
+            return false;
+        };
         self.alloc.free(slot);
         s.due_since = None;
         s.applied.clear();
@@ -356,7 +363,9 @@ impl Planner {
         if between {
             self.evicted_between.push(name);
         } else {
-            self.plan.changes.push(ResidencyChange::Evict(ManagedId(index)));
+            self.plan
+                .changes
+                .push(ResidencyChange::Evict(ManagedId(index)));
             self.plan.stats.evicted.push(name);
         }
         true
@@ -399,7 +408,9 @@ impl Planner {
         if !(radius.is_finite() && radius >= 0.0) {
             return Err(SnowError::InvalidMesh {
                 name: format!("mesh {}", mesh.0),
-                reason: format!("bounding radius {radius} is not a finite number of metres, 0 or more"),
+                reason: format!(
+                    "bounding radius {radius} is not a finite number of metres, 0 or more"
+                ),
             });
         }
         let i = mesh.0 as usize;
@@ -413,7 +424,11 @@ impl Planner {
     /// Undo an admission the world could not carry out (it should never happen: the planner's
     /// allocator mirrors the world's). The surface goes back to waiting for a slot.
     pub fn admission_failed(&mut self, id: ManagedId) {
-        if self.surfaces.get(id.0 as usize).is_some_and(|s| s.slot.is_some()) {
+        if self
+            .surfaces
+            .get(id.0 as usize)
+            .is_some_and(|s| s.slot.is_some())
+        {
             self.release(id.0, true);
             self.evicted_between.pop();
         }
@@ -442,6 +457,12 @@ impl Planner {
     /// A surface's world-space bounds (capture volume).
     pub fn bounds(&self, id: ManagedId) -> Result<Aabb> {
         Ok(self.get(id)?.bounds)
+    }
+
+    /// Whether a surface was active in the last tick.
+    pub fn is_active(&self, id: ManagedId) -> bool {
+        self.get(id)
+            .is_ok_and(|s| s.active == self.tick && self.tick > 0)
     }
 
     /// Whether a surface holds a heightmap.
@@ -496,7 +517,11 @@ impl Planner {
     /// budget `K` of 2 or more, `1` for a budget of 1 (the player then gets no reserved slot).
     pub fn non_player_slots(&self) -> usize {
         let k = self.config.updates_per_frame;
-        let reserved = if k >= 2 { (k - 1).min(self.config.player_slots) } else { 0 };
+        let reserved = if k >= 2 {
+            (k - 1).min(self.config.player_slots)
+        } else {
+            0
+        };
         k - reserved
     }
 
@@ -504,7 +529,8 @@ impl Planner {
     /// `distance_slack_frames + floor((n - 1) / non_player_slots)` frames, where `n` is the largest
     /// number of due surfaces during its wait (see `docs/MANAGER.md` for the proof).
     pub fn wait_bound(&self, n: usize) -> u64 {
-        self.config.distance_slack_frames as u64 + (n.saturating_sub(1) / self.non_player_slots()) as u64
+        self.config.distance_slack_frames as u64
+            + (n.saturating_sub(1) / self.non_player_slots()) as u64
     }
 
     fn ensure_index(&mut self) {
@@ -543,7 +569,10 @@ impl Planner {
                     .get(id.0 as usize)
                     .copied()
                     .flatten()
-                    .ok_or(SnowError::StaleHandle { what: "mesh", index: id.0 })?;
+                    .ok_or(SnowError::StaleHandle {
+                        what: "mesh",
+                        index: id.0,
+                    })?;
                 // Meshes are captured at their pose only.
                 Ok((d.pose.position, d.pose.position, r))
             }
@@ -576,7 +605,12 @@ impl Planner {
     /// Run one frame: `dt` seconds passed, the camera (if any) looks at the world and the deformers
     /// are posed as at the end of the frame (with `previous` = last frame's pose for a sweep).
     /// Everything is checked before anything changes.
-    pub fn tick(&mut self, dt: f32, camera: Option<&CameraView>, deformers: &[ManagedDeformer]) -> Result<&Plan> {
+    pub fn tick(
+        &mut self,
+        dt: f32,
+        camera: Option<&CameraView>,
+        deformers: &[ManagedDeformer],
+    ) -> Result<&Plan> {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(SnowError::InvalidTimeStep { dt });
         }
@@ -671,14 +705,21 @@ impl Planner {
             k += 1;
         }
         let previous = std::mem::take(&mut self.active);
-        for &i in &previous {
+        // In index order, so that the plan does not depend on the order of lookups.
+        let mut gone: Vec<u32> = previous
+            .iter()
+            .copied()
+            .filter(|&i| {
+                self.surfaces[i as usize].active != now && !self.surfaces[i as usize].removed
+            })
+            .collect();
+        gone.sort_unstable();
+        for i in gone {
             let s = &mut self.surfaces[i as usize];
-            if s.active != now && !s.removed {
-                s.last_useful = now - 1;
-                s.due_since = None;
-                if !self.config.retain_inactive {
-                    self.release(i, false);
-                }
+            s.last_useful = now - 1;
+            s.due_since = None;
+            if !self.config.retain_inactive {
+                self.release(i, false);
             }
         }
         self.active = std::mem::take(&mut self.active_next);
@@ -723,7 +764,11 @@ impl Planner {
 
     /// Give slots to active surfaces without one, most useful first, evicting less useful ones.
     fn admit(&mut self, now: u64, focus: Option<Vec3>) {
-        let mut victims: Vec<Rank> = self.resident.iter().map(|&i| self.rank(i, now, focus)).collect();
+        let mut victims: Vec<Rank> = self
+            .resident
+            .iter()
+            .map(|&i| self.rank(i, now, focus))
+            .collect();
         victims.sort_unstable_by(Rank::least_useful_first);
         let weakest = victims.first().copied();
         let largest_free = self.alloc.largest_free();
@@ -762,7 +807,9 @@ impl Planner {
                 if !rank.evictable_for(cand) {
                     break;
                 }
-                let Some(slot) = self.surfaces[rank.index as usize].slot else { continue };
+                let Some(slot) = self.surfaces[rank.index as usize].slot else {
+                    continue;
+                };
                 let t = trial.get_or_insert_with(|| self.alloc.clone());
                 t.free(slot);
                 chosen.push(v);
@@ -793,7 +840,9 @@ impl Planner {
         s.applied.clear();
         s.due_since = None;
         self.resident.push(index);
-        self.plan.changes.push(ResidencyChange::Admit(ManagedId(index)));
+        self.plan
+            .changes
+            .push(ResidencyChange::Admit(ManagedId(index)));
     }
 
     /// Pick at most K due surfaces and hand them their queued imprints.

@@ -17,7 +17,10 @@ const UPDATES_HEIGHT: f32 = 150.0;
 const HEIGHT: f32 = 530.0;
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 fn bytes_label(b: f64) -> String {
@@ -38,7 +41,11 @@ pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) 
     let plot_w = WIDTH - LEFT - RIGHT;
     let n = frames.len().max(1) as f32;
     let x_of = |i: usize| LEFT + plot_w * i as f32 / n;
-    let budget = frames.iter().map(|f| f.pool_bytes_budget).max().unwrap_or(0);
+    let budget = frames
+        .iter()
+        .map(|f| f.pool_bytes_budget)
+        .max()
+        .unwrap_or(0);
     let peak = frames.iter().map(|f| f.pool_bytes_used).max().unwrap_or(0);
     let y_max = (budget.max(peak).max(1) as f64 * 1.1) as f32;
     let pool_y = |b: u64| POOL_TOP + POOL_HEIGHT * (1.0 - b as f32 / y_max);
@@ -72,7 +79,10 @@ pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) 
         let _ = write!(area, " L{:.1},{y:.1} L{:.1},{y:.1}", x_of(i), x_of(i + 1));
     }
     let _ = write!(area, " L{:.1},{bottom:.1} Z", x_of(frames.len()));
-    let _ = writeln!(s, r##"<path d="{area}" fill="#9ecae1" stroke="#3182bd" stroke-width="1"/>"##);
+    let _ = writeln!(
+        s,
+        r##"<path d="{area}" fill="#9ecae1" stroke="#3182bd" stroke-width="1"/>"##
+    );
     let by = pool_y(budget);
     let _ = writeln!(
         s,
@@ -98,7 +108,9 @@ pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) 
 
     // Updates panel.
     let label = match updates_per_frame {
-        Some(k) => format!("surfaces updated per frame (bars, budget {k} dashed); evictions (red, below)"),
+        Some(k) => {
+            format!("surfaces updated per frame (bars, budget {k} dashed); evictions (red, below)")
+        }
         None => "surfaces updated per frame (bars); evictions (red, below)".to_owned(),
     };
     let _ = writeln!(
@@ -117,11 +129,19 @@ pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) 
         }
         if !f.evicted.is_empty() {
             let len = 4.0 + 3.0 * f.evicted.len().min(6) as f32;
-            let _ = write!(evictions, "M{:.1},{:.1} v{len:.1} ", (x0 + x1) * 0.5, base + 2.0);
+            let _ = write!(
+                evictions,
+                "M{:.1},{:.1} v{len:.1} ",
+                (x0 + x1) * 0.5,
+                base + 2.0
+            );
         }
     }
     let _ = writeln!(s, r##"<path d="{bars}" fill="#74c476" stroke="none"/>"##);
-    let _ = writeln!(s, r##"<path d="{evictions}" stroke="#d62728" stroke-width="1.5"/>"##);
+    let _ = writeln!(
+        s,
+        r##"<path d="{evictions}" stroke="#d62728" stroke-width="1.5"/>"##
+    );
     if let Some(k) = updates_per_frame {
         let y = upd_y(k as f32);
         let _ = writeln!(
@@ -153,7 +173,9 @@ pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) 
     for k in 0..=ticks {
         let i = frames.len() * k / ticks;
         let x = x_of(i);
-        let frame = frames.get(i).map_or(frames.last().map_or(0, |f| f.frame + 1), |f| f.frame);
+        let frame = frames
+            .get(i)
+            .map_or(frames.last().map_or(0, |f| f.frame + 1), |f| f.frame);
         let _ = writeln!(
             s,
             r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{frame}</text>"##,
@@ -171,7 +193,12 @@ pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) 
 }
 
 /// Write [`svg`] to a file.
-pub fn write_svg(path: &Path, frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) -> Result<()> {
+pub fn write_svg(
+    path: &Path,
+    frames: &[TickStats],
+    title: &str,
+    updates_per_frame: Option<usize>,
+) -> Result<()> {
     std::fs::write(path, svg(frames, title, updates_per_frame)).map_err(|e| SnowError::Output {
         path: path.to_owned(),
         reason: e.to_string(),

@@ -101,7 +101,12 @@ impl SurfaceIndex {
         let items: Vec<LeafItem> = bounds
             .iter()
             .enumerate()
-            .filter_map(|(i, b)| b.map(|bounds| LeafItem { bounds, id: i as u32 }))
+            .filter_map(|(i, b)| {
+                b.map(|bounds| LeafItem {
+                    bounds,
+                    id: i as u32,
+                })
+            })
             .collect();
         index.items = items.len();
         if items.is_empty() {
@@ -122,7 +127,14 @@ impl SurfaceIndex {
         index
     }
 
-    fn build_node(&mut self, at: usize, items: Vec<LeafItem>, min: [f32; 2], max: [f32; 2], depth: u32) {
+    fn build_node(
+        &mut self,
+        at: usize,
+        items: Vec<LeafItem>,
+        min: [f32; 2],
+        max: [f32; 2],
+        depth: u32,
+    ) {
         let (cx, cz) = ((min[0] + max[0]) * 0.5, (min[1] + max[1]) * 0.5);
         self.depth = self.depth.max(depth);
         let make_leaf = |index: &mut Self, items: Vec<LeafItem>| {
@@ -171,8 +183,16 @@ impl SurfaceIndex {
             });
         }
         for (k, quad) in quads.into_iter().enumerate() {
-            let x = if k & 1 == 0 { [min[0], cx] } else { [cx, max[0]] };
-            let z = if k & 2 == 0 { [min[1], cz] } else { [cz, max[1]] };
+            let x = if k & 1 == 0 {
+                [min[0], cx]
+            } else {
+                [cx, max[0]]
+            };
+            let z = if k & 2 == 0 {
+                [min[1], cz]
+            } else {
+                [cz, max[1]]
+            };
             self.build_node(first + k, quad, [x[0], z[0]], [x[1], z[1]], depth + 1);
         }
     }
@@ -230,7 +250,10 @@ impl SurfaceIndex {
             }
             let (lo_x, hi_x) = (query.min.x <= n.cx, query.max.x >= n.cx);
             let (lo_z, hi_z) = (query.min.z <= n.cz, query.max.z >= n.cz);
-            for (k, ok) in [lo_x && lo_z, hi_x && lo_z, lo_x && hi_z, hi_x && hi_z].into_iter().enumerate() {
+            for (k, ok) in [lo_x && lo_z, hi_x && lo_z, lo_x && hi_z, hi_x && hi_z]
+                .into_iter()
+                .enumerate()
+            {
                 if ok {
                     stack[sp] = n.first + k as u32;
                     sp += 1;
@@ -261,18 +284,34 @@ mod tests {
         proptest::collection::vec(
             proptest::option::weighted(
                 0.9,
-                (-100f32..100.0, -5f32..30.0, -100f32..100.0, 0f32..20.0, 0.05f32..1.0, 0f32..20.0).prop_map(
-                    |(x, y, z, sx, sy, sz)| Aabb::new(Vec3::new(x, y, z), Vec3::new(x + sx, y + sy, z + sz)),
-                ),
+                (
+                    -100f32..100.0,
+                    -5f32..30.0,
+                    -100f32..100.0,
+                    0f32..20.0,
+                    0.05f32..1.0,
+                    0f32..20.0,
+                )
+                    .prop_map(|(x, y, z, sx, sy, sz)| {
+                        Aabb::new(Vec3::new(x, y, z), Vec3::new(x + sx, y + sy, z + sz))
+                    }),
             ),
             0..400,
         )
     }
 
     fn query_box() -> impl Strategy<Value = Aabb> {
-        (-120f32..120.0, -10f32..35.0, -120f32..120.0, 0f32..30.0, 0f32..5.0, 0f32..30.0).prop_map(
-            |(x, y, z, sx, sy, sz)| Aabb::new(Vec3::new(x, y, z), Vec3::new(x + sx, y + sy, z + sz)),
+        (
+            -120f32..120.0,
+            -10f32..35.0,
+            -120f32..120.0,
+            0f32..30.0,
+            0f32..5.0,
+            0f32..30.0,
         )
+            .prop_map(|(x, y, z, sx, sy, sz)| {
+                Aabb::new(Vec3::new(x, y, z), Vec3::new(x + sx, y + sy, z + sz))
+            })
     }
 
     proptest! {
@@ -297,10 +336,16 @@ mod tests {
         let roof = Aabb::new(Vec3::new(0.0, 8.0, 0.0), Vec3::new(10.0, 8.5, 4.0));
         let mut index = SurfaceIndex::build(&[Some(street), Some(roof)]);
         let mut out = Vec::new();
-        index.query(&Aabb::new(Vec3::new(2.0, 0.1, 1.0), Vec3::new(2.3, 0.4, 1.3)), &mut out);
+        index.query(
+            &Aabb::new(Vec3::new(2.0, 0.1, 1.0), Vec3::new(2.3, 0.4, 1.3)),
+            &mut out,
+        );
         assert_eq!(out, vec![0]);
         out.clear();
-        index.query(&Aabb::new(Vec3::new(2.0, 8.1, 1.0), Vec3::new(2.3, 8.4, 1.3)), &mut out);
+        index.query(
+            &Aabb::new(Vec3::new(2.0, 8.1, 1.0), Vec3::new(2.3, 8.4, 1.3)),
+            &mut out,
+        );
         assert_eq!(out, vec![1]);
     }
 

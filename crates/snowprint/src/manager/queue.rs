@@ -94,7 +94,9 @@ pub fn contains(outer: &Deformer, inner: &Deformer) -> bool {
 /// For a sphere continuing in a straight line (`next` starts where `prev` ends and heads the same
 /// way), the single sweep covering both.
 fn straight_extension(prev: &Deformer, next: &Deformer) -> Option<Deformer> {
-    let Shape::Sphere { .. } = prev.shape else { return None };
+    let Shape::Sphere { .. } = prev.shape else {
+        return None;
+    };
     if prev.shape != next.shape || prev.pose.position != start(next).position {
         return None;
     }
@@ -113,7 +115,13 @@ fn straight_extension(prev: &Deformer, next: &Deformer) -> Option<Deformer> {
 /// Push one frame's deformer into a surface's queue. `applied` is what the surface's last update
 /// captured; it is consulted only when `skip_applied` (no snowfall on the surface, so pressing the
 /// same shape again cannot change the heightmap). `cap` is the most entries kept.
-pub fn push(queue: &mut VecDeque<Deformer>, applied: &[Deformer], skip_applied: bool, d: Deformer, cap: usize) -> Push {
+pub fn push(
+    queue: &mut VecDeque<Deformer>,
+    applied: &[Deformer],
+    skip_applied: bool,
+    d: Deformer,
+    cap: usize,
+) -> Push {
     let scan_from = queue.len().saturating_sub(SCAN);
     if queue.range(scan_from..).any(|q| contains(q, &d))
         || (skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)))
@@ -186,13 +194,25 @@ mod tests {
         let mut q = VecDeque::new();
         for k in 0..10 {
             let x = k as f32 * 0.25;
-            push(&mut q, &[], false, sphere([x, 0.1, 0.0], [x + 0.25, 0.1, 0.0]), 16);
+            push(
+                &mut q,
+                &[],
+                false,
+                sphere([x, 0.1, 0.0], [x + 0.25, 0.1, 0.0]),
+                16,
+            );
         }
         assert_eq!(q.len(), 1);
         assert_eq!(start(&q[0]).position, Vec3::new(0.0, 0.1, 0.0));
         assert_eq!(q[0].pose.position, Vec3::new(2.5, 0.1, 0.0));
         // A turn starts a new entry.
-        push(&mut q, &[], false, sphere([2.5, 0.1, 0.0], [2.5, 0.1, 0.5]), 16);
+        push(
+            &mut q,
+            &[],
+            false,
+            sphere([2.5, 0.1, 0.0], [2.5, 0.1, 0.5]),
+            16,
+        );
         assert_eq!(q.len(), 2);
     }
 
@@ -225,11 +245,23 @@ mod tests {
         let a = Deformer::moving(shape, Pose::at([0.0, 0.1, 0.0]), Pose::at([0.3, 0.1, 0.0]));
         push(&mut q, &[], false, a, 8);
         assert_eq!(
-            push(&mut q, &[], false, Deformer::new(shape, Pose::at([0.3, 0.1, 0.0])), 8),
+            push(
+                &mut q,
+                &[],
+                false,
+                Deformer::new(shape, Pose::at([0.3, 0.1, 0.0])),
+                8
+            ),
             Push::Redundant
         );
         assert_eq!(
-            push(&mut q, &[], false, Deformer::new(shape, Pose::at([0.2, 0.1, 0.0])), 8),
+            push(
+                &mut q,
+                &[],
+                false,
+                Deformer::new(shape, Pose::at([0.2, 0.1, 0.0])),
+                8
+            ),
             Push::Queued
         );
     }
