@@ -392,6 +392,8 @@ impl SnowManager {
                 capture: config.capture,
                 pool_bytes: config.pool_bytes,
                 atlas_side: config.atlas_side,
+                // The planner sizes slots by the talk's rule (`SurfaceDesc::layout`, 512 a side).
+                max_resolution: crate::surface::MAX_RESOLUTION,
             },
         )?;
         // The planner mirrors the world's allocator: same budget after the world's clamping.
