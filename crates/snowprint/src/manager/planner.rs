@@ -21,7 +21,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::quadtree::{Aabb, SurfaceIndex};
 use super::queue::{self, Push};
@@ -89,25 +89,25 @@ pub struct Plan {
 }
 
 /// Usefulness of a surface for memory: which class, then distance (or, for inactive surfaces that
-/// keep their slot, when they were last useful).
+/// keep their slot, when they were last active).
 #[derive(Clone, Copy, Debug)]
 struct Rank {
     /// 0 inactive (kept), 1 active, 2 touched or with queued imprints, 3 touched by the player.
     class: u8,
     dist: f32,
-    last_useful: u64,
+    last_active: u64,
     index: u32,
 }
 
 impl Rank {
-    /// Order from least to most useful: class, then (inactive) least recently useful first or
+    /// Order from least to most useful: class, then (inactive) least recently active first or
     /// (active) farthest first, then index.
     fn least_useful_first(a: &Rank, b: &Rank) -> std::cmp::Ordering {
         a.class
             .cmp(&b.class)
             .then_with(|| {
                 if a.class == 0 {
-                    a.last_useful.cmp(&b.last_useful)
+                    a.last_active.cmp(&b.last_active)
                 } else {
                     b.dist.total_cmp(&a.dist)
                 }
@@ -124,19 +124,73 @@ impl Rank {
     }
 }
 
-/// One surface as the planner sees it.
+/// A [`Rank`] ordered by usefulness (most useful is greatest), for the candidates' heap.
+#[derive(Clone, Copy, Debug)]
+struct ByUse(Rank);
+
+impl PartialEq for ByUse {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == std::cmp::Ordering::Equal
+    }
+}
+
+impl Eq for ByUse {}
+
+impl PartialOrd for ByUse {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for ByUse {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        Rank::least_useful_first(&self.0, &other.0)
+    }
+}
+
+const RESIDENT: u8 = 1;
+const REMOVED: u8 = 2;
+/// Listed in [`Planner::queued`].
+const LISTED: u8 = 4;
+/// Snow falls on it (replenish rate above 0).
+const SNOWFALL: u8 = 8;
+
+/// What the per-tick passes over touched, active and waiting surfaces read and write, in one cache
+/// line per surface: a city with hundreds of surfaces waiting for memory is walked several times a
+/// tick, and the rest of a surface's state (its description, queue, slot) stays cold.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Status {
+    bounds: Aabb,
+    /// Tick stamps: last touched, last touched by the player, last active.
+    touched: u64,
+    player: u64,
+    active: u64,
+    /// Pool bytes of its slot (at most 3 MiB for 512 x 512 texels).
+    bytes: u32,
+    zone: u32,
+    queue_len: u32,
+    flags: u8,
+}
+
+impl Status {
+    fn has(&self, flag: u8) -> bool {
+        self.flags & flag != 0
+    }
+
+    fn set(&mut self, flag: u8, on: bool) {
+        if on {
+            self.flags |= flag;
+        } else {
+            self.flags &= !flag;
+        }
+    }
+}
+
+/// The rest of a surface's state.
 #[derive(Clone, Debug)]
 struct Managed {
     desc: SurfaceDesc,
-    zone: usize,
-    removed: bool,
-    to_local: Mat4,
-    half: Vec2,
-    /// Snow depth plus ankle height: the capture frustum's height.
-    top: f32,
-    bounds: Aabb,
-    sphere: (Vec3, f32),
-    bytes: u64,
     texels: u64,
     slot: Option<Slot>,
     /// Position in [`Planner::resident`] while resident.
@@ -144,27 +198,51 @@ struct Managed {
     queue: VecDeque<Deformer>,
     /// What the last update captured (cleared when the heightmap is lost).
     applied: Vec<Deformer>,
-    /// Whether the surface is listed in [`Planner::queued`].
-    listed_queued: bool,
     due_since: Option<u64>,
     last_update_time: f64,
     /// Until when (seconds) snowfall still has something to refill.
     pressed_until: f64,
-    touched: u64,
-    player: u64,
-    active: u64,
-    last_useful: u64,
 }
 
-impl Managed {
+/// What the touch test reads of a surface, in one cache line: a tick tests thousands of candidates
+/// and few of them are touched.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct TouchVolume {
+    /// The first three rows of the world-to-local transform.
+    rows: [Vec4; 3],
+    half: Vec2,
+    /// Snow depth plus ankle height: the capture frustum's height.
+    top: f32,
+    zone: u32,
+}
+
+impl TouchVolume {
+    fn new(to_local: Mat4, half: Vec2, top: f32, zone: u32) -> Self {
+        let t = to_local.transpose();
+        Self {
+            rows: [t.x_axis, t.y_axis, t.z_axis],
+            half,
+            top,
+            zone,
+        }
+    }
+
+    #[inline]
+    fn local(&self, p: Vec3) -> Vec3 {
+        let p = p.extend(1.0);
+        Vec3::new(
+            self.rows[0].dot(p),
+            self.rows[1].dot(p),
+            self.rows[2].dot(p),
+        )
+    }
+
     /// The world's culling test, made conservative: a ball of radius `r` swept from `a` to `b`
     /// against the capture volume, in the surface's frame.
     #[inline]
     fn touched_by(&self, a: Vec3, b: Vec3, r: f32) -> bool {
-        let (la, lb) = (
-            self.to_local.transform_point3(a),
-            self.to_local.transform_point3(b),
-        );
+        let (la, lb) = (self.local(a), self.local(b));
         let e = Vec3::splat(r + TOUCH_MARGIN);
         let (lo, hi) = (la.min(lb) - e, la.max(lb) + e);
         hi.x >= -self.half.x
@@ -176,10 +254,30 @@ impl Managed {
     }
 }
 
+/// A quick check that a deformer's numbers are usable (finite, sizes above 0); the full check, with
+/// its message, runs only when this one fails.
+fn plausible(d: &Deformer) -> bool {
+    let sizes = match d.shape {
+        Shape::Sphere { radius } => radius > 0.0 && radius.is_finite(),
+        Shape::Capsule {
+            radius,
+            half_height,
+        } => radius > 0.0 && (radius + half_height).is_finite() && half_height >= 0.0,
+        Shape::Box { half_extents } => half_extents.min_element() > 0.0 && half_extents.is_finite(),
+        Shape::Mesh(_) => true,
+    };
+    let prev = d.previous.unwrap_or(d.pose);
+    sizes
+        && d.pose.position.is_finite()
+        && prev.position.is_finite()
+        && d.pose.rotation.is_finite()
+        && prev.rotation.is_finite()
+}
+
 /// The planner. See the module docs for the tick, and `docs/MANAGER.md` for the bounds.
 ///
 /// Eviction order when a surface needs room: residents of a lower class first (inactive ones that
-/// kept their slot, least recently useful first; then active ones; then touched ones), within a
+/// kept their slot, least recently active first; then active ones; then touched ones), within a
 /// class the farthest from the focus (the player, else the camera) first, and a resident of the
 /// candidate's own class only when it is clearly farther (hysteresis). A candidate that would have
 /// to evict something at least as useful as itself waits without a slot; its queued imprints wait
@@ -188,6 +286,9 @@ impl Managed {
 pub struct Planner {
     config: ManagerConfig,
     lookup: Lookup,
+    /// Per surface, by index: hot state, touch volume, and the rest.
+    status: Vec<Status>,
+    volumes: Vec<TouchVolume>,
     surfaces: Vec<Managed>,
     index: SurfaceIndex,
     index_dirty: bool,
@@ -206,6 +307,7 @@ pub struct Planner {
     queued: Vec<u32>,
     touched: Vec<u32>,
     scratch: Vec<u32>,
+    sweeps: Vec<(Vec3, Vec3, f32)>,
     /// Names of surfaces evicted between ticks (zone unloads, removals), reported by the next tick.
     evicted_between: Vec<String>,
     plan: Plan,
@@ -219,6 +321,8 @@ impl Planner {
             alloc: SlotAllocator::new(config.pool_bytes),
             config: config.clone(),
             lookup: Lookup::QuadTree,
+            status: Vec::new(),
+            volumes: Vec::new(),
             surfaces: Vec::new(),
             index: SurfaceIndex::default(),
             index_dirty: false,
@@ -234,6 +338,7 @@ impl Planner {
             queued: Vec::new(),
             touched: Vec::new(),
             scratch: Vec::new(),
+            sweeps: Vec::new(),
             evicted_between: Vec::new(),
             plan: Plan::default(),
         })
@@ -264,7 +369,8 @@ impl Planner {
     /// could never hold a heightmap).
     pub fn add_surface(&mut self, desc: &SurfaceDesc, zone: ZoneId) -> Result<ManagedId> {
         desc.validate()?;
-        let needed = slot_bytes(desc.layout().texels());
+        let texels = desc.layout().texels();
+        let needed = slot_bytes(texels);
         if needed > self.alloc.budget() {
             return Err(SnowError::PoolExhausted {
                 name: desc.name.clone(),
@@ -290,33 +396,35 @@ impl Planner {
             desc.center - Vec3::new(ext.x, 0.0, ext.z),
             desc.center + Vec3::new(ext.x, top, ext.z),
         );
-        let texels = desc.layout().texels();
-        self.surfaces.push(Managed {
-            to_local: desc.world_to_local(),
+        let mut status = Status {
+            bounds,
+            touched: 0,
+            player: 0,
+            active: 0,
+            // A slot is at most 512 x 512 texels x 12 bytes.
+            bytes: u32::try_from(needed).unwrap_or(u32::MAX),
+            zone: zone as u32,
+            queue_len: 0,
+            flags: 0,
+        };
+        status.set(SNOWFALL, desc.replenish_rate > 0.0);
+        self.status.push(status);
+        self.volumes.push(TouchVolume::new(
+            desc.world_to_local(),
             half,
             top,
-            bounds,
-            sphere: (
-                desc.center + Vec3::Y * (top * 0.5),
-                Vec3::new(half.x, top * 0.5, half.y).length(),
-            ),
-            bytes: slot_bytes(texels),
-            texels,
+            zone as u32,
+        ));
+        self.surfaces.push(Managed {
             desc: desc.clone(),
-            zone,
-            removed: false,
+            texels,
             slot: None,
             resident_pos: 0,
             queue: VecDeque::new(),
             applied: Vec::new(),
-            listed_queued: false,
             due_since: None,
             last_update_time: 0.0,
             pressed_until: 0.0,
-            touched: 0,
-            player: 0,
-            active: 0,
-            last_useful: 0,
         });
         self.zone_members[zone].push(index);
         self.index_dirty = true;
@@ -324,25 +432,31 @@ impl Planner {
     }
 
     fn get(&self, id: ManagedId) -> Result<&Managed> {
-        self.surfaces
-            .get(id.0 as usize)
-            .filter(|s| !s.removed)
-            .ok_or(SnowError::StaleHandle {
+        let i = id.0 as usize;
+        match (self.surfaces.get(i), self.status.get(i)) {
+            (Some(m), Some(s)) if !s.has(REMOVED) => Ok(m),
+            _ => Err(SnowError::StaleHandle {
                 what: "managed surface",
                 index: id.0,
-            })
+            }),
+        }
     }
 
     /// Remove a surface for good. Returns whether it held a slot (the caller frees the world's).
     pub fn remove_surface(&mut self, id: ManagedId) -> Result<bool> {
         self.get(id)?;
         let had = self.release(id.0, true);
-        let s = &mut self.surfaces[id.0 as usize];
-        s.removed = true;
-        s.queue = VecDeque::new();
-        s.applied = Vec::new();
+        let i = id.0 as usize;
+        self.status[i].set(REMOVED, true);
+        self.clear_queue(id.0);
+        self.surfaces[i].applied = Vec::new();
         self.index_dirty = true;
         Ok(had)
+    }
+
+    fn clear_queue(&mut self, index: u32) {
+        self.surfaces[index as usize].queue = VecDeque::new();
+        self.status[index as usize].queue_len = 0;
     }
 
     /// Free a surface's slot, if it has one. `between` = outside a tick (reported by the next).
@@ -352,6 +466,7 @@ impl Planner {
             return false;
         };
         self.alloc.free(slot);
+        self.status[index as usize].set(RESIDENT, false);
         s.due_since = None;
         s.applied.clear();
         let pos = s.resident_pos;
@@ -389,9 +504,8 @@ impl Planner {
             if self.release(m, true) {
                 freed.push(ManagedId(m));
             }
-            let s = &mut self.surfaces[m as usize];
-            s.queue.clear();
-            s.active = 0;
+            self.clear_queue(m);
+            self.status[m as usize].active = 0;
         }
         self.zone_members[z] = members;
         freed
@@ -456,13 +570,13 @@ impl Planner {
 
     /// A surface's world-space bounds (capture volume).
     pub fn bounds(&self, id: ManagedId) -> Result<Aabb> {
-        Ok(self.get(id)?.bounds)
+        self.get(id)?;
+        Ok(self.status[id.0 as usize].bounds)
     }
 
     /// Whether a surface was active in the last tick.
     pub fn is_active(&self, id: ManagedId) -> bool {
-        self.get(id)
-            .is_ok_and(|s| s.active == self.tick && self.tick > 0)
+        self.get(id).is_ok() && self.tick > 0 && self.status[id.0 as usize].active == self.tick
     }
 
     /// Whether a surface holds a heightmap.
@@ -489,7 +603,7 @@ impl Planner {
     pub fn pending_surfaces(&self) -> usize {
         self.queued
             .iter()
-            .filter(|&&s| !self.surfaces[s as usize].queue.is_empty())
+            .filter(|&&s| self.status[s as usize].queue_len > 0)
             .count()
     }
 
@@ -536,9 +650,9 @@ impl Planner {
     fn ensure_index(&mut self) {
         if self.index_dirty {
             let bounds: Vec<Option<Aabb>> = self
-                .surfaces
+                .status
                 .iter()
-                .map(|s| (!s.removed).then_some(s.bounds))
+                .map(|s| (!s.has(REMOVED)).then_some(s.bounds))
                 .collect();
             self.index = SurfaceIndex::build(&bounds);
             self.index_dirty = false;
@@ -551,8 +665,8 @@ impl Planner {
         match self.lookup {
             Lookup::QuadTree => self.index.query(q, out),
             Lookup::BruteForce => {
-                for (i, s) in self.surfaces.iter().enumerate() {
-                    if !s.removed && s.bounds.overlaps(q) {
+                for (i, s) in self.status.iter().enumerate() {
+                    if !s.has(REMOVED) && s.bounds.overlaps(q) {
                         out.push(i as u32);
                     }
                 }
@@ -584,12 +698,12 @@ impl Planner {
     }
 
     fn rank(&self, index: u32, now: u64, focus: Option<Vec3>) -> Rank {
-        let s = &self.surfaces[index as usize];
+        let s = &self.status[index as usize];
         let class = if s.active != now {
             0
         } else if s.player == now {
             3
-        } else if s.touched == now || !s.queue.is_empty() {
+        } else if s.touched == now || s.queue_len > 0 {
             2
         } else {
             1
@@ -597,7 +711,7 @@ impl Planner {
         Rank {
             class,
             dist: focus.map_or(0.0, |f| s.bounds.distance_to(f)),
-            last_useful: s.last_useful,
+            last_active: s.active,
             index,
         }
     }
@@ -615,12 +729,22 @@ impl Planner {
             return Err(SnowError::InvalidTimeStep { dt });
         }
         let frustum = camera.map(CameraView::frustum).transpose()?;
-        let mut sweeps = Vec::with_capacity(deformers.len());
+        let mut sweeps = std::mem::take(&mut self.sweeps);
+        sweeps.clear();
         for (i, d) in deformers.iter().enumerate() {
-            if d.deformer.validate("").is_err() {
-                d.deformer.validate(&format!("#{i}"))?;
+            if !plausible(&d.deformer)
+                && let Err(e) = d.deformer.validate(&format!("#{i}"))
+            {
+                self.sweeps = sweeps;
+                return Err(e);
             }
-            sweeps.push(self.sweep_of(&d.deformer)?);
+            match self.sweep_of(&d.deformer) {
+                Ok(sweep) => sweeps.push(sweep),
+                Err(e) => {
+                    self.sweeps = sweeps;
+                    return Err(e);
+                }
+            }
         }
         self.ensure_index();
         self.tick += 1;
@@ -638,33 +762,39 @@ impl Planner {
 
         // 1. Touches.
         self.touched.clear();
-        for (d, &(a, b, r)) in deformers.iter().zip(&sweeps) {
+        // The deformers themselves are read only where they touch something.
+        for (k, &(a, b, r)) in sweeps.iter().enumerate() {
             let m = Vec3::splat(r + TOUCH_MARGIN);
             self.lookup_into(&Aabb::new(a.min(b) - m, a.max(b) + m), &mut scratch);
             for &i in &scratch {
-                let s = &mut self.surfaces[i as usize];
-                if !self.zone_loaded[s.zone] || !s.touched_by(a, b, r) {
+                let v = &self.volumes[i as usize];
+                if !v.touched_by(a, b, r) || !self.zone_loaded[v.zone as usize] {
                     continue;
                 }
-                if s.touched != now {
-                    s.touched = now;
+                let d = &deformers[k];
+                let st = &mut self.status[i as usize];
+                if st.touched != now {
+                    st.touched = now;
                     self.touched.push(i);
                 }
                 if d.player {
-                    s.player = now;
+                    st.player = now;
                 }
-                let skip_applied = s.desc.replenish_rate == 0.0;
-                match queue::push(&mut s.queue, &s.applied, skip_applied, d.deformer, cap) {
+                let m = &mut self.surfaces[i as usize];
+                let skip_applied = !st.has(SNOWFALL);
+                match queue::push(&mut m.queue, &m.applied, skip_applied, d.deformer, cap) {
                     Push::Merged => self.plan.stats.imprints_merged += 1,
                     Push::DroppedOldest => self.plan.stats.imprints_dropped += 1,
                     _ => {}
                 }
-                if !s.queue.is_empty() && !s.listed_queued {
-                    s.listed_queued = true;
+                st.queue_len = m.queue.len() as u32;
+                if st.queue_len > 0 && !st.has(LISTED) {
+                    st.set(LISTED, true);
                     self.queued.push(i);
                 }
             }
         }
+        self.sweeps = sweeps;
         self.plan.stats.touched = self.touched.len();
         let focus = deformers
             .iter()
@@ -678,10 +808,15 @@ impl Planner {
             let reach = Vec3::splat(self.config.active_distance);
             self.lookup_into(&Aabb::new(cam.eye - reach, cam.eye + reach), &mut scratch);
             for &i in &scratch {
-                let s = &self.surfaces[i as usize];
-                if self.zone_loaded[s.zone]
+                let s = &self.status[i as usize];
+                // The bounding sphere of the surface's box.
+                let (centre, radius) = (
+                    (s.bounds.min + s.bounds.max) * 0.5,
+                    (s.bounds.max - s.bounds.min).length() * 0.5,
+                );
+                if self.zone_loaded[s.zone as usize]
                     && s.bounds.distance_to(cam.eye) <= self.config.active_distance
-                    && frustum.sees(s.sphere.0, s.sphere.1)
+                    && frustum.sees(centre, radius)
                 {
                     self.activate(i, now);
                 }
@@ -693,13 +828,13 @@ impl Planner {
         let mut k = 0;
         while k < self.queued.len() {
             let i = self.queued[k];
-            let s = &mut self.surfaces[i as usize];
-            if s.queue.is_empty() || s.removed {
-                s.listed_queued = false;
+            let s = &mut self.status[i as usize];
+            if s.queue_len == 0 || s.has(REMOVED) {
+                s.set(LISTED, false);
                 self.queued.swap_remove(k);
                 continue;
             }
-            if self.zone_loaded[s.zone] {
+            if self.zone_loaded[s.zone as usize] {
                 self.activate(i, now);
             }
             k += 1;
@@ -710,23 +845,19 @@ impl Planner {
             .iter()
             .copied()
             .filter(|&i| {
-                self.surfaces[i as usize].active != now && !self.surfaces[i as usize].removed
+                let s = &self.status[i as usize];
+                s.active != now && !s.has(REMOVED)
             })
             .collect();
         gone.sort_unstable();
         for i in gone {
-            let s = &mut self.surfaces[i as usize];
-            s.last_useful = now - 1;
-            s.due_since = None;
+            self.surfaces[i as usize].due_since = None;
             if !self.config.retain_inactive {
                 self.release(i, false);
             }
         }
         self.active = std::mem::take(&mut self.active_next);
         self.active_next = previous;
-        for &i in &self.active {
-            self.surfaces[i as usize].last_useful = now;
-        }
         self.plan.stats.active = self.active.len();
 
         // 3. Residency.
@@ -743,9 +874,9 @@ impl Planner {
         let mut waiting_for_memory = 0;
         let mut queued = 0;
         for &i in &self.queued {
-            let s = &self.surfaces[i as usize];
-            queued += s.queue.len();
-            if s.slot.is_none() && !s.queue.is_empty() && s.active == now {
+            let s = &self.status[i as usize];
+            queued += s.queue_len as usize;
+            if !s.has(RESIDENT) && s.queue_len > 0 && s.active == now {
                 waiting_for_memory += 1;
             }
         }
@@ -755,7 +886,7 @@ impl Planner {
     }
 
     fn activate(&mut self, i: u32, now: u64) {
-        let s = &mut self.surfaces[i as usize];
+        let s = &mut self.status[i as usize];
         if s.active != now {
             s.active = now;
             self.active_next.push(i);
@@ -772,39 +903,77 @@ impl Planner {
         victims.sort_unstable_by(Rank::least_useful_first);
         let weakest = victims.first().copied();
         let largest_free = self.alloc.largest_free();
-        let mut candidates: Vec<Rank> = Vec::new();
+        let mut candidates: Vec<ByUse> = Vec::new();
+        let mut best: Option<ByUse> = None;
         for &i in &self.active {
-            let s = &self.surfaces[i as usize];
-            if s.slot.is_some() {
+            let s = &self.status[i as usize];
+            if s.has(RESIDENT) {
                 continue;
             }
-            let r = self.rank(i, now, focus);
+            let r = ByUse(self.rank(i, now, focus));
             // Cheap filter: it fits as things are, or it could evict the weakest resident.
-            if s.bytes <= largest_free || weakest.is_some_and(|w| w.evictable_for(&r)) {
+            if s.bytes as u64 <= largest_free || weakest.is_some_and(|w| w.evictable_for(&r.0)) {
+                best = best.max(Some(r));
                 candidates.push(r);
             }
         }
-        candidates.sort_unstable_by(|a, b| Rank::least_useful_first(b, a));
+        let Some(best) = best else { return };
+        // The largest room any candidate can make: what the most useful one frees by evicting all
+        // it may (eviction is monotone in usefulness). Larger candidates cannot get a slot now.
+        let mut trial = self.alloc.clone();
+        for v in victims.iter().take_while(|v| v.evictable_for(&best.0)) {
+            if let Some(slot) = self.surfaces[v.index as usize].slot {
+                trial.free(slot);
+            }
+        }
+        let room = trial.largest_free();
+        candidates.retain(|c| self.status[c.0.index as usize].bytes as u64 <= room);
+        let smallest = candidates
+            .iter()
+            .map(|c| self.status[c.0.index as usize].bytes as u64)
+            .min()
+            .unwrap_or(u64::MAX);
+        // Most useful first, popped only as far as needed (a heap builds in linear time; a city of
+        // walkers can have hundreds of candidates for a handful of slots).
+        let mut candidates = std::collections::BinaryHeap::from(candidates);
         let mut evicted = vec![false; victims.len()];
+        let mut weakest_alive = 0;
         let mut chosen: Vec<usize> = Vec::new();
-        for cand in &candidates {
-            let (bytes, texels) = {
-                let s = &self.surfaces[cand.index as usize];
-                (s.bytes, s.texels)
-            };
-            if let Some(slot) = self.alloc.alloc(texels) {
+        // Evicting can only get less from here on: a candidate at least this large cannot fit.
+        let mut hopeless = u64::MAX;
+        while let Some(ByUse(cand)) = candidates.pop() {
+            while weakest_alive < victims.len() && evicted[weakest_alive] {
+                weakest_alive += 1;
+            }
+            let can_evict = victims
+                .get(weakest_alive)
+                .is_some_and(|v| v.evictable_for(&cand));
+            // Eviction is monotone in usefulness: if this candidate cannot evict the weakest
+            // resident, no later (less useful) one can; only free room is left for them.
+            let free = self.alloc.largest_free();
+            if (!can_evict || smallest >= hopeless) && free < smallest {
+                break;
+            }
+            let bytes = self.status[cand.index as usize].bytes as u64;
+            let texels = self.surfaces[cand.index as usize].texels;
+            if bytes <= free
+                && let Some(slot) = self.alloc.alloc(texels)
+            {
                 self.give_slot(cand.index, slot);
+                continue;
+            }
+            if !can_evict || bytes >= hopeless {
                 continue;
             }
             // Try evicting the least useful residents, on a copy, until it fits.
             chosen.clear();
             let mut trial: Option<SlotAllocator> = None;
             let mut fits = false;
-            for (v, rank) in victims.iter().enumerate() {
+            for (v, rank) in victims.iter().enumerate().skip(weakest_alive) {
                 if evicted[v] {
                     continue;
                 }
-                if !rank.evictable_for(cand) {
+                if !rank.evictable_for(&cand) {
                     break;
                 }
                 let Some(slot) = self.surfaces[rank.index as usize].slot else {
@@ -819,6 +988,8 @@ impl Planner {
                 }
             }
             if !fits {
+                // Later candidates can evict at most what this one could.
+                hopeless = hopeless.min(bytes);
                 continue;
             }
             for &v in &chosen {
@@ -839,6 +1010,7 @@ impl Planner {
         s.pressed_until = 0.0;
         s.applied.clear();
         s.due_since = None;
+        self.status[index as usize].set(RESIDENT, true);
         self.resident.push(index);
         self.plan
             .changes
@@ -852,26 +1024,27 @@ impl Planner {
         // (deadline, due since, index, player)
         let mut due: Vec<(u64, u64, u32, bool)> = Vec::new();
         for &i in &self.resident {
-            let s = &mut self.surfaces[i as usize];
-            if s.active != now {
+            let st = &self.status[i as usize];
+            if st.active != now {
                 continue;
             }
+            let s = &mut self.surfaces[i as usize];
             if s.due_since.is_none() {
-                let replenish = s.desc.replenish_rate > 0.0
+                let replenish = st.has(SNOWFALL)
                     && s.pressed_until > s.last_update_time
                     && self.time - s.last_update_time >= self.config.replenish_interval as f64;
-                if !s.queue.is_empty() || replenish {
+                if st.queue_len > 0 || replenish {
                     s.due_since = Some(now);
                 }
             }
             let Some(since) = s.due_since else { continue };
-            let player = s.player == now;
+            let player = st.player == now;
             let slack = if player {
                 0
-            } else if s.queue.is_empty() {
+            } else if st.queue_len == 0 {
                 slack_max
             } else {
-                let d = focus.map_or(0.0, |f| s.bounds.distance_to(f));
+                let d = focus.map_or(0.0, |f| st.bounds.distance_to(f));
                 (slack_max as f32 * (d / reach).min(1.0)).round() as u64
             };
             due.push((since + slack, since, i, player));
@@ -918,6 +1091,7 @@ impl Planner {
             let s = &mut self.surfaces[i as usize];
             let since = s.due_since.take().unwrap_or(now);
             let imprints: Vec<Deformer> = std::mem::take(&mut s.queue).into();
+            self.status[i as usize].queue_len = 0;
             let elapsed = (time - s.last_update_time) as f32;
             s.last_update_time = time;
             if !imprints.is_empty() && s.desc.replenish_rate > 0.0 {

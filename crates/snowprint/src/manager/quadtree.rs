@@ -37,12 +37,13 @@ impl Aabb {
     /// Whether two boxes share at least one point (touching counts).
     #[inline]
     pub fn overlaps(&self, other: &Aabb) -> bool {
-        self.min.x <= other.max.x
-            && self.max.x >= other.min.x
-            && self.min.z <= other.max.z
-            && self.max.z >= other.min.z
-            && self.min.y <= other.max.y
-            && self.max.y >= other.min.y
+        // Non-short-circuit `&`: one predictable branch instead of six (leaf tests are hot).
+        (self.min.x <= other.max.x)
+            & (self.max.x >= other.min.x)
+            & (self.min.z <= other.max.z)
+            & (self.max.z >= other.min.z)
+            & (self.min.y <= other.max.y)
+            & (self.max.y >= other.min.y)
     }
 
     /// Distance from a point to the box (0 inside).
@@ -78,10 +79,24 @@ struct LeafItem {
     id: u32,
 }
 
+/// Levels covered by the jump table (a 64 x 64 grid of the nodes at level 6).
+const JUMP_LEVELS: u32 = 6;
+
 /// Quad tree over surface bounds (XZ split, height range checked). See the module docs.
+///
+/// A query that falls well inside one cell of a `2^6 x 2^6` grid over the root starts at the node
+/// covering that cell (a jump table built with the tree), instead of walking down six levels.
 #[derive(Clone, Debug, Default)]
 pub struct SurfaceIndex {
     nodes: Vec<Node>,
+    /// Root rectangle `[min x, min z, max x, max z]`.
+    root: [f32; 4],
+    /// Jump-table cells per metre along x and z.
+    cells_per_metre: [f32; 2],
+    /// Cells per side of the jump table (0 = no table).
+    grid: u32,
+    /// Per cell, row-major: the deepest node at most `JUMP_LEVELS` down that holds the whole cell.
+    jump: Vec<u32>,
     leaf: Vec<LeafItem>,
     /// Per item id: the query stamp that last reported it.
     stamps: Vec<u32>,
@@ -124,7 +139,69 @@ impl SurfaceIndex {
             count: 0,
         });
         index.build_node(0, items, [lo.x, lo.z], [hi.x, hi.z], 0);
+        index.root = [lo.x, lo.z, hi.x, hi.z];
+        index.build_jump_table();
         index
+    }
+
+    /// For each cell of the grid, walk down from the root with the tree's own split centres
+    /// (following the cell's centre) for at most `JUMP_LEVELS` levels.
+    fn build_jump_table(&mut self) {
+        let [x0, z0, x1, z1] = self.root;
+        if !(x1 > x0 && z1 > z0) {
+            return;
+        }
+        let levels = JUMP_LEVELS.min(self.depth);
+        let grid = 1u32 << levels;
+        let (w, h) = ((x1 - x0) / grid as f32, (z1 - z0) / grid as f32);
+        self.jump = Vec::with_capacity((grid * grid) as usize);
+        for cz in 0..grid {
+            for cx in 0..grid {
+                let (px, pz) = (x0 + (cx as f32 + 0.5) * w, z0 + (cz as f32 + 0.5) * h);
+                let mut at = 0usize;
+                for _ in 0..levels {
+                    let n = self.nodes[at];
+                    if n.count != INNER {
+                        break;
+                    }
+                    at = n.first as usize + (px >= n.cx) as usize + 2 * (pz >= n.cz) as usize;
+                }
+                self.jump.push(at as u32);
+            }
+        }
+        self.cells_per_metre = [grid as f32 / (x1 - x0), grid as f32 / (z1 - z0)];
+        self.grid = grid;
+    }
+
+    /// Where a query may start: the jump table's node when the query lies inside one cell with a
+    /// margin (so that float differences between the grid and the tree's split centres cannot
+    /// matter), else the root.
+    #[inline]
+    fn start_node(&self, query: &Aabb) -> usize {
+        if self.grid == 0 {
+            return 0;
+        }
+        let [x0, z0, ..] = self.root;
+        let g = self.grid as f32;
+        let [sx, sz] = self.cells_per_metre;
+        let (ax, bx) = ((query.min.x - x0) * sx, (query.max.x - x0) * sx);
+        let (az, bz) = ((query.min.z - z0) * sz, (query.max.z - z0) * sz);
+        if !(ax >= 0.0 && az >= 0.0 && bx < g && bz < g) {
+            return 0;
+        }
+        // Non-negative here, so truncation is the floor (and needs no call into libm).
+        let (ix, iz) = (ax as u32, az as u32);
+        let (cx, cz) = (ix as f32, iz as f32);
+        const MARGIN: f32 = 1e-3;
+        let inside = (ax - cx >= MARGIN)
+            & (bx <= cx + 1.0 - MARGIN)
+            & (az - cz >= MARGIN)
+            & (bz <= cz + 1.0 - MARGIN);
+        if inside {
+            self.jump[(iz * self.grid + ix) as usize] as usize
+        } else {
+            0
+        }
     }
 
     fn build_node(
@@ -223,14 +300,40 @@ impl SurfaceIndex {
         if self.nodes.is_empty() {
             return;
         }
+        // Fast path: a small query (a foot) usually falls in one child at every level, so it walks
+        // a single path to one leaf, where every item is listed once: no stamps needed.
+        let mut at = self.start_node(query);
+        loop {
+            let n = self.nodes[at];
+            if n.count != INNER {
+                let start = n.first as usize;
+                for it in &self.leaf[start..start + n.count as usize] {
+                    if it.bounds.overlaps(query) {
+                        out.push(it.id);
+                    }
+                }
+                return;
+            }
+            let (lo_x, hi_x) = (query.min.x <= n.cx, query.max.x >= n.cx);
+            let (lo_z, hi_z) = (query.min.z <= n.cz, query.max.z >= n.cz);
+            if lo_x == hi_x || lo_z == hi_z {
+                // Straddles a split (or, with NaN, matches nothing): the general walk below.
+                if !(lo_x || hi_x) || !(lo_z || hi_z) {
+                    return;
+                }
+                break;
+            }
+            at = n.first as usize + (hi_x as usize) + 2 * (hi_z as usize);
+        }
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             self.stamps.iter_mut().for_each(|s| *s = 0);
             self.stamp = 1;
         }
-        // Depth-first; each inner node pushes at most 4 children, so the stack never holds more
-        // than 3 * MAX_DEPTH + 4 nodes.
+        // Depth-first from where the path split; each inner node pushes at most 4 children, so the
+        // stack never holds more than 3 * MAX_DEPTH + 4 nodes.
         let mut stack = [0u32; 3 * MAX_DEPTH as usize + 8];
+        stack[0] = at as u32;
         let mut sp = 1;
         while sp > 0 {
             sp -= 1;

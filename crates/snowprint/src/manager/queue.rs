@@ -53,6 +53,24 @@ fn start(d: &Deformer) -> Pose {
     d.previous.unwrap_or(d.pose)
 }
 
+/// The cheap, exact form of [`contains`] that covers most pushes: `d` is `q` again, or `d` rests
+/// (no motion) where `q`'s sweep ends or starts. Positions are compared first, so most entries are
+/// rejected by one comparison.
+#[inline]
+fn covers_exactly(q: &Deformer, d: &Deformer, resting: bool) -> bool {
+    let p = d.pose.position;
+    let (at_end, at_start) = (q.pose.position == p, start(q).position == p);
+    if !(at_end || at_start) || q.shape != d.shape {
+        return false;
+    }
+    if q == d {
+        return true;
+    }
+    resting
+        && ((at_end && q.pose == d.pose)
+            || (at_start && !matches!(d.shape, Shape::Mesh(_)) && start(q) == d.pose))
+}
+
 /// Distance from `p` to the segment `a..b`.
 fn point_segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
     let ab = b - a;
@@ -77,8 +95,15 @@ pub fn contains(outer: &Deformer, inner: &Deformer) -> bool {
     match outer.shape {
         Shape::Sphere { .. } => {
             let (a, b) = (start(outer).position, outer.pose.position);
-            point_segment_distance(start(inner).position, a, b) <= EPS
-                && point_segment_distance(inner.pose.position, a, b) <= EPS
+            let (p, q) = (start(inner).position, inner.pose.position);
+            // Cheap rejection first: both ends must lie in the segment's box.
+            let (lo, hi) = (a.min(b) - Vec3::splat(EPS), a.max(b) + Vec3::splat(EPS));
+            let inside = |v: Vec3| v.cmpge(lo).all() && v.cmple(hi).all();
+            if !(inside(p) && inside(q)) {
+                return false;
+            }
+            let on = |v: Vec3| v == a || v == b || point_segment_distance(v, a, b) <= EPS;
+            on(p) && on(q)
         }
         Shape::Mesh(_) => outer.pose == inner.pose,
         _ => {
@@ -123,20 +148,43 @@ pub fn push(
     cap: usize,
 ) -> Push {
     let scan_from = queue.len().saturating_sub(SCAN);
-    if queue.range(scan_from..).any(|q| contains(q, &d))
-        || (skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)))
+    // The common case first, by exact comparison: a deformer resting where a queued sweep of the
+    // same shape ends or starts (a planted foot), or the same entry again.
+    let resting = start(&d) == d.pose;
+    if queue
+        .range(scan_from..)
+        .rev()
+        .any(|q| covers_exactly(q, &d, resting))
+        || (skip_applied
+            && applied
+                .iter()
+                .rev()
+                .take(SCAN)
+                .any(|q| covers_exactly(q, &d, resting)))
     {
         return Push::Redundant;
     }
+    // Newest first: a foot standing still matches its own last entry.
     for i in (scan_from..queue.len()).rev() {
-        if contains(&d, &queue[i]) {
+        let q = &queue[i];
+        if q.shape != d.shape {
+            continue;
+        }
+        if contains(q, &d) {
+            return Push::Redundant;
+        }
+        if contains(&d, q) {
+            // Whatever else the window holds, the union only grows by what `d` adds.
             queue[i] = d;
             return Push::Absorbed;
         }
-        if let Some(longer) = straight_extension(&queue[i], &d) {
+        if let Some(longer) = straight_extension(q, &d) {
             queue[i] = longer;
             return Push::Absorbed;
         }
+    }
+    if skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) {
+        return Push::Redundant;
     }
     if queue.len() < cap.max(1) {
         queue.push_back(d);
