@@ -153,6 +153,10 @@ fn ticks<M: Measurement>(c: &mut Criterion<M>, group: &str, long_samples: bool) 
         stats.pool_bytes_budget
     );
     group.bench_function("quad_tree", |b| b.iter(|| black_box(fast.tick())));
+    // Brute force takes milliseconds a tick: 10 samples of equal size keep the run short.
+    group
+        .sample_size(10)
+        .sampling_mode(criterion::SamplingMode::Flat);
     // Built here so that filtering it out (`-- quad_tree`) skips its slow warm-up.
     group.bench_function("brute_force", |b| {
         let mut slow = Run::new(Lookup::BruteForce);

@@ -9,9 +9,9 @@
 //!    volume in the surface's own frame. A touch queues the deformer on the surface
 //!    ([`super::queue`]); no per-surface actor list is kept from one frame to the next.
 //! 2. **Activity.** A surface of a loaded zone is active while it is in the camera's frustum
-//!    (bounding sphere) and within `active_distance` of the eye (its box), while something touches
-//!    it, or while imprints wait in its queue. A surface that stops being active gives its slot up
-//!    (or, with `retain_inactive`, keeps it until the memory is wanted).
+//!    (the bounding sphere of its box) and within `active_distance` of the eye (its box), while
+//!    something touches it, or while imprints wait in its queue. A surface that stops being active
+//!    gives its slot up (or, with `retain_inactive`, keeps it until the memory is wanted).
 //! 3. **Residency.** Active surfaces without a slot ask for one, most useful first; when the pool
 //!    has no room, less useful residents are evicted (see [`Planner`] for the order). The planner
 //!    keeps its own copy of the world's first-fit allocator, so it knows exactly what fits.
