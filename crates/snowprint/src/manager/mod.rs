@@ -394,6 +394,7 @@ impl SnowManager {
                 atlas_side: config.atlas_side,
                 // The planner sizes slots by the talk's rule (`SurfaceDesc::layout`, 512 a side).
                 max_resolution: crate::surface::MAX_RESOLUTION,
+                ..WorldConfig::default()
             },
         )?;
         // The planner mirrors the world's allocator: same budget after the world's clamping.
