@@ -28,6 +28,7 @@ pub mod demo;
 pub mod error;
 pub mod gpu;
 pub mod heightmap;
+pub mod manager;
 pub mod mesh;
 pub mod pool;
 pub mod scene;
@@ -39,6 +40,9 @@ pub use deformer::{Deformer, Pose, Shape};
 pub use error::{Result, SnowError};
 pub use gpu::{Capabilities, GpuContext, GpuOptions};
 pub use heightmap::Heightmap;
+pub use manager::{
+    CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
+};
 pub use mesh::{Mesh, MeshId};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
