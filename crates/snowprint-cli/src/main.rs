@@ -5,6 +5,7 @@
 
 mod bench;
 mod demo;
+mod managed;
 mod simulate;
 
 use std::process::ExitCode;

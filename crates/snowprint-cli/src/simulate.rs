@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use snowprint::scene::{Scene, SceneShape};
-use snowprint::{Deformer, GpuContext, GpuOptions, Shape, SnowWorld, WorldConfig};
+use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap, Shape, SnowWorld, WorldConfig};
 
 /// Arguments of `snowprint simulate`.
 #[derive(clap::Args, Debug)]
@@ -21,6 +21,11 @@ pub struct Args {
     /// Folder for `<surface>.png` (16-bit depression) and `<surface>.json`.
     #[arg(long)]
     pub dump: PathBuf,
+    /// Run the surface manager (budget, pool, priorities: the scene's `[budget]`, or the talk's
+    /// defaults) and write its per-frame statistics to this JSON file, with a plot of pool use and
+    /// updates per frame beside it (same name, `.svg`).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
 }
 
 /// Run the scene for the frames asked and write `<surface>.png` and `<surface>.json` into the dump
@@ -33,10 +38,62 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         ));
     }
     let scene = Scene::load(&args.scene).map_err(|e| e.to_string())?;
+    if args.report.is_some() || scene.budget.is_some() {
+        return crate::managed::simulate(
+            gpu,
+            &scene,
+            args.frames,
+            args.dt,
+            &args.dump,
+            args.report.as_deref(),
+        );
+    }
     simulate(gpu, &scene, args.frames, args.dt, &args.dump)
 }
 
-/// Run a loaded scene and dump its heightmaps.
+/// The library shape of each scene deformer, registering meshes through `add_mesh`.
+pub fn scene_shapes(
+    scene: &Scene,
+    mut add_mesh: impl FnMut(&str, &snowprint::Mesh) -> snowprint::Result<snowprint::MeshId>,
+) -> Result<Vec<Shape>, String> {
+    scene
+        .deformers
+        .iter()
+        .map(|d| {
+            Ok(match &d.shape {
+                SceneShape::Sphere { radius } => Shape::Sphere { radius: *radius },
+                SceneShape::Capsule {
+                    radius,
+                    half_height,
+                } => Shape::Capsule {
+                    radius: *radius,
+                    half_height: *half_height,
+                },
+                SceneShape::Box { half_extents } => Shape::Box {
+                    half_extents: *half_extents,
+                },
+                SceneShape::Mesh { mesh, .. } => {
+                    Shape::Mesh(add_mesh(&d.name, mesh).map_err(|e| e.to_string())?)
+                }
+            })
+        })
+        .collect()
+}
+
+/// A progress bar over frames.
+pub fn frame_bar(frames: u32, what: &str) -> Result<ProgressBar, String> {
+    let bar = ProgressBar::new(frames as u64);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} frames {{elapsed}}"
+        ))
+        .map_err(|e| e.to_string())?
+        .progress_chars("=> "),
+    );
+    Ok(bar)
+}
+
+/// Run a loaded scene, every surface every frame, and dump its heightmaps.
 pub fn simulate(
     gpu: &GpuOptions,
     scene: &Scene,
@@ -63,32 +120,8 @@ pub fn simulate(
     for s in &scene.surfaces {
         ids.push(world.add_surface(s.clone()).map_err(|e| e.to_string())?);
     }
-    let mut shapes = Vec::new();
-    for d in &scene.deformers {
-        shapes.push(match &d.shape {
-            SceneShape::Sphere { radius } => Shape::Sphere { radius: *radius },
-            SceneShape::Capsule {
-                radius,
-                half_height,
-            } => Shape::Capsule {
-                radius: *radius,
-                half_height: *half_height,
-            },
-            SceneShape::Box { half_extents } => Shape::Box {
-                half_extents: *half_extents,
-            },
-            SceneShape::Mesh { mesh, .. } => {
-                Shape::Mesh(world.add_mesh(&d.name, mesh).map_err(|e| e.to_string())?)
-            }
-        });
-    }
-
-    let bar = ProgressBar::new(frames as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} simulate [{bar:30}] {pos}/{len} frames {elapsed}")
-            .map_err(|e| e.to_string())?
-            .progress_chars("=> "),
-    );
+    let shapes = scene_shapes(scene, |name, mesh| world.add_mesh(name, mesh))?;
+    let bar = frame_bar(frames, "simulate")?;
     for f in 1..=frames {
         let t = f as f32 * dt;
         let deformers: Vec<Deformer> = scene
@@ -102,20 +135,33 @@ pub fn simulate(
     }
     bar.finish_and_clear();
 
-    // Write everything into a fresh folder beside the destination, then move the files in: an
-    // error leaves no output that looks complete.
+    let maps = ids
+        .iter()
+        .map(|&id| world.read_heightmap(id).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
+    write_dump(scene, &maps, frames, dt, dump)
+}
+
+/// Write each surface's heightmap and description into `dump`, through a staging folder so that an
+/// error leaves no output that looks complete.
+pub fn write_dump(
+    scene: &Scene,
+    maps: &[Heightmap],
+    frames: u32,
+    dt: f32,
+    dump: &Path,
+) -> Result<(), String> {
     std::fs::create_dir_all(dump)
         .map_err(|e| format!("cannot create the dump folder {}: {e}", dump.display()))?;
     let staging = dump.join(format!(".snowprint-partial-{}", std::process::id()));
-    let result = write_dump(&world, scene, &ids, frames, dt, &staging, dump);
+    let result = write_staged(scene, maps, frames, dt, &staging, dump);
     let _ = std::fs::remove_dir_all(&staging);
     result
 }
 
-fn write_dump(
-    world: &SnowWorld,
+fn write_staged(
     scene: &Scene,
-    ids: &[snowprint::SurfaceId],
+    maps: &[Heightmap],
     frames: u32,
     dt: f32,
     staging: &Path,
@@ -124,8 +170,7 @@ fn write_dump(
     std::fs::create_dir_all(staging)
         .map_err(|e| format!("cannot write into {}: {e}", dump.display()))?;
     let mut files: Vec<PathBuf> = Vec::new();
-    for (desc, &id) in scene.surfaces.iter().zip(ids) {
-        let map = world.read_heightmap(id).map_err(|e| e.to_string())?;
+    for (desc, map) in scene.surfaces.iter().zip(maps) {
         let png = staging.join(format!("{}.png", desc.name));
         map.save_png(&png).map_err(|e| e.to_string())?;
         let layout = desc.layout();

@@ -128,3 +128,50 @@ fn bad_scene_is_one_sentence_and_leaves_no_output() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--dt -1"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn managed_run_reports_every_frame_within_the_budget() {
+    let out = scratch("managed");
+    let report = out.join("report.json");
+    let status = snowprint()
+        .args(["simulate", "--scene"])
+        .arg(repo().join("scenes/rooftops.toml"))
+        .args(["--frames", "120", "--dump"])
+        .arg(&out)
+        .arg("--report")
+        .arg(&report)
+        .status()
+        .expect("run snowprint");
+    assert!(status.success());
+    let frames: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(frames.len(), 120);
+    for (i, f) in frames.iter().enumerate() {
+        assert_eq!(f["frame"], i as u64);
+        for key in [
+            "updated",
+            "active",
+            "resident",
+            "evicted",
+            "pool_bytes_used",
+            "pool_bytes_budget",
+            "max_wait_frames",
+        ] {
+            assert!(f.get(key).is_some(), "frame {i} has no {key}");
+        }
+        // The scene's [budget]: 2 updates a frame, 2 MiB.
+        assert!(f["updated"].as_array().unwrap().len() <= 2);
+        assert!(f["pool_bytes_used"].as_u64().unwrap() <= 2 * 1024 * 1024);
+        assert_eq!(f["pool_bytes_budget"], 2 * 1024 * 1024);
+    }
+    let svg = std::fs::read_to_string(out.join("report.svg")).unwrap();
+    assert!(svg.starts_with("<svg") || svg.contains("<svg"));
+    // The player's roof and the street were pressed; the balcony over the street was not.
+    let pressed = |name: &str| {
+        let map = snowprint::Heightmap::load_png(&out.join(format!("{name}.png"))).unwrap();
+        map.depression.iter().filter(|&&v| v > 32768).count()
+    };
+    assert!(pressed("roof_a") > 50 && pressed("street") > 50);
+    assert_eq!(pressed("balcony"), 0);
+    let _ = std::fs::remove_dir_all(&out);
+}

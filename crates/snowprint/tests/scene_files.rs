@@ -1105,3 +1105,83 @@ fn nothing_panics_on_garbage() {
         assert!(!msg.contains('\n'), "{msg}");
     }
 }
+
+mod manager_keys {
+    use std::path::Path;
+
+    use snowprint::scene::Scene;
+
+    const BASE: &str = "version = 1\n[[surface]]\nname = \"a\"\ncenter = [0, 0, 0]\nsize = [2, 2]\nsnow_depth = 0.3\n";
+
+    fn parse(extra: &str) -> snowprint::Result<Scene> {
+        Scene::parse(&format!("{BASE}{extra}"), Path::new("m.toml"))
+    }
+
+    #[test]
+    fn budget_camera_player_and_zone_parse() {
+        let s = parse(
+            "zone = 3\n[budget]\nupdates_per_frame = 4\npool_bytes = 1048576\nactive_distance = 25.5\n\
+             [camera]\ntarget = [1, 2, 3]\nkeys = [{ t = 0, eye = [0, 10, 0] }, { t = 2, eye = [4, 10, 0] }]\n\
+             [[deformer]]\nname = \"p\"\nshape = \"sphere\"\nradius = 0.1\nplayer = true\nkeys = [{ t = 0, position = [0, 0.1, 0] }]\n",
+        )
+        .unwrap();
+        assert_eq!(s.zones, vec![3]);
+        let b = s.budget.unwrap();
+        assert_eq!(
+            (b.updates_per_frame, b.pool_bytes, b.active_distance),
+            (Some(4), Some(1 << 20), Some(25.5))
+        );
+        let c = s.camera.unwrap();
+        assert_eq!(c.fov_y_degrees, 50.0);
+        // Halfway between the keys.
+        assert_eq!(c.at(1.0).eye, glam::Vec3::new(2.0, 10.0, 0.0));
+        assert_eq!(c.at(-1.0).eye, glam::Vec3::new(0.0, 10.0, 0.0));
+        assert_eq!(c.at(9.0).eye, glam::Vec3::new(4.0, 10.0, 0.0));
+        assert!(s.deformers[0].player);
+    }
+
+    #[test]
+    fn manager_key_errors_name_line_and_value() {
+        let cases = [
+            (
+                "[budget]\nupdates_per_frame = 0\n",
+                "m.toml:8:",
+                "updates_per_frame 0",
+            ),
+            ("[budget]\npool_bytes = -5\n", "m.toml:8:", "pool_bytes -5"),
+            (
+                "[budget]\nactive_distance = nan\n",
+                "m.toml:8:",
+                "active_distance nan",
+            ),
+            ("[budget]\nspeed = 1\n", "m.toml:8:", "speed"),
+            (
+                "[camera]\ntarget = [0, 0, 0]\nkeys = [{ t = 1, eye = [0, 1, 0] }, { t = 0.5, eye = [0, 2, 0] }]\n",
+                "m.toml:9:",
+                "t = 0.5",
+            ),
+            (
+                "[camera]\nkeys = [{ t = 0, eye = [0, 1, 0] }]\n",
+                "m.toml:7:",
+                "target",
+            ),
+            (
+                "[[deformer]]\nname = \"p\"\nshape = \"sphere\"\nradius = 0.1\nplayer = true\nkeys = [{ t = 0, position = [0, 0, 0] }]\n\
+                 [[deformer]]\nname = \"q\"\nshape = \"sphere\"\nradius = 0.1\nplayer = true\nkeys = [{ t = 0, position = [0, 0, 0] }]\n",
+                "m.toml:17:",
+                "already deformer \"p\"",
+            ),
+        ];
+        for (extra, line, value) in cases {
+            let e = parse(extra).unwrap_err().to_string();
+            assert!(e.contains(line) && e.contains(value), "{extra:?}: {e}");
+        }
+        let e = Scene::parse(
+            &BASE.replace("snow_depth = 0.3\n", "snow_depth = 0.3\nzone = -1\n"),
+            Path::new("m.toml"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("m.toml:7:") && e.contains("zone -1"), "{e}");
+    }
+}

@@ -15,8 +15,10 @@ use crate::surface::SurfaceDesc;
 use crate::world::{CaptureConfig, CaptureMode};
 
 use super::diagnose::Source;
-use super::raw::{Num, Nums, RawCapture, RawDeformer, RawKey, RawScene, RawSurface, Str};
-use super::{Key, SCENE_VERSION, Scene, SceneDeformer, SceneShape};
+use super::raw::{
+    Num, Nums, RawBudget, RawCamera, RawCapture, RawDeformer, RawKey, RawScene, RawSurface, Str,
+};
+use super::{Key, SCENE_VERSION, Scene, SceneBudget, SceneCamera, SceneDeformer, SceneShape};
 
 /// Largest surface side accepted, metres (as [`SurfaceDesc::validate`]).
 const MAX_SIDE: f32 = 100_000.0;
@@ -47,11 +49,13 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
     };
 
     let mut names = HashMap::new();
-    let surfaces = raw
+    let (surfaces, zones): (Vec<SurfaceDesc>, Vec<u32>) = raw
         .surface
         .into_iter()
         .map(|s| surface(src, s, &mut names))
-        .collect::<Result<Vec<_>>>()?;
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
     if surfaces.is_empty() {
         return Err(src.error_at_line(
             1,
@@ -61,17 +65,207 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
     }
 
     let mut names = HashMap::new();
-    let deformers = raw
-        .deformer
-        .into_iter()
-        .map(|d| deformer(src, d, dir, &mut names))
-        .collect::<Result<Vec<_>>>()?;
+    let mut first_player: Option<usize> = None;
+    let mut deformers = Vec::new();
+    for d in raw.deformer {
+        let player = d
+            .get_ref()
+            .player
+            .as_ref()
+            .map(|p| (*p.get_ref(), p.span()));
+        deformers.push(deformer(src, d, dir, &mut names)?);
+        if let Some((true, span)) = player {
+            if let Some(first) = first_player {
+                return Err(src.error(
+                    &span,
+                    format!(
+                        "deformer {:?} has player = true, but the player is already deformer {:?}",
+                        deformers[deformers.len() - 1].name,
+                        deformers[first].name
+                    ),
+                    "mark one deformer only with player = true",
+                ));
+            }
+            first_player = Some(deformers.len() - 1);
+        }
+    }
+
+    let budget = raw
+        .budget
+        .map(|b| budget(src, b.into_inner()))
+        .transpose()?;
+    let camera = raw
+        .camera
+        .map(|c| camera(src, c.span(), c.into_inner()))
+        .transpose()?;
 
     Ok(Scene {
         path: path.to_owned(),
         capture,
         surfaces,
         deformers,
+        zones,
+        budget,
+        camera,
+    })
+}
+
+fn budget(src: &Source<'_>, b: RawBudget) -> Result<SceneBudget> {
+    let whole = |v: &Spanned<i64>, key: &str, min: i64, max: i64, rule: &str| -> Result<i64> {
+        let x = *v.get_ref();
+        if (min..=max).contains(&x) {
+            Ok(x)
+        } else {
+            Err(src.error(
+                &v.span(),
+                format!("[budget] has {key} {}", src.quote(&v.span())),
+                rule,
+            ))
+        }
+    };
+    Ok(SceneBudget {
+        updates_per_frame: b
+            .updates_per_frame
+            .as_ref()
+            .map(|v| {
+                whole(
+                    v,
+                    "updates_per_frame",
+                    1,
+                    1 << 20,
+                    "updates_per_frame must be a whole number of surfaces from 1 to 1048576",
+                )
+            })
+            .transpose()?
+            .map(|x| x as u32),
+        pool_bytes: b
+            .pool_bytes
+            .as_ref()
+            .map(|v| {
+                whole(
+                    v,
+                    "pool_bytes",
+                    256,
+                    1 << 40,
+                    "pool_bytes must be a whole number of bytes, at least 256 (2 MiB is 2097152)",
+                )
+            })
+            .transpose()?
+            .map(|x| x as u64),
+        active_distance: b
+            .active_distance
+            .as_ref()
+            .map(|v| {
+                number(
+                    src,
+                    v,
+                    "[budget]",
+                    "active_distance",
+                    |x| x > 0.0,
+                    "active_distance must be a finite number of metres above 0",
+                )
+            })
+            .transpose()?,
+    })
+}
+
+fn camera(src: &Source<'_>, table: Range<usize>, c: RawCamera) -> Result<SceneCamera> {
+    let target = required(
+        src,
+        &table,
+        c.target.as_ref(),
+        "[camera]",
+        "target",
+        "add target = [x, y, z], the point the camera looks at",
+    )?;
+    let target = vector::<3>(
+        src,
+        target,
+        "[camera]",
+        "target",
+        "[x, y, z] in metres",
+        |_| true,
+        "target must be three finite numbers of metres",
+    )?;
+    let fov_y_degrees = match &c.fov_y_degrees {
+        Some(v) => number(
+            src,
+            v,
+            "[camera]",
+            "fov_y_degrees",
+            |x| x > 1.0 && x < 179.0,
+            "fov_y_degrees must be an angle between 1 and 179 degrees",
+        )?,
+        None => 50.0,
+    };
+    let keys = required(
+        src,
+        &table,
+        c.keys,
+        "[camera]",
+        "keys",
+        "add keys = [{ t = 0.0, eye = [x, y, z] }, ...]",
+    )?;
+    let keys_span = keys.span();
+    let mut out: Vec<(f32, Vec3)> = Vec::new();
+    for k in keys.into_inner() {
+        let span = k.span();
+        let k = k.into_inner();
+        let t = required(
+            src,
+            &span,
+            k.t.as_ref(),
+            "a camera key",
+            "t",
+            "add t = <seconds>",
+        )?;
+        let t = number(
+            src,
+            t,
+            "a camera key",
+            "t",
+            |_| true,
+            "t must be a finite number of seconds",
+        )?;
+        let eye = required(
+            src,
+            &span,
+            k.eye.as_ref(),
+            "a camera key",
+            "eye",
+            "add eye = [x, y, z]",
+        )?;
+        let eye = vector::<3>(
+            src,
+            eye,
+            "a camera key",
+            "eye",
+            "[x, y, z] in metres",
+            |_| true,
+            "eye must be three finite numbers of metres",
+        )?;
+        if let Some(&(prev, _)) = out.last()
+            && t <= prev
+        {
+            return Err(src.error(
+                &span,
+                format!("a camera key has t = {t} after a key at t = {prev}"),
+                "list the camera keys in strictly increasing time",
+            ));
+        }
+        out.push((t, Vec3::from(eye)));
+    }
+    if out.is_empty() {
+        return Err(src.error(
+            &keys_span,
+            "[camera] has no keys",
+            "add at least one key: keys = [{ t = 0.0, eye = [x, y, z] }]",
+        ));
+    }
+    Ok(SceneCamera {
+        keys: out,
+        target: Vec3::from(target),
+        fov_y_degrees,
     })
 }
 
@@ -227,7 +421,7 @@ fn surface(
     src: &Source<'_>,
     s: Spanned<RawSurface>,
     names: &mut HashMap<String, usize>,
-) -> Result<SurfaceDesc> {
+) -> Result<(SurfaceDesc, u32)> {
     let table = s.span();
     let s = s.into_inner();
     let name = required(
@@ -338,7 +532,18 @@ fn surface(
     };
     desc.validate()
         .map_err(|e| src.error(&table, e, "fix this [[surface]] table"))?;
-    Ok(desc)
+    let zone = match &s.zone {
+        Some(z) if (0..=i64::from(u32::MAX)).contains(z.get_ref()) => *z.get_ref() as u32,
+        Some(z) => {
+            return Err(src.error(
+                &z.span(),
+                format!("surface {:?} has zone {}", desc.name, src.quote(&z.span())),
+                "zone must be a whole number from 0 to 4294967295",
+            ));
+        }
+        None => 0,
+    };
+    Ok((desc, zone))
 }
 
 /// The shapes, as written in `shape = "..."`.
@@ -553,6 +758,7 @@ fn deformer(
         name: name.into_inner(),
         shape,
         keys,
+        player: d.player.is_some_and(|p| *p.get_ref()),
     })
 }
 

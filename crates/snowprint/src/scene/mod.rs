@@ -52,6 +52,55 @@ pub struct Scene {
     pub surfaces: Vec<SurfaceDesc>,
     /// The deformers, in file order (`[[deformer]]`).
     pub deformers: Vec<SceneDeformer>,
+    /// The streaming zone of each surface (`zone`, default 0), in the order of `surfaces`.
+    pub zones: Vec<u32>,
+    /// The surface manager's limits (`[budget]`); `None` runs every surface every frame.
+    pub budget: Option<SceneBudget>,
+    /// The camera (`[camera]`), which decides what the manager counts as visible.
+    pub camera: Option<SceneCamera>,
+}
+
+/// `[budget]` of a scene: see `docs/SCENES.md` and `docs/MANAGER.md`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneBudget {
+    /// Surface updates per frame (the talk's 2).
+    pub updates_per_frame: Option<u32>,
+    /// Bytes of the heightmap pool (the talk's 2 MiB).
+    pub pool_bytes: Option<u64>,
+    /// Distance from the player (or camera) within which a visible surface is active, metres.
+    pub active_distance: Option<f32>,
+}
+
+/// `[camera]` of a scene: eye positions keyed in time, looking at one target.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneCamera {
+    /// `(t, eye)` keys, times strictly increasing.
+    pub keys: Vec<(f32, Vec3)>,
+    /// The point looked at.
+    pub target: Vec3,
+    /// Vertical field of view, degrees.
+    pub fov_y_degrees: f32,
+}
+
+impl SceneCamera {
+    /// The camera at time `t` (eye interpolated linearly, held before the first key and after the
+    /// last).
+    pub fn at(&self, t: f32) -> crate::view::Camera {
+        let eye = match (self.keys.first(), self.keys.iter().position(|k| k.0 > t)) {
+            (None, _) => Vec3::ZERO,
+            (Some(first), Some(0)) => first.1,
+            (Some(_), None) => self.keys[self.keys.len() - 1].1,
+            (Some(_), Some(i)) => {
+                let (a, b) = (self.keys[i - 1], self.keys[i]);
+                a.1.lerp(b.1, (t - a.0) / (b.0 - a.0))
+            }
+        };
+        crate::view::Camera {
+            eye,
+            target: self.target,
+            fov_y_degrees: self.fov_y_degrees,
+        }
+    }
 }
 
 /// One keyframed deformer of a scene.
@@ -63,6 +112,8 @@ pub struct SceneDeformer {
     pub shape: SceneShape,
     /// Its keys: at least one, times strictly increasing.
     pub keys: Vec<Key>,
+    /// Whether it is the player (`player = true`): the manager updates the player's surface first.
+    pub player: bool,
 }
 
 /// The geometry of a scene deformer, in its own frame.
@@ -231,6 +282,7 @@ mod tests {
             name: "d".into(),
             shape: SceneShape::Sphere { radius: 0.1 },
             keys,
+            player: false,
         }
     }
 
@@ -298,6 +350,9 @@ mod tests {
             capture: CaptureConfig::default(),
             surfaces: vec![],
             deformers: vec![d],
+            zones: vec![],
+            budget: None,
+            camera: None,
         };
         assert_eq!(scene.duration(), 0.0);
         let empty = deformer(vec![]);

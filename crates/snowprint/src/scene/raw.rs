@@ -22,6 +22,34 @@ pub(super) struct RawScene {
     pub surface: Vec<Spanned<RawSurface>>,
     #[serde(default)]
     pub deformer: Vec<Spanned<RawDeformer>>,
+    pub budget: Option<Spanned<RawBudget>>,
+    pub camera: Option<Spanned<RawCamera>>,
+}
+
+/// `[budget]`: the surface manager's limits.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawBudget {
+    pub updates_per_frame: Option<Spanned<i64>>,
+    pub pool_bytes: Option<Spanned<i64>>,
+    pub active_distance: Option<Num>,
+}
+
+/// `[camera]`: keyed eye positions looking at one target.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCamera {
+    pub target: Option<Nums>,
+    pub fov_y_degrees: Option<Num>,
+    pub keys: Option<Spanned<Vec<Spanned<RawCameraKey>>>>,
+}
+
+/// One key of the camera.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCameraKey {
+    pub t: Option<Num>,
+    pub eye: Option<Nums>,
 }
 
 /// `[capture]`.
@@ -43,6 +71,7 @@ pub(super) struct RawSurface {
     pub yaw_degrees: Option<Num>,
     pub snow_depth: Option<Num>,
     pub replenish_rate: Option<Num>,
+    pub zone: Option<Spanned<i64>>,
 }
 
 /// One `[[deformer]]`.
@@ -55,6 +84,7 @@ pub(super) struct RawDeformer {
     pub half_height: Option<Num>,
     pub half_extents: Option<Nums>,
     pub path: Option<Str>,
+    pub player: Option<Spanned<bool>>,
     pub keys: Option<Spanned<Vec<Spanned<RawKey>>>>,
 }
 
@@ -72,7 +102,9 @@ pub(super) struct RawKey {
 pub(super) const TABLES: &[(&str, &[&str])] = &[
     (
         "at the top level",
-        &["version", "capture", "surface", "deformer"],
+        &[
+            "version", "capture", "surface", "deformer", "budget", "camera",
+        ],
     ),
     ("in [capture]", &["mode", "ankle_height", "mask_depth"]),
     (
@@ -84,6 +116,7 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "yaw_degrees",
             "snow_depth",
             "replenish_rate",
+            "zone",
         ],
     ),
     (
@@ -95,8 +128,15 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "half_height",
             "half_extents",
             "path",
+            "player",
             "keys",
         ],
     ),
     ("in a deformer key", &["t", "position", "rotation_degrees"]),
+    (
+        "in [budget]",
+        &["updates_per_frame", "pool_bytes", "active_distance"],
+    ),
+    ("in [camera]", &["target", "fov_y_degrees", "keys"]),
+    ("in a camera key", &["t", "eye"]),
 ];
