@@ -17,10 +17,16 @@ pub struct Args {
     /// Frames to run (default: the whole walk).
     #[arg(long)]
     pub frames: Option<u32>,
+    /// Which demo: `rooftops` or `city` (several hundred surfaces under the manager's budget).
+    #[arg(long, default_value = "rooftops")]
+    pub scene: String,
 }
 
 /// Run the built-in walker scene and write its heightmaps.
 pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
+    if args.scene == "city" {
+        return crate::city::run(gpu, &args.out, args.frames);
+    }
     let scene =
         Scene::parse(DEMO_SCENE, Path::new("scenes/walker.toml")).map_err(|e| e.to_string())?;
     let dt = 1.0 / 60.0;

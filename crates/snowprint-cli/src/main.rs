@@ -4,6 +4,7 @@
 //! turns errors into one sentence and a non-zero exit.
 
 mod bench;
+mod city;
 mod demo;
 mod managed;
 mod simulate;

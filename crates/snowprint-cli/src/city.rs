@@ -1,0 +1,174 @@
+//! `snowprint demo --scene city`: several hundred rooftops and streets, many walkers, two surface
+//! updates a frame inside the talk's 2 MiB pool. Writes the manager's statistics, the pool plot and
+//! a top-down map of every surface's snow.
+
+use std::path::Path;
+
+use glam::Vec3;
+use snowprint::manager::city::{self, SurfaceKind};
+use snowprint::manager::{CameraView, ManagerConfig, SnowManager, TickStats, plot};
+use snowprint::{GpuContext, GpuOptions};
+
+/// Surfaces and walkers of the city demo.
+pub const SURFACES: usize = 400;
+/// Walkers of the city demo (the first is the player).
+pub const WALKERS: usize = 60;
+/// Seed of the city.
+pub const SEED: u64 = 2014;
+/// Map scale: metres per pixel.
+const MAP_METRES_PER_PIXEL: f32 = 0.1;
+
+/// Run the city for `frames` frames (default 10 s at 60 Hz) and write `city_report.json`,
+/// `city_pool.svg` and `city_map.png` into `out`.
+pub fn run(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), String> {
+    let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
+    let frames = frames.unwrap_or(600);
+    let dt = 1.0 / 60.0;
+    let city = city::generate(SEED, SURFACES, WALKERS);
+    let config = ManagerConfig::default();
+    let budget = config.updates_per_frame;
+    let mut snow = SnowManager::new(&ctx, config).map_err(|e| e.to_string())?;
+    let mut ids = Vec::new();
+    for s in &city.surfaces {
+        ids.push(
+            snow.add_surface(s.desc.clone(), s.zone)
+                .map_err(|e| e.to_string())?,
+        );
+    }
+    let bar = crate::simulate::frame_bar(frames, "city")?;
+    let mut stats: Vec<TickStats> = Vec::new();
+    for f in 0..frames {
+        let t = f as f32 * dt;
+        let camera = CameraView::new(&city.player_camera(t), 16.0 / 9.0);
+        let deformers = city.deformers(f as u64, dt);
+        stats.push(
+            snow.tick(dt, Some(&camera), &deformers)
+                .map_err(|e| e.to_string())?,
+        );
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+    write_atomic(&out.join("city_report.json"), (json + "\n").as_bytes())?;
+    plot::write_svg(
+        &out.join("city_pool.svg"),
+        &stats,
+        &format!(
+            "city: {} surfaces, {} walkers, {budget} updates a frame, 2 MiB pool",
+            city.surfaces.len(),
+            city.walkers.len()
+        ),
+        Some(budget),
+    )
+    .map_err(|e| e.to_string())?;
+    let map = city_map(&snow, &city, &ids)?;
+    write_atomic(&out.join("city_map.png"), &map)?;
+    let last = stats.last();
+    eprintln!(
+        "snowprint: city of {} surfaces and {} walkers, {frames} frames: {} surfaces hold a heightmap at the end, {} evictions, longest wait {} frames; wrote city_report.json, city_pool.svg and city_map.png to {}",
+        city.surfaces.len(),
+        city.walkers.len(),
+        last.map_or(0, |s| s.resident),
+        stats.iter().map(|s| s.evicted.len()).sum::<usize>(),
+        stats.iter().map(|s| s.max_wait_frames).max().unwrap_or(0),
+        out.display()
+    );
+    Ok(())
+}
+
+/// A top-down map (PNG bytes): streets grey, roofs brick, snow white where untouched and blue
+/// where pressed, surfaces without a heightmap shaded darker.
+fn city_map(
+    snow: &SnowManager,
+    city: &city::City,
+    ids: &[snowprint::manager::ManagedId],
+) -> Result<Vec<u8>, String> {
+    let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+    for s in &city.surfaces {
+        let r = s.desc.size.length() * 0.5;
+        lo = lo.min(s.desc.center - Vec3::splat(r));
+        hi = hi.max(s.desc.center + Vec3::splat(r));
+    }
+    let width = (((hi.x - lo.x) / MAP_METRES_PER_PIXEL).ceil() as u32).clamp(1, 4096);
+    let height = (((hi.z - lo.z) / MAP_METRES_PER_PIXEL).ceil() as u32).clamp(1, 4096);
+    let scale = ((hi.x - lo.x) / width as f32).max((hi.z - lo.z) / height as f32);
+    let mut rgb = vec![18u8; (width * height * 3) as usize];
+    // Streets first, roofs over them (roofs are higher).
+    let mut order: Vec<usize> = (0..city.surfaces.len()).collect();
+    order.sort_by(|&a, &b| {
+        city.surfaces[a]
+            .desc
+            .center
+            .y
+            .total_cmp(&city.surfaces[b].desc.center.y)
+    });
+    for i in order {
+        let s = &city.surfaces[i];
+        let map = snow.read_heightmap(ids[i]).map_err(|e| e.to_string())?;
+        let layout = s.desc.layout();
+        let to_world = s.desc.local_to_world();
+        let resident = map.is_some();
+        for row in 0..layout.height {
+            for col in 0..layout.width {
+                let local = Vec3::new(
+                    -0.5 * s.desc.size.x + (col as f32 + 0.5) * s.desc.size.x / layout.width as f32,
+                    0.0,
+                    -0.5 * s.desc.size.y
+                        + (row as f32 + 0.5) * s.desc.size.y / layout.height as f32,
+                );
+                let w = to_world.transform_point3(local);
+                let px = ((w.x - lo.x) / scale) as u32;
+                let pz = ((w.z - lo.z) / scale) as u32;
+                if px >= width || pz >= height {
+                    continue;
+                }
+                let d = map.as_ref().map_or(0.0, |m| {
+                    m.depression[(row * layout.width + col) as usize] as f32 / 65535.0
+                });
+                let ground = match s.kind {
+                    SurfaceKind::Roof => [150.0, 72.0, 58.0],
+                    SurfaceKind::Street => [92.0, 92.0, 98.0],
+                };
+                let fresh = if resident {
+                    [236.0, 242.0, 250.0]
+                } else {
+                    [170.0, 176.0, 188.0]
+                };
+                let trail = [70.0, 110.0, 200.0];
+                // Untouched snow, then blue as it is pressed, then the ground at the bottom.
+                let c: Vec<f32> = (0..3)
+                    .map(|k| {
+                        if d < 0.85 {
+                            fresh[k] + (trail[k] - fresh[k]) * (d / 0.85)
+                        } else {
+                            trail[k] + (ground[k] - trail[k]) * ((d - 0.85) / 0.15)
+                        }
+                    })
+                    .collect();
+                let o = ((pz * width + px) * 3) as usize;
+                for k in 0..3 {
+                    // Keep the deepest print a pixel covers.
+                    let v = c[k].clamp(0.0, 255.0) as u8;
+                    rgb[o + k] = if d > 0.0 { v.min(rgb[o + k].max(v)) } else { v };
+                }
+            }
+        }
+    }
+    let mut bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut bytes, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(|e| e.to_string())?;
+        w.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    }
+    Ok(bytes)
+}
+
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let tmp = path.with_extension("partial");
+    std::fs::write(&tmp, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
