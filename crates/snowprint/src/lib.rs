@@ -31,6 +31,7 @@ pub mod heightmap;
 pub mod manager;
 pub mod mesh;
 pub mod pool;
+pub mod render;
 pub mod scene;
 pub mod surface;
 pub mod view;

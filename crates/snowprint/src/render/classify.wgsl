@@ -1,0 +1,60 @@
+// classify.wgsl: which snow material each surface needs this frame, decided on the GPU. A surface
+// whose heightmap is all zero (nothing ever pressed it, or the snow has filled every print back)
+// gets the basic material; any other the deformable one. The pass writes, per surface, the
+// indirect draw arguments of both snow pipelines (one of them with zero instances), the indirect
+// dispatch of its heightfield pass (zero workgroups when basic), and the flag the report reads.
+// Reads: the heightmap pool, the surface list. Writes: the surface state table.
+
+// Must match `ClassifyRecord` in src/render/gpu.rs.
+struct ClassifyRecord {
+    heights: u32,     // element offset of the current heightmap in the pool
+    width: u32,
+    height: u32,
+    box_vertices: u32,
+}
+
+// Words per surface in the state table. Must match `STATE_WORDS` in src/render/gpu.rs.
+const STATE_WORDS: u32 = 16u;
+
+@group(0) @binding(0) var<storage, read> pool: array<u32>;
+@group(0) @binding(1) var<storage, read> records: array<ClassifyRecord>;
+@group(0) @binding(2) var<storage, read_write> state: array<u32>;
+
+var<workgroup> deepest: atomic<u32>;
+
+@compute @workgroup_size(256, 1, 1)
+fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg: vec3<u32>) {
+    let rec = records[wg.x];
+    if li == 0u {
+        atomicStore(&deepest, 0u);
+    }
+    workgroupBarrier();
+    let count = rec.width * rec.height;
+    var local_max = 0u;
+    for (var i = li; i < count; i += 256u) {
+        local_max = max(local_max, pool[rec.heights + i] & 0xffffu);
+    }
+    atomicMax(&deepest, local_max);
+    workgroupBarrier();
+    if li == 0u {
+        let d = atomicLoad(&deepest);
+        let touched = select(0u, 1u, d > 0u);
+        let base = wg.x * STATE_WORDS;
+        // Basic material draw: vertex count, instance count, first vertex, first instance.
+        state[base + 0u] = rec.box_vertices;
+        state[base + 1u] = 1u - touched;
+        state[base + 2u] = 0u;
+        state[base + 3u] = 0u;
+        // Deformable material draw.
+        state[base + 4u] = rec.box_vertices;
+        state[base + 5u] = touched;
+        state[base + 6u] = 0u;
+        state[base + 7u] = 0u;
+        // Heightfield dispatch (8 x 8 workgroups).
+        state[base + 8u] = select(0u, (rec.width + 7u) / 8u, touched == 1u);
+        state[base + 9u] = (rec.height + 7u) / 8u;
+        state[base + 10u] = 1u;
+        state[base + 11u] = touched;
+        state[base + 12u] = d;
+    }
+}

@@ -1,0 +1,139 @@
+// frame.wgsl: what every pass of the renderer shares: the frame's uniforms (camera, moon, sky,
+// point lights, options), the shadow map, and the lighting model. Prepended to each pass's WGSL.
+
+struct PointLight {
+    position_radius: vec4<f32>,   // world position, radius of influence (metres)
+    color: vec4<f32>,             // linear colour times intensity at 1 m; w unused
+}
+
+const MAX_POINT_LIGHTS: u32 = 8u;
+
+// Must match `FrameUniform` in src/render/gpu.rs (a test checks the layout with naga).
+struct Frame {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    shadow_view_proj: mat4x4<f32>,
+    eye: vec4<f32>,             // xyz: camera position; w: time, seconds
+    moon_dir: vec4<f32>,        // xyz: unit direction towards the moon; w: cosine of the moon's radius on the sky
+    moon_color: vec4<f32>,      // rgb: moonlight (what a white Lambertian surface facing it reflects); w: shadow-map texel, metres
+    sky_zenith: vec4<f32>,      // rgb: sky overhead; w: exposure
+    sky_horizon: vec4<f32>,     // rgb: sky at the horizon; w: fog density per metre
+    ground_bounce: vec4<f32>,   // rgb: light bounced from below; w: city glow on the horizon
+    sss_tint: vec4<f32>,        // rgb: the sky tint of the snow's transition zone (luminance about 1); w: its strength
+    viewport: vec4<f32>,        // internal (supersampled) width, height, and their reciprocals
+    options: vec4<u32>,         // x: debug view, y: point lights in use, z: tier, w: snowflakes
+    lights: array<PointLight, 8>,
+}
+
+const DEBUG_SHADED: u32 = 0u;
+const DEBUG_MATERIALS: u32 = 1u;
+const DEBUG_DEPRESSION: u32 = 2u;
+const DEBUG_OCCLUSION: u32 = 3u;
+const DEBUG_NORMALS: u32 = 4u;
+const DEBUG_TAPS: u32 = 5u;
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var shadow_map: texture_depth_2d;
+@group(0) @binding(2) var shadow_sampler: sampler_comparison;
+@group(0) @binding(3) var linear_sampler: sampler;
+
+const PI: f32 = 3.14159265;
+
+// The night sky in a world direction: a dark blue gradient, the orange glow of the city low on the
+// horizon, and the moon with its halo.
+fn sky_radiance(dir: vec3<f32>) -> vec3<f32> {
+    let up = clamp(dir.y, -1.0, 1.0);
+    let h = max(up, 0.0);
+    var c = mix(frame.sky_horizon.rgb, frame.sky_zenith.rgb, pow(h, 0.45));
+    // Light pollution: warm, hugging the horizon.
+    let glow = exp(-max(up + 0.02, 0.0) * 9.0) * frame.ground_bounce.w;
+    c += vec3<f32>(0.55, 0.30, 0.14) * glow;
+    if up < 0.0 {
+        c = mix(c, frame.ground_bounce.rgb, clamp(-up * 4.0, 0.0, 1.0));
+    }
+    let m = dot(dir, frame.moon_dir.xyz);
+    c += frame.moon_color.rgb * (0.015 * pow(max(m, 0.0), 24.0) + 0.06 * pow(max(m, 0.0), 400.0));
+    if m > frame.moon_dir.w {
+        c += frame.moon_color.rgb * 6.0;
+    }
+    return c;
+}
+
+// Light from the sky and the ground reaching a surface facing `n` (hemisphere lighting).
+fn ambient_light(n: vec3<f32>) -> vec3<f32> {
+    let sky = 0.5 * (frame.sky_zenith.rgb + frame.sky_horizon.rgb);
+    return mix(frame.ground_bounce.rgb, sky, clamp(n.y * 0.5 + 0.5, 0.0, 1.0));
+}
+
+// Moon shadow at a world point with normal `n`: 3x3 PCF on the shadow map, offset along the normal
+// by a texel to avoid acne.
+fn moon_shadow(p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let texel = frame.moon_color.w;
+    let q = frame.shadow_view_proj * vec4<f32>(p + n * (1.5 * texel), 1.0);
+    let ndc = q.xyz / q.w;
+    let uv = ndc.xy * vec2<f32>(0.5, -0.5) + vec2<f32>(0.5);
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || ndc.z > 1.0 {
+        return 1.0;
+    }
+    let size = vec2<f32>(textureDimensions(shadow_map));
+    var lit = 0.0;
+    for (var y = -1; y <= 1; y++) {
+        for (var x = -1; x <= 1; x++) {
+            let o = vec2<f32>(f32(x), f32(y)) / size;
+            lit += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, ndc.z - 0.0005);
+        }
+    }
+    return lit / 9.0;
+}
+
+// GGX specular (normalized so that it multiplies the same light as the diffuse term).
+fn specular_ggx(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, roughness: f32, f0: f32) -> f32 {
+    let h = normalize(v + l);
+    let a = max(roughness * roughness, 0.02);
+    let a2 = a * a;
+    let nh = max(dot(n, h), 0.0);
+    let nv = max(dot(n, v), 1e-3);
+    let nl = max(dot(n, l), 0.0);
+    let d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+    let k = a * 0.5;
+    let vis = 0.25 / ((nv * (1.0 - k) + k) * (nl * (1.0 - k) + k));
+    let f = f0 + (1.0 - f0) * pow(1.0 - max(dot(v, h), 0.0), 5.0);
+    return d * vis * f * PI;
+}
+
+// A lit opaque surface: moon (with shadow), sky ambient (with occlusion) and point lights.
+// `wrap` lets light wrap around the terminator, as it does through snow.
+fn light_surface(albedo: vec3<f32>, roughness: f32, f0: f32, n: vec3<f32>, p: vec3<f32>, ao: f32, wrap: f32, shadow: f32) -> vec3<f32> {
+    let v = normalize(frame.eye.xyz - p);
+    let l = frame.moon_dir.xyz;
+    let ndl = dot(n, l);
+    let diffuse = clamp((ndl + wrap) / (1.0 + wrap), 0.0, 1.0);
+    var c = frame.moon_color.rgb * shadow * (albedo * diffuse + specular_ggx(n, v, l, roughness, f0) * max(ndl, 0.0));
+    c += albedo * ambient_light(n) * ao;
+    let count = min(frame.options.y, MAX_POINT_LIGHTS);
+    for (var i = 0u; i < count; i++) {
+        let light = frame.lights[i];
+        let to = light.position_radius.xyz - p;
+        let d2 = max(dot(to, to), 1e-4);
+        let d = sqrt(d2);
+        let lp = to / d;
+        let fall = pow(clamp(1.0 - pow(d / light.position_radius.w, 4.0), 0.0, 1.0), 2.0) / d2;
+        let nl = dot(n, lp);
+        let dl = clamp((nl + wrap) / (1.0 + wrap), 0.0, 1.0);
+        c += light.color.rgb * fall * (albedo * dl + specular_ggx(n, v, lp, roughness, f0) * max(nl, 0.0));
+    }
+    return c;
+}
+
+// A colour ramp for debug views.
+fn debug_ramp(x: f32) -> vec3<f32> {
+    let t = clamp(x, 0.0, 1.0);
+    return clamp(vec3<f32>(1.5 * t - 0.2, sin(PI * t), 1.2 - 1.5 * t), vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// A fullscreen triangle: vertex `i` of 3.
+fn fullscreen_position(i: u32) -> vec2<f32> {
+    let x = f32((i << 1u) & 2u);
+    let y = f32(i & 2u);
+    return vec2<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0);
+}

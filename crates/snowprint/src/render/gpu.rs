@@ -1,0 +1,282 @@
+//! The Rust side of every uniform and table the renderer's WGSL reads. Each struct names the WGSL
+//! struct it must match; the unit tests below parse the WGSL with naga and compare sizes and member
+//! offsets, so a change made on one side only fails `cargo test`, not the first frame.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Per-surface words in the surface state table written by `classify.wgsl`. Must match
+/// `STATE_WORDS` there.
+pub const STATE_WORDS: u64 = 16;
+/// Offset (in words) of the basic material's indirect draw arguments.
+pub const STATE_BASIC_DRAW: u64 = 0;
+/// Offset of the deformable material's indirect draw arguments.
+pub const STATE_DEFORMABLE_DRAW: u64 = 4;
+/// Offset of the heightfield pass's indirect dispatch arguments.
+pub const STATE_HEIGHTFIELD_DISPATCH: u64 = 8;
+/// Offset of the "deformed" flag.
+pub const STATE_TOUCHED: u64 = 11;
+/// Offset of the deepest depression (units of 1/65535 of the snow depth).
+pub const STATE_DEEPEST: u64 = 12;
+/// Vertices of a surface's box: five faces of two triangles (no bottom).
+pub const BOX_VERTICES: u32 = 30;
+/// Alignment of uniform blocks addressed by offset.
+pub const UNIFORM_STRIDE: u64 = 256;
+/// Point lights the frame uniform holds. Must match `MAX_POINT_LIGHTS` in `frame.wgsl`.
+pub const MAX_POINT_LIGHTS: usize = 8;
+
+/// One point light. Must match `PointLight` in `frame.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PointLightRaw {
+    /// World position and radius of influence.
+    pub position_radius: [f32; 4],
+    /// Colour times intensity; w unused.
+    pub color: [f32; 4],
+}
+
+/// The frame's uniforms. Must match `Frame` in `frame.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FrameUniform {
+    /// World to clip.
+    pub view_proj: [[f32; 4]; 4],
+    /// Clip to world.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// World to the moon's shadow-map clip space.
+    pub shadow_view_proj: [[f32; 4]; 4],
+    /// Eye position; w: time.
+    pub eye: [f32; 4],
+    /// Towards the moon; w: cosine of the moon's angular radius.
+    pub moon_dir: [f32; 4],
+    /// Moonlight; w: shadow-map texel in metres.
+    pub moon_color: [f32; 4],
+    /// Sky overhead; w: exposure.
+    pub sky_zenith: [f32; 4],
+    /// Sky at the horizon; w: fog density.
+    pub sky_horizon: [f32; 4],
+    /// Bounce from below; w: city glow.
+    pub ground_bounce: [f32; 4],
+    /// Sky tint of the snow's transition zone; w: strength.
+    pub sss_tint: [f32; 4],
+    /// Internal width, height and reciprocals.
+    pub viewport: [f32; 4],
+    /// Debug view, point lights, tier, snowflakes.
+    pub options: [u32; 4],
+    /// Point lights.
+    pub lights: [PointLightRaw; MAX_POINT_LIGHTS],
+}
+
+/// One snow surface. Must match `SnowSurface` in `snow.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SurfaceUniform {
+    /// Local to world.
+    pub local_to_world: [[f32; 4]; 4],
+    /// World to local.
+    pub world_to_local: [[f32; 4]; 4],
+    /// Half the sides, metres.
+    pub half_size: [f32; 2],
+    /// Snow depth, metres.
+    pub snow_depth: f32,
+    /// Texel side, metres.
+    pub texel: f32,
+    /// Heightmap width and height.
+    pub grid: [f32; 2],
+    /// Ground material (0 tiles, 1 concrete).
+    pub ground: u32,
+    /// Slot in the per-surface tables.
+    pub index: u32,
+    /// Search parameters: taps per texel, min taps, max taps, binary refinement taps.
+    pub search: [f32; 4],
+    /// Look: ground from, ground full, AO strength, POM self-shadow taps.
+    pub look: [f32; 4],
+    /// Pattern offset (xy), reserved.
+    pub pattern: [f32; 4],
+}
+
+/// One surface for the classify pass. Must match `ClassifyRecord` in `classify.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct ClassifyRecord {
+    /// Element offset of the current heightmap in the pool.
+    pub heights: u32,
+    /// Texels along x.
+    pub width: u32,
+    /// Texels along z.
+    pub height: u32,
+    /// Vertices of the box.
+    pub box_vertices: u32,
+}
+
+/// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct HeightfieldParams {
+    /// Element offset of the current heightmap in the pool.
+    pub heights: u32,
+    /// Texels along x.
+    pub width: u32,
+    /// Texels along z.
+    pub height: u32,
+    /// Padding.
+    pub _pad: u32,
+    /// Snow depth, metres.
+    pub snow_depth: f32,
+    /// Texel side along x, metres.
+    pub texel_x: f32,
+    /// Texel side along z, metres.
+    pub texel_z: f32,
+    /// Padding.
+    pub _pad2: f32,
+}
+
+/// A mesh vertex. Must match `MeshVertex` in `mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MeshVertexRaw {
+    /// Position in the mesh's frame.
+    pub position: [f32; 3],
+    /// Unit normal.
+    pub normal: [f32; 3],
+}
+
+/// One instance of a mesh. Must match `MeshInstance` in `mesh.wgsl` (locations 2 to 10).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct InstanceRaw {
+    /// Model matrix columns.
+    pub model: [[f32; 4]; 4],
+    /// Normal matrix columns (inverse transpose of the model's 3x3), w unused.
+    pub normal: [[f32; 4]; 3],
+    /// Albedo and material.
+    pub albedo_material: [f32; 4],
+    /// Roughness, emission, snow cover, seed.
+    pub params: [f32; 4],
+}
+
+/// Vertex buffer layouts of the mesh pipelines.
+pub fn mesh_vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
+    const VERTEX: [wgpu::VertexAttribute; 2] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+    const INSTANCE: [wgpu::VertexAttribute; 9] = wgpu::vertex_attr_array![
+        2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4,
+        6 => Float32x4, 7 => Float32x4, 8 => Float32x4, 9 => Float32x4, 10 => Float32x4
+    ];
+    [
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<MeshVertexRaw>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &VERTEX,
+        },
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<InstanceRaw>() as u64,
+            step_mode: wgpu::VertexStepMode::Instance,
+            attributes: &INSTANCE,
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::shaders;
+
+    /// Size and member offsets of a WGSL struct, from naga.
+    fn layout(source: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+        let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+        let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+        validator
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name}"));
+        match &ty.inner {
+            naga::TypeInner::Struct { members, span } => (
+                *span,
+                members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                    .collect(),
+            ),
+            _ => panic!("{name} is not a struct"),
+        }
+    }
+
+    #[test]
+    fn frame_uniform_matches_wgsl() {
+        let (size, members) = layout(&shaders::sky(), "Frame");
+        assert_eq!(size as usize, std::mem::size_of::<FrameUniform>());
+        let offsets = [
+            ("view_proj", std::mem::offset_of!(FrameUniform, view_proj)),
+            ("inv_view_proj", std::mem::offset_of!(FrameUniform, inv_view_proj)),
+            ("shadow_view_proj", std::mem::offset_of!(FrameUniform, shadow_view_proj)),
+            ("eye", std::mem::offset_of!(FrameUniform, eye)),
+            ("moon_dir", std::mem::offset_of!(FrameUniform, moon_dir)),
+            ("moon_color", std::mem::offset_of!(FrameUniform, moon_color)),
+            ("sky_zenith", std::mem::offset_of!(FrameUniform, sky_zenith)),
+            ("sky_horizon", std::mem::offset_of!(FrameUniform, sky_horizon)),
+            ("ground_bounce", std::mem::offset_of!(FrameUniform, ground_bounce)),
+            ("sss_tint", std::mem::offset_of!(FrameUniform, sss_tint)),
+            ("viewport", std::mem::offset_of!(FrameUniform, viewport)),
+            ("options", std::mem::offset_of!(FrameUniform, options)),
+            ("lights", std::mem::offset_of!(FrameUniform, lights)),
+        ];
+        for (name, offset) in offsets {
+            let m = members.iter().find(|m| m.0 == name).unwrap_or_else(|| panic!("no member {name}"));
+            assert_eq!(m.1 as usize, offset, "{name}");
+        }
+    }
+
+    #[test]
+    fn surface_uniform_matches_wgsl() {
+        let (size, members) = layout(&shaders::surface(), "SnowSurface");
+        assert_eq!(size as usize, std::mem::size_of::<SurfaceUniform>());
+        let offsets = [
+            ("local_to_world", std::mem::offset_of!(SurfaceUniform, local_to_world)),
+            ("world_to_local", std::mem::offset_of!(SurfaceUniform, world_to_local)),
+            ("half_size", std::mem::offset_of!(SurfaceUniform, half_size)),
+            ("snow_depth", std::mem::offset_of!(SurfaceUniform, snow_depth)),
+            ("texel", std::mem::offset_of!(SurfaceUniform, texel)),
+            ("grid", std::mem::offset_of!(SurfaceUniform, grid)),
+            ("ground", std::mem::offset_of!(SurfaceUniform, ground)),
+            ("index", std::mem::offset_of!(SurfaceUniform, index)),
+            ("search", std::mem::offset_of!(SurfaceUniform, search)),
+            ("look", std::mem::offset_of!(SurfaceUniform, look)),
+            ("pattern", std::mem::offset_of!(SurfaceUniform, pattern)),
+        ];
+        for (name, offset) in offsets {
+            let m = members.iter().find(|m| m.0 == name).unwrap_or_else(|| panic!("no member {name}"));
+            assert_eq!(m.1 as usize, offset, "{name}");
+        }
+    }
+
+    #[test]
+    fn compute_tables_match_wgsl() {
+        let (size, _) = layout(shaders::CLASSIFY, "ClassifyRecord");
+        assert_eq!(size as usize, std::mem::size_of::<ClassifyRecord>());
+        let (size, _) = layout(shaders::HEIGHTFIELD, "HeightfieldParams");
+        assert_eq!(size as usize, std::mem::size_of::<HeightfieldParams>());
+        assert!(shaders::CLASSIFY.contains(&format!("const STATE_WORDS: u32 = {STATE_WORDS}u;")));
+    }
+
+    #[test]
+    fn every_pass_shader_validates() {
+        for (name, source) in shaders::all() {
+            let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                .validate(&module)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+        }
+    }
+
+    #[test]
+    fn instance_layout_covers_the_struct() {
+        let [v, i] = mesh_vertex_layouts();
+        assert_eq!(v.array_stride, 24);
+        assert_eq!(i.array_stride as usize, std::mem::size_of::<InstanceRaw>());
+        assert_eq!(i.attributes.len() * 16, std::mem::size_of::<InstanceRaw>());
+        assert!(shaders::MESH.contains("@location(10) params"));
+    }
+}

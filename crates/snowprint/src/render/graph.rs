@@ -1,0 +1,184 @@
+//! The frame graph: the renderer's passes in order, each naming the resources it reads and writes.
+//! The renderer encodes its passes from this table (labels and timestamp slots come from it), and
+//! a test checks that every resource a pass reads was written by an earlier pass or comes from
+//! outside the frame.
+
+/// A resource passes read or write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Resource {
+    /// The world's heightmap pool (from [`crate::SnowWorld`]; outside the frame).
+    HeightmapPool,
+    /// Meshes and their instances this frame (uploaded by the CPU; outside the frame).
+    Instances,
+    /// Camera, moon, sky, lights, options (uploaded by the CPU; outside the frame).
+    FrameUniforms,
+    /// Surfaces this frame with their transforms (uploaded by the CPU; outside the frame).
+    SurfaceTable,
+    /// Per surface: material flag, indirect draw and dispatch arguments.
+    SurfaceState,
+    /// Per deformed surface: the filtered texture of (depression, normal, occlusion).
+    Heightfields,
+    /// The moon's shadow map.
+    ShadowMap,
+    /// The scene's HDR colour (supersampled).
+    SceneColor,
+    /// The scene's depth (supersampled).
+    SceneDepth,
+    /// The output image (an offscreen texture or the caller's view).
+    Output,
+}
+
+impl Resource {
+    /// Whether the resource comes from outside the frame (nothing in the graph writes it).
+    pub fn is_external(self) -> bool {
+        matches!(
+            self,
+            Resource::HeightmapPool | Resource::Instances | Resource::FrameUniforms | Resource::SurfaceTable
+        )
+    }
+}
+
+/// Compute or render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PassKind {
+    /// A compute pass.
+    Compute,
+    /// A render pass.
+    Render,
+}
+
+/// One pass of the frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct PassInfo {
+    /// Name (label, timestamp and report key).
+    pub name: &'static str,
+    /// Compute or render.
+    pub kind: PassKind,
+    /// What it reads.
+    pub reads: &'static [Resource],
+    /// What it writes.
+    pub writes: &'static [Resource],
+}
+
+use Resource as R;
+
+/// Index of each pass in [`PASSES`].
+pub mod pass {
+    /// Choose each surface's material.
+    pub const CLASSIFY: usize = 0;
+    /// Heightmaps to filtered shading textures.
+    pub const HEIGHTFIELD: usize = 1;
+    /// The moon's shadow map.
+    pub const SHADOW: usize = 2;
+    /// Opaque meshes.
+    pub const OPAQUE: usize = 3;
+    /// Snow surfaces.
+    pub const SNOW: usize = 4;
+    /// Sky.
+    pub const SKY: usize = 5;
+    /// Falling snow.
+    pub const SNOWFALL: usize = 6;
+    /// Resolve and tonemap.
+    pub const TONEMAP: usize = 7;
+}
+
+/// The passes of a frame, in the order they run.
+pub const PASSES: [PassInfo; 8] = [
+    PassInfo {
+        name: "classify",
+        kind: PassKind::Compute,
+        reads: &[R::HeightmapPool, R::SurfaceTable],
+        writes: &[R::SurfaceState],
+    },
+    PassInfo {
+        name: "heightfield",
+        kind: PassKind::Compute,
+        reads: &[R::HeightmapPool, R::SurfaceTable, R::SurfaceState],
+        writes: &[R::Heightfields],
+    },
+    PassInfo {
+        name: "shadow",
+        kind: PassKind::Render,
+        reads: &[R::Instances, R::FrameUniforms],
+        writes: &[R::ShadowMap],
+    },
+    PassInfo {
+        name: "opaque",
+        kind: PassKind::Render,
+        reads: &[R::Instances, R::FrameUniforms, R::ShadowMap],
+        writes: &[R::SceneColor, R::SceneDepth],
+    },
+    PassInfo {
+        name: "snow",
+        kind: PassKind::Render,
+        reads: &[R::SurfaceTable, R::SurfaceState, R::Heightfields, R::FrameUniforms, R::ShadowMap, R::SceneDepth],
+        writes: &[R::SceneColor, R::SceneDepth],
+    },
+    PassInfo {
+        name: "sky",
+        kind: PassKind::Render,
+        reads: &[R::FrameUniforms, R::SceneDepth],
+        writes: &[R::SceneColor],
+    },
+    PassInfo {
+        name: "snowfall",
+        kind: PassKind::Render,
+        reads: &[R::FrameUniforms, R::SceneDepth],
+        writes: &[R::SceneColor],
+    },
+    PassInfo {
+        name: "tonemap",
+        kind: PassKind::Render,
+        reads: &[R::FrameUniforms, R::SceneColor, R::SceneDepth],
+        writes: &[R::Output],
+    },
+];
+
+/// Check that every read is produced earlier or external, and that the output is written.
+pub fn validate(passes: &[PassInfo]) -> Result<(), String> {
+    let mut written: Vec<Resource> = Vec::new();
+    for p in passes {
+        for r in p.reads {
+            if !r.is_external() && !written.contains(r) {
+                return Err(format!("pass {} reads {r:?} before any pass writes it", p.name));
+            }
+        }
+        for w in p.writes {
+            if w.is_external() {
+                return Err(format!("pass {} writes {w:?}, which comes from outside the frame", p.name));
+            }
+            written.push(*w);
+        }
+    }
+    if !written.contains(&Resource::Output) {
+        return Err("no pass writes the output".into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_frame_graph_is_ordered() {
+        validate(&PASSES).unwrap();
+        assert_eq!(PASSES[pass::CLASSIFY].name, "classify");
+        assert_eq!(PASSES[pass::HEIGHTFIELD].name, "heightfield");
+        assert_eq!(PASSES[pass::SHADOW].name, "shadow");
+        assert_eq!(PASSES[pass::OPAQUE].name, "opaque");
+        assert_eq!(PASSES[pass::SNOW].name, "snow");
+        assert_eq!(PASSES[pass::SKY].name, "sky");
+        assert_eq!(PASSES[pass::SNOWFALL].name, "snowfall");
+        assert_eq!(PASSES[pass::TONEMAP].name, "tonemap");
+    }
+
+    #[test]
+    fn a_misordered_graph_is_refused() {
+        let mut p = PASSES;
+        p.swap(pass::SHADOW, pass::OPAQUE);
+        assert!(validate(&p).unwrap_err().contains("opaque reads ShadowMap"));
+    }
+}

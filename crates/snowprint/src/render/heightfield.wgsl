@@ -1,0 +1,87 @@
+// heightfield.wgsl: turns one surface's heightmap in the pool into the texture the snow material
+// samples with filtering: (depression, normal.x, normal.z, ambient occlusion) per texel. Normals
+// by a 3x3 Sobel filter, occlusion from the horizon of the snow around each texel (the talk's
+// "derive parametric AO from the heightmap"). Dispatched indirectly: zero workgroups for a surface
+// on the basic material.
+// Reads: the heightmap pool. Writes: the surface's heightfield texture.
+// CPU reference: render::cpu::{sobel_normal, horizon_ao}.
+
+// Must match `HeightfieldParams` in src/render/gpu.rs.
+struct HeightfieldParams {
+    heights: u32,
+    width: u32,
+    height: u32,
+    _pad: u32,
+    snow_depth: f32,
+    texel_x: f32,
+    texel_z: f32,
+    _pad2: f32,
+}
+
+@group(0) @binding(0) var<storage, read> pool: array<u32>;
+@group(0) @binding(1) var<uniform> params: HeightfieldParams;
+@group(0) @binding(2) var out_texture: texture_storage_2d<rgba16float, write>;
+
+// Must match AO_DIRECTIONS and AO_RADII in cpu.rs.
+const AO_DIRS: u32 = 8u;
+const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
+
+fn depression(c: i32, r: i32) -> f32 {
+    let x = u32(clamp(c, 0, i32(params.width) - 1));
+    let y = u32(clamp(r, 0, i32(params.height) - 1));
+    return f32(pool[params.heights + y * params.width + x] & 0xffffu) / 65535.0;
+}
+
+// Snow height (metres above the ground) at the texel nearest to a metric offset.
+fn height_at(c: i32, r: i32, dx: f32, dz: f32) -> f32 {
+    let oc = i32(round(dx / params.texel_x));
+    let orow = i32(round(dz / params.texel_z));
+    return params.snow_depth * (1.0 - depression(c + oc, r + orow));
+}
+
+// Must match `sobel_normal` in cpu.rs.
+fn sobel_normal(c: i32, r: i32) -> vec3<f32> {
+    let d = params.snow_depth;
+    let h00 = -depression(c - 1, r - 1) * d;
+    let h10 = -depression(c, r - 1) * d;
+    let h20 = -depression(c + 1, r - 1) * d;
+    let h01 = -depression(c - 1, r) * d;
+    let h21 = -depression(c + 1, r) * d;
+    let h02 = -depression(c - 1, r + 1) * d;
+    let h12 = -depression(c, r + 1) * d;
+    let h22 = -depression(c + 1, r + 1) * d;
+    let gx = (h20 + 2.0 * h21 + h22) - (h00 + 2.0 * h01 + h02);
+    let gz = (h02 + 2.0 * h12 + h22) - (h00 + 2.0 * h10 + h20);
+    return normalize(vec3<f32>(-gx / (8.0 * params.texel_x), 1.0, -gz / (8.0 * params.texel_z)));
+}
+
+// Must match `horizon_ao` in cpu.rs.
+fn horizon_ao(c: i32, r: i32) -> f32 {
+    let h0 = height_at(c, r, 0.0, 0.0);
+    var sum = 0.0;
+    for (var k = 0u; k < AO_DIRS; k++) {
+        let a = 6.28318530718 * f32(k) / f32(AO_DIRS);
+        let sx = cos(a);
+        let sz = sin(a);
+        var best = 0.0;
+        for (var j = 0u; j < 4u; j++) {
+            let rad = AO_RADII[j];
+            let dh = height_at(c, r, sx * rad, sz * rad) - h0;
+            best = max(best, dh / sqrt(dh * dh + rad * rad));
+        }
+        sum += best;
+    }
+    return 1.0 - sum / f32(AO_DIRS);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= params.width || gid.y >= params.height {
+        return;
+    }
+    let c = i32(gid.x);
+    let r = i32(gid.y);
+    let n = sobel_normal(c, r);
+    let ao = horizon_ao(c, r);
+    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(depression(c, r), n.x, n.z, ao));
+}

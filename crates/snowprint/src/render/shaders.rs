@@ -1,0 +1,65 @@
+//! The renderer's WGSL, one file per pass, and how each pass's module is put together. A pass's
+//! module is its own file after the modules it imports (`frame.wgsl` for the shared uniforms and
+//! lighting, `snow.wgsl` for the material); WGSL lets declarations come in any order, so plain
+//! concatenation is the import.
+
+/// Shared frame uniforms, shadow map and lighting.
+pub const FRAME: &str = include_str!("frame.wgsl");
+/// The snow material (basic and deformable), importable by other renderers: see its header.
+pub const SNOW: &str = include_str!("snow.wgsl");
+/// The snow pass: surface boxes, relief mapping, frag depth.
+pub const SURFACE: &str = include_str!("surface.wgsl");
+/// Opaque meshes and the shadow map.
+pub const MESH: &str = include_str!("mesh.wgsl");
+/// The night sky.
+pub const SKY: &str = include_str!("sky.wgsl");
+/// Falling snow.
+pub const SNOWFALL: &str = include_str!("snowfall.wgsl");
+/// Resolve and tonemap.
+pub const TONEMAP: &str = include_str!("tonemap.wgsl");
+/// Per-surface material choice and indirect arguments.
+pub const CLASSIFY: &str = include_str!("classify.wgsl");
+/// Heightmap to filtered shading texture (depression, normal, occlusion).
+pub const HEIGHTFIELD: &str = include_str!("heightfield.wgsl");
+
+fn join(parts: &[&str]) -> String {
+    parts.join("\n")
+}
+
+/// Module of the snow pass.
+pub fn surface() -> String {
+    join(&[FRAME, SNOW, SURFACE])
+}
+
+/// Module of the shadow and opaque passes.
+pub fn mesh() -> String {
+    join(&[FRAME, SNOW, MESH])
+}
+
+/// Module of the sky pass.
+pub fn sky() -> String {
+    join(&[FRAME, SKY])
+}
+
+/// Module of the snowfall pass.
+pub fn snowfall() -> String {
+    join(&[FRAME, SNOWFALL])
+}
+
+/// Module of the tonemap pass.
+pub fn tonemap() -> String {
+    join(&[FRAME, TONEMAP])
+}
+
+/// Every pass's module, by name (for validation tests).
+pub fn all() -> Vec<(&'static str, String)> {
+    vec![
+        ("surface", surface()),
+        ("mesh", mesh()),
+        ("sky", sky()),
+        ("snowfall", snowfall()),
+        ("tonemap", tonemap()),
+        ("classify", CLASSIFY.to_owned()),
+        ("heightfield", HEIGHTFIELD.to_owned()),
+    ]
+}

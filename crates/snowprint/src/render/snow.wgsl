@@ -1,0 +1,492 @@
+// snow.wgsl: the snow material of the talk ("Stage 3 - Shading"), as a WGSL module a renderer can
+// import. It declares no bindings and no entry points.
+//
+// How to import it: put this file's text into your shader module (WGSL declarations may come in any
+// order) and define the heightfield contract, two functions that read one surface's heightmap:
+//
+//   // Fraction of the snow depth pressed down at `uv` (0 = untouched, 1 = ground), filtered.
+//   // Called by the relief search, several times per pixel: make it one texture tap.
+//   fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32
+//   // (depression, normal.x, normal.z, ambient occlusion) at `uv`, as smooth as you can afford
+//   // (the renderer uses a 4-tap bicubic B-spline). Called once per pixel, at the hit.
+//   fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32>
+//
+// UVs run 0..1 across the surface: u along local +x, v along local +z (texel column 0 / row 0 at the
+// smallest x / z, as the heightmap pool stores them). The snowprint renderer fills both from a
+// texture that `heightfield.wgsl` derives from the pool each frame.
+//
+// Then, per pixel of the box drawn for a surface (top face at y = snow_depth, sides down to y = 0,
+// in the surface's local frame):
+//   let hit = snow_trace(s, local_position, local_view_direction, tier);   // relief mapping or POM
+//   if hit.found == 0u { discard; }
+//   let m = snow_deformable(s, hit, snow_heightfield(s, snow_uv(s, hit.position.xz)), sky_tint);
+//   ... light m.albedo, m.roughness, m.normal (local frame), m.ao with your own lights ...
+// or, for a surface nothing has pressed yet, the cheaper `snow_basic(s, local_position, face_normal,
+// sky_tint)`.
+//
+// The maths have CPU references in src/render/cpu.rs, in the same form: keep them in step.
+
+// One snow surface as the material sees it. Must match `SurfaceUniform` in src/render/gpu.rs (a
+// test checks the layout with naga).
+struct SnowSurface {
+    local_to_world: mat4x4<f32>,
+    world_to_local: mat4x4<f32>,
+    half_size: vec2<f32>,   // half the sides along local x and z, metres
+    snow_depth: f32,        // metres of fresh snow over the ground
+    texel: f32,             // heightmap texel side, metres
+    grid: vec2<f32>,        // heightmap width and height, texels
+    ground: u32,            // SNOW_GROUND_TILES or SNOW_GROUND_CONCRETE
+    index: u32,             // the surface's slot in the renderer's per-surface tables
+    search: vec4<f32>,      // x: linear taps per texel crossed, y: min taps, z: max taps, w: binary refinement taps
+    look: vec4<f32>,        // x: depression where the ground starts to show, y: where it shows fully, z: AO strength, w: POM self-shadow taps
+    pattern: vec4<f32>,     // xy: offset of the procedural patterns (metres), z: snow sparkle (unused: 0), w: reserved
+}
+
+const SNOW_GROUND_TILES: u32 = 0u;
+const SNOW_GROUND_CONCRETE: u32 = 1u;
+const SNOW_TIER_RELIEF: u32 = 0u;
+const SNOW_TIER_POM: u32 = 1u;
+// Slack of the inside test, metres. Must match `INSIDE_EPSILON` in cpu.rs.
+const SNOW_EPSILON: f32 = 1e-4;
+const SNOW_PI: f32 = 3.14159265;
+
+// Where a view ray meets the snow.
+struct SnowHit {
+    position: vec3<f32>,    // surface-local, metres
+    t: f32,                 // distance from the entry, metres
+    found: u32,             // 0: the ray left the slab without meeting snow (discard)
+    taps: u32,              // heightfield taps spent (debug view)
+    side: u32,              // 1: met at the entry on a side face (a cut through the snow)
+    shadow: f32,            // self-shadow of the heightfield towards the light (POM tier), 1 = lit
+}
+
+// What the material gives to lighting.
+struct SnowSample {
+    albedo: vec3<f32>,      // diffuse albedo, already tinted with the sky in the transition zone
+    roughness: f32,         // perceptual roughness
+    normal: vec3<f32>,      // surface-local, unit
+    f0: f32,                // specular reflectance at normal incidence
+    ao: f32,                // ambient occlusion from the heightmap
+    ground: f32,            // weight of the flattened-ground stage (0 = snow)
+    transition: f32,        // weight of the transition zone (the fake subsurface scattering)
+    wrap: f32,              // diffuse wrap (light bleeding through snow), 0 for hard surfaces
+}
+
+// ---------------------------------------------------------------------------------------------
+// Noise: integer hashing, so that every GPU (and the CPU) computes the same patterns.
+
+fn snow_pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+fn snow_hash2(c: vec2<i32>) -> f32 {
+    let h = snow_pcg(bitcast<u32>(c.x) + snow_pcg(bitcast<u32>(c.y)));
+    return f32(h >> 8u) * (1.0 / 16777215.0);
+}
+
+// Value noise in [0, 1] and its gradient (x: value, yz: d/dp), quintic interpolation.
+fn snow_noise(p: vec2<f32>) -> vec3<f32> {
+    let i = floor(p);
+    let f = p - i;
+    let u = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
+    let du = 30.0 * f * f * (f * (f - 2.0) + 1.0);
+    let c = vec2<i32>(i);
+    let a = snow_hash2(c);
+    let b = snow_hash2(c + vec2<i32>(1, 0));
+    let d = snow_hash2(c + vec2<i32>(0, 1));
+    let e = snow_hash2(c + vec2<i32>(1, 1));
+    let k1 = b - a;
+    let k2 = d - a;
+    let k3 = a - b - d + e;
+    return vec3<f32>(a + k1 * u.x + k2 * u.y + k3 * u.x * u.y, du * vec2<f32>(k1 + k3 * u.y, k2 + k3 * u.x));
+}
+
+// Three octaves of value noise at `freq` cycles per metre, each rotated to hide the lattice:
+// (value in about [0, 1], gradient per metre).
+fn snow_fbm(p: vec2<f32>, freq: f32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    var q = p * freq;
+    var f = freq;
+    var amp = 0.5;
+    // Rotation by about 37 degrees and its transpose for the gradient.
+    let r = mat2x2<f32>(0.8, 0.6, -0.6, 0.8);
+    var back = mat2x2<f32>(1.0, 0.0, 0.0, 1.0);
+    for (var o = 0; o < 3; o++) {
+        let n = snow_noise(q);
+        sum += vec3<f32>(amp * n.x, amp * f * (back * n.yz));
+        q = r * q * 2.03 + vec2<f32>(17.1, 9.3);
+        back = back * transpose(r);
+        f *= 2.03;
+        amp *= 0.5;
+    }
+    return sum;
+}
+
+// Tangent-space normal (+z up, x along local x, y along local z) of a height gradient.
+fn snow_normal_from_gradient(g: vec2<f32>) -> vec3<f32> {
+    return normalize(vec3<f32>(-g.x, -g.y, 1.0));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reoriented Normal Mapping [Barré-Brisebois & Hill 2012], the talk's formula on unpacked normals:
+// the detail normal rotated by the rotation that takes +z to the base normal.
+// Must match `rnm` in cpu.rs.
+fn snow_rnm(base: vec3<f32>, detail: vec3<f32>) -> vec3<f32> {
+    let t = base + vec3<f32>(0.0, 0.0, 1.0);
+    let u = detail * vec3<f32>(-1.0, -1.0, 1.0);
+    return normalize(t * dot(t, u) / t.z - u);
+}
+
+// Tangent space (x, y along local x, z; z up) to the surface's local frame (y up), and back.
+fn snow_ts_to_local(n: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(n.x, n.z, n.y);
+}
+
+fn snow_local_to_ts(n: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(n.x, n.z, n.y);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The heightfield and the ray through the snow slab.
+
+fn snow_uv(s: SnowSurface, xz: vec2<f32>) -> vec2<f32> {
+    return (xz + s.half_size) / (2.0 * s.half_size);
+}
+
+// Snow height above the ground at a local (x, z), metres.
+fn snow_height(s: SnowSurface, xz: vec2<f32>) -> f32 {
+    return s.snow_depth * (1.0 - snow_depression(s, snow_uv(s, xz)));
+}
+
+fn snow_inside(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t: f32) -> bool {
+    let p = o + d * t;
+    return p.y <= snow_height(s, p.xz) + SNOW_EPSILON;
+}
+
+// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, 0 <= y <= depth:
+// (t, 1 when it reaches the ground first). Must match `slab_exit` in cpu.rs.
+fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
+    var t = 3.0e38;
+    var ground = 0.0;
+    if d.y < 0.0 {
+        t = o.y / -d.y;
+        ground = 1.0;
+    } else if d.y > 0.0 {
+        t = (s.snow_depth - o.y) / d.y;
+    }
+    if d.x != 0.0 {
+        let tx = (select(-s.half_size.x, s.half_size.x, d.x > 0.0) - o.x) / d.x;
+        if tx < t {
+            t = tx;
+            ground = 0.0;
+        }
+    }
+    if d.z != 0.0 {
+        let tz = (select(-s.half_size.y, s.half_size.y, d.z > 0.0) - o.z) / d.z;
+        if tz < t {
+            t = tz;
+            ground = 0.0;
+        }
+    }
+    return vec2<f32>(max(t, 0.0), ground);
+}
+
+// Linear taps for `t_max` metres of ray: s.search.x per texel crossed, within [min, max].
+// Must match `linear_taps` in cpu.rs.
+fn snow_linear_taps(s: SnowSurface, d: vec3<f32>, t_max: f32) -> u32 {
+    let travel = length(d.xz) * t_max / s.texel;
+    return u32(clamp(ceil(travel * s.search.x), s.search.y, s.search.z));
+}
+
+// Relief mapping: linear taps, then binary refinement. Returns (t, found).
+// Must match `relief_search` in cpu.rs.
+fn snow_relief_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, taps: u32, refine: u32) -> vec2<f32> {
+    if snow_inside(s, o, d, 0.0) {
+        return vec2<f32>(0.0, 1.0);
+    }
+    let dt = t_max / f32(taps);
+    var lo = 0.0;
+    var hi = -1.0;
+    for (var i = 1u; i <= taps; i++) {
+        let t = dt * f32(i);
+        if snow_inside(s, o, d, t) {
+            hi = t;
+            break;
+        }
+        lo = t;
+    }
+    if hi < 0.0 {
+        return vec2<f32>(t_max, 0.0);
+    }
+    for (var k = 0u; k < refine; k++) {
+        let mid = 0.5 * (lo + hi);
+        if snow_inside(s, o, d, mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    return vec2<f32>(0.5 * (lo + hi), 1.0);
+}
+
+// Parallax occlusion mapping: linear taps, then the secant through the last two. Returns
+// (t, found). Must match `pom_search` in cpu.rs.
+fn snow_pom_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, taps: u32) -> vec2<f32> {
+    let f0 = o.y - snow_height(s, o.xz) - SNOW_EPSILON;
+    if f0 <= 0.0 {
+        return vec2<f32>(0.0, 1.0);
+    }
+    let dt = t_max / f32(taps);
+    var lo = 0.0;
+    var f_lo = f0;
+    for (var i = 1u; i <= taps; i++) {
+        let t = dt * f32(i);
+        let p = o + d * t;
+        let f = p.y - snow_height(s, p.xz) - SNOW_EPSILON;
+        if f <= 0.0 {
+            return vec2<f32>(lo + (t - lo) * f_lo / (f_lo - f), 1.0);
+        }
+        lo = t;
+        f_lo = f;
+    }
+    return vec2<f32>(t_max, 0.0);
+}
+
+// Soft self-shadow of the heightfield towards a local light direction `l` (POM tier): march from
+// the hit up to the snow top; the deepest the ray goes under the snow, relative to how far it has
+// travelled, sets the penumbra.
+fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f32 {
+    if l.y <= 0.02 || taps == 0u {
+        return 1.0;
+    }
+    let t_top = (s.snow_depth - p.y) / l.y;
+    if t_top <= s.texel * 0.25 {
+        return 1.0;
+    }
+    var lit = 1.0;
+    for (var i = 1u; i <= taps; i++) {
+        let t = t_top * (f32(i) - 0.5) / f32(taps);
+        let q = p + l * t;
+        let under = snow_height(s, q.xz) - q.y;
+        lit = min(lit, 1.0 - clamp(under / (0.08 * t + 0.004), 0.0, 1.0));
+    }
+    return lit;
+}
+
+// Trace the view ray entering the surface's box at local `o` with unit local direction `d`.
+fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_local: vec3<f32>) -> SnowHit {
+    // The rasterized point can lie a hair outside the box: pull it in.
+    let o = clamp(o_in, vec3<f32>(-s.half_size.x, 0.0, -s.half_size.y), vec3<f32>(s.half_size.x, s.snow_depth, s.half_size.y));
+    var hit: SnowHit;
+    hit.shadow = 1.0;
+    hit.side = 0u;
+    let exit = snow_slab_exit(s, o, d);
+    let taps = snow_linear_taps(s, d, exit.x);
+    var r: vec2<f32>;
+    if tier == SNOW_TIER_POM {
+        r = snow_pom_search(s, o, d, exit.x, taps);
+        hit.taps = taps + 1u;
+    } else {
+        let refine = u32(s.search.w);
+        r = snow_relief_search(s, o, d, exit.x, taps, refine);
+        hit.taps = taps + refine + 1u;
+    }
+    hit.t = r.x;
+    hit.found = u32(r.y);
+    hit.position = o + d * r.x;
+    if r.x == 0.0 && o.y < s.snow_depth - 1e-3 {
+        hit.side = 1u;
+    }
+    if tier == SNOW_TIER_POM && hit.found == 1u && hit.side == 0u {
+        let shadow_taps = u32(s.look.w);
+        hit.shadow = snow_self_shadow(s, hit.position, light_local, shadow_taps);
+        hit.taps += shadow_taps;
+    }
+    return hit;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Procedural layers: snow (macro "wave" and detail normals), roof tiles, concrete.
+
+// The macro "wave" of wind-blown snow: drifts about 1.7 m apart and broad undulations, a few cm
+// high. Height in metres.
+fn snow_macro_height(p: vec2<f32>) -> f32 {
+    let warp = snow_noise(p * 0.45).x;
+    let ripple = sin(dot(p, vec2<f32>(0.93, 0.37)) * (2.0 * SNOW_PI / 1.7) + 3.0 * warp);
+    let broad = snow_noise(p * 0.22 + vec2<f32>(3.1, 7.7)).x;
+    return 0.012 * ripple * (0.5 + 0.5 * broad) + 0.05 * broad;
+}
+
+fn snow_macro_normal(p: vec2<f32>) -> vec3<f32> {
+    let e = 0.02;
+    let h = snow_macro_height(p);
+    let g = vec2<f32>(snow_macro_height(p + vec2<f32>(e, 0.0)) - h, snow_macro_height(p + vec2<f32>(0.0, e)) - h) / e;
+    return snow_normal_from_gradient(g);
+}
+
+// Grain of the snow: a few millimetres over a few centimetres.
+fn snow_detail_normal(p: vec2<f32>, strength: f32) -> vec3<f32> {
+    let n = snow_fbm(p, 14.0);
+    return snow_normal_from_gradient(n.yz * 0.004 * strength);
+}
+
+struct SnowLayer {
+    albedo: vec3<f32>,
+    roughness: f32,
+    normal: vec3<f32>,      // tangent space
+    f0: f32,
+}
+
+// Clay roof tiles in staggered rows along local z: each tile rises towards the row above (where it
+// hides under the next one) and is curved across; dark gaps between tiles.
+fn snow_roof_tiles(p: vec2<f32>) -> SnowLayer {
+    let row_pitch = 0.30;
+    let tile_w = 0.22;
+    let row = floor(p.y / row_pitch);
+    let fz = p.y / row_pitch - row;
+    let xo = p.x / tile_w + 0.5 * (row - 2.0 * floor(row * 0.5));
+    let col = floor(xo);
+    let fx = xo - col;
+    let id = vec2<i32>(i32(col), i32(row));
+    let v = snow_hash2(id);
+    // Height profile and its gradient (per metre).
+    let dhdz = 0.014 / row_pitch;
+    let dhdx = 0.007 * SNOW_PI * cos(SNOW_PI * fx) / tile_w;
+    let grain = snow_fbm(p, 40.0);
+    var n = snow_normal_from_gradient(vec2<f32>(dhdx, dhdz) + grain.yz * 0.0008);
+    // Gaps: the lower edge of each row (a shadowed step) and the joints between tiles.
+    let edge_z = smoothstep(0.0, 0.06, fz);
+    let edge_x = smoothstep(0.0, 0.05, fx) * smoothstep(0.0, 0.05, 1.0 - fx);
+    let gap = edge_z * edge_x;
+    let clay = mix(vec3<f32>(0.30, 0.085, 0.05), vec3<f32>(0.42, 0.16, 0.08), v);
+    let weathered = mix(clay, vec3<f32>(0.16, 0.12, 0.10), 0.35 * snow_noise(p * 1.3).x);
+    var layer: SnowLayer;
+    layer.albedo = weathered * (0.25 + 0.75 * gap) * (0.85 + 0.3 * grain.x);
+    layer.roughness = mix(0.75, 0.45, gap);
+    layer.normal = normalize(mix(vec3<f32>(0.0, -0.6, 0.8), n, 0.3 + 0.7 * edge_z));
+    layer.f0 = 0.04;
+    return layer;
+}
+
+// Concrete: blotchy grey with a fine grain and expansion joints every 2 m.
+fn snow_concrete(p: vec2<f32>) -> SnowLayer {
+    let blotch = snow_fbm(p, 0.8);
+    let grain = snow_fbm(p, 35.0);
+    let cell = p / 2.0;
+    let f = abs(cell - round(cell)) * 2.0;            // 0 on a joint
+    let joint = smoothstep(0.0, 0.012, min(f.x, f.y));
+    var layer: SnowLayer;
+    let base = vec3<f32>(0.30, 0.30, 0.29) * (0.75 + 0.5 * blotch.x) * (0.9 + 0.2 * grain.x);
+    layer.albedo = base * (0.35 + 0.65 * joint);
+    layer.roughness = 0.85 - 0.2 * blotch.x;
+    // The joint grooves tilt the normal towards their middle.
+    let s = sign(cell - round(cell));
+    let groove = vec2<f32>(
+        select(0.0, s.x * 0.35, f.x < 0.012),
+        select(0.0, s.y * 0.35, f.y < 0.012),
+    );
+    layer.normal = snow_normal_from_gradient(grain.yz * 0.0012 + groove);
+    layer.f0 = 0.04;
+    return layer;
+}
+
+fn snow_ground_layer(s: SnowSurface, p: vec2<f32>) -> SnowLayer {
+    if s.ground == SNOW_GROUND_CONCRETE {
+        return snow_concrete(p);
+    }
+    return snow_roof_tiles(p);
+}
+
+// Fresh snow: bright, faintly blue; packed snow at the bottom of prints: greyer and smoother.
+const SNOW_FRESH: vec3<f32> = vec3<f32>(0.86, 0.89, 0.93);
+const SNOW_PACKED: vec3<f32> = vec3<f32>(0.66, 0.71, 0.78);
+
+// Albedo in the transition zone tinted with the sky, to fake light scattered under the snow (the
+// talk's fake SSS). `sky` is the sky colour scaled to a luminance near 1.
+fn snow_sss_tint(albedo: vec3<f32>, transition: f32, sky: vec3<f32>) -> vec3<f32> {
+    return mix(albedo, albedo * sky, clamp(transition, 0.0, 1.0));
+}
+
+// The basic snow material: fresh, untouched snow, no heightmap at all (the talk's cheaper material
+// for surfaces nothing has pressed). `face` is the box face's local normal.
+fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>) -> SnowSample {
+    var m: SnowSample;
+    let q = p.xz + s.pattern.xy;
+    m.ao = 1.0;
+    m.ground = 0.0;
+    m.f0 = 0.02;
+    m.wrap = 0.35;
+    if face.y > 0.5 {
+        let n = snow_rnm(snow_macro_normal(q), snow_detail_normal(q, 1.0));
+        m.normal = snow_ts_to_local(n);
+        m.albedo = SNOW_FRESH;
+        m.roughness = 0.62;
+        m.transition = 0.0;
+    } else {
+        // The cut through the snow at an open edge: faint layers of successive snowfalls.
+        let along = dot(p.xz, vec2<f32>(-face.z, face.x));
+        let layers = snow_noise(vec2<f32>(along * 2.0, p.y * 40.0)).x;
+        m.normal = face;
+        m.albedo = SNOW_FRESH * (0.85 + 0.1 * layers);
+        m.roughness = 0.8;
+        m.transition = 0.45;
+        m.ao = mix(0.6, 1.0, clamp(p.y / max(s.snow_depth, 1e-3), 0.0, 1.0));
+    }
+    m.albedo = snow_sss_tint(m.albedo, m.transition, sky);
+    return m;
+}
+
+// The deformable snow material: the two stages of the talk (untouched snow, flattened ground)
+// blended by the heightmap at the relief hit. `hf` is `snow_heightfield` at the hit, `face` the
+// entry face's local normal.
+fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>, sky: vec3<f32>) -> SnowSample {
+    if hit.side == 1u {
+        var cut = snow_basic(s, hit.position, face, sky);
+        cut.ao = min(cut.ao, mix(1.0, hf.w, s.look.z));
+        return cut;
+    }
+    let p = hit.position;
+    let q = p.xz + s.pattern.xy;
+    let dep = clamp(hf.x, 0.0, 1.0);
+    // Stage weights: how much ground shows, and the transition (walls and rims of prints).
+    let ground = smoothstep(s.look.x, s.look.y, dep);
+    let rim = smoothstep(0.01, 0.12, dep);
+    let transition = rim * (1.0 - ground) * (0.55 + 0.45 * (1.0 - smoothstep(0.3, 0.9, dep)));
+
+    // Normals. The heightmap's normal is the base; on it, RNM puts the snow's macro wave (pressed
+    // flat where the snow is packed) and its detail, or the ground's own normal where it shows.
+    let hn = vec3<f32>(hf.y, hf.z, sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)));
+    let flatten = 1.0 - smoothstep(0.0, 0.5, dep);
+    let wave = normalize(mix(vec3<f32>(0.0, 0.0, 1.0), snow_macro_normal(q), flatten));
+    let snow_n = snow_rnm(wave, snow_detail_normal(q, mix(1.0, 0.45, dep)));
+    var ground_layer: SnowLayer;
+    if ground > 0.0 {
+        ground_layer = snow_ground_layer(s, q);
+    } else {
+        ground_layer.albedo = vec3<f32>(0.0);
+        ground_layer.roughness = 1.0;
+        ground_layer.normal = vec3<f32>(0.0, 0.0, 1.0);
+        ground_layer.f0 = 0.04;
+    }
+    // Detail normals of the two stages are mixed as perturbations of the same surface, then
+    // reoriented onto the heightmap's normal.
+    let detail = normalize(mix(snow_n, ground_layer.normal, ground));
+    let n = snow_rnm(hn, detail);
+
+    // Diffuse and specular: a simple lerp between the stages, as in the talk. The ground is wet
+    // where the snow was pressed onto it.
+    let snow_albedo = mix(SNOW_FRESH, SNOW_PACKED, smoothstep(0.05, 0.8, dep));
+    let wet_ground = ground_layer.albedo * 0.6;
+    var m: SnowSample;
+    m.albedo = snow_sss_tint(mix(snow_albedo, wet_ground, ground), transition, sky);
+    m.roughness = mix(mix(0.62, 0.5, dep), ground_layer.roughness * 0.55, ground);
+    m.f0 = mix(0.02, 0.05, ground);
+    m.normal = snow_ts_to_local(n);
+    m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z);
+    m.ground = ground;
+    m.transition = transition;
+    m.wrap = 0.35 * (1.0 - ground);
+    return m;
+}

@@ -1,0 +1,208 @@
+// surface.wgsl: the snow pass. Each surface is drawn as the box of its snow slab (top face at
+// y = snow_depth, four sides down to the ground) in its local frame; every fragment of the
+// deformable material traces its view ray through the heightfield (snow.wgsl) and writes the depth
+// of the point it hits, so characters standing in prints and bodies lying in trenches are hidden
+// and shown correctly.
+// Prepended: frame.wgsl, snow.wgsl.
+// Reads: frame uniforms, shadow map, the surface's heightfield texture (heightfield.wgsl).
+// Writes: scene colour (HDR) and depth.
+
+@group(1) @binding(0) var<uniform> surface: SnowSurface;
+@group(1) @binding(1) var heightfield: texture_2d<f32>;
+
+// Set when the device cannot filter Rgba16Float: bilinear filtering is then done by hand.
+override MANUAL_FILTER: bool = false;
+
+// Corners of the five visible faces of the box (no bottom): face k uses vertices 6k..6k+5.
+fn box_vertex(i: u32) -> array<vec3<f32>, 2> {
+    let face = i / 6u;
+    let corner = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    )[i % 6u];
+    let a = corner * 2.0 - 1.0;
+    let hx = surface.half_size.x;
+    let hz = surface.half_size.y;
+    let top = surface.snow_depth;
+    let y = corner.y * top;
+    var p: vec3<f32>;
+    var n: vec3<f32>;
+    switch face {
+        // Top: counter-clockwise seen from above.
+        case 0u: {
+            p = vec3<f32>(a.x * hx, top, -a.y * hz);
+            n = vec3<f32>(0.0, 1.0, 0.0);
+        }
+        case 1u: {
+            p = vec3<f32>(hx, y, -a.x * hz);
+            n = vec3<f32>(1.0, 0.0, 0.0);
+        }
+        case 2u: {
+            p = vec3<f32>(-hx, y, a.x * hz);
+            n = vec3<f32>(-1.0, 0.0, 0.0);
+        }
+        case 3u: {
+            p = vec3<f32>(a.x * hx, y, hz);
+            n = vec3<f32>(0.0, 0.0, 1.0);
+        }
+        default: {
+            p = vec3<f32>(-a.x * hx, y, -hz);
+            n = vec3<f32>(0.0, 0.0, -1.0);
+        }
+    }
+    return array<vec3<f32>, 2>(p, n);
+}
+
+struct SurfaceVarying {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) local: vec3<f32>,
+    @location(1) @interpolate(flat) face: vec3<f32>,
+}
+
+@vertex
+fn vs_surface(@builtin(vertex_index) i: u32) -> SurfaceVarying {
+    let v = box_vertex(i);
+    var out: SurfaceVarying;
+    let world = surface.local_to_world * vec4<f32>(v[0], 1.0);
+    out.clip = frame.view_proj * world;
+    out.local = v[0];
+    out.face = v[1];
+    return out;
+}
+
+fn load_texel(c: vec2<i32>) -> vec4<f32> {
+    let size = vec2<i32>(surface.grid);
+    return textureLoad(heightfield, clamp(c, vec2<i32>(0), size - 1), 0);
+}
+
+// Bilinear filtering by hand (the fallback when the format cannot be filtered).
+fn manual_bilinear(uv: vec2<f32>) -> vec4<f32> {
+    let p = uv * surface.grid - 0.5;
+    let i = floor(p);
+    let f = p - i;
+    let c = vec2<i32>(i);
+    let a = mix(load_texel(c), load_texel(c + vec2<i32>(1, 0)), f.x);
+    let b = mix(load_texel(c + vec2<i32>(0, 1)), load_texel(c + vec2<i32>(1, 1)), f.x);
+    return mix(a, b, f.y);
+}
+
+fn sample_bilinear(uv: vec2<f32>) -> vec4<f32> {
+    if MANUAL_FILTER {
+        return manual_bilinear(uv);
+    }
+    return textureSampleLevel(heightfield, linear_sampler, uv, 0.0);
+}
+
+// The heightfield contract of snow.wgsl, for the search: one bilinear tap with its weights
+// remapped by a smoothstep, so that the heightfield has no creases at texel boundaries (creases
+// show as stair-steps on grazing rims).
+fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    let p = uv * s.grid + 0.5;
+    let i = floor(p);
+    let f = p - i;
+    let w = f * f * (3.0 - 2.0 * f);
+    return sample_bilinear((i + w - 0.5) / s.grid).x;
+}
+
+// ... and for shading: a cubic B-spline from four bilinear taps (smooth normals and occlusion,
+// no texel grid).
+fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
+    let p = uv * s.grid - 0.5;
+    let i = floor(p);
+    let f = p - i;
+    let f2 = f * f;
+    let f3 = f2 * f;
+    let w0 = (1.0 / 6.0) * (-f3 + 3.0 * f2 - 3.0 * f + 1.0);
+    let w1 = (1.0 / 6.0) * (3.0 * f3 - 6.0 * f2 + 4.0);
+    let w2 = (1.0 / 6.0) * (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0);
+    let w3 = (1.0 / 6.0) * f3;
+    let g0 = w0 + w1;
+    let g1 = w2 + w3;
+    let h0 = (i - 0.5 + w1 / g0) / s.grid;
+    let h1 = (i + 1.5 + w3 / g1) / s.grid;
+    let a = mix(sample_bilinear(vec2<f32>(h1.x, h0.y)), sample_bilinear(vec2<f32>(h0.x, h0.y)), g0.x);
+    let b = mix(sample_bilinear(vec2<f32>(h1.x, h1.y)), sample_bilinear(vec2<f32>(h0.x, h1.y)), g0.x);
+    return mix(b, a, g0.y);
+}
+
+fn sky_tint() -> vec3<f32> {
+    return mix(vec3<f32>(1.0), frame.sss_tint.rgb, frame.sss_tint.w);
+}
+
+fn shade(m: SnowSample, local: vec3<f32>, shadow_in: f32) -> vec3<f32> {
+    let world = (surface.local_to_world * vec4<f32>(local, 1.0)).xyz;
+    let n = normalize((surface.local_to_world * vec4<f32>(m.normal, 0.0)).xyz);
+    let shadow = moon_shadow(world, n) * shadow_in;
+    return light_surface(m.albedo, m.roughness, m.f0, n, world, m.ao, m.wrap, shadow);
+}
+
+struct SnowOut {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+// The deformable snow material (the talk's second material): relief mapping (or POM), the two
+// stages blended by the heightmap, RNM normals, fake SSS, occlusion from the heightmap.
+@fragment
+fn fs_deformable(in: SurfaceVarying) -> SnowOut {
+    let eye = (surface.world_to_local * vec4<f32>(frame.eye.xyz, 1.0)).xyz;
+    let d = normalize(in.local - eye);
+    let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
+    let hit = snow_trace(surface, in.local, d, frame.options.z, moon);
+    if hit.found == 0u {
+        discard;
+    }
+    let hf = snow_heightfield(surface, snow_uv(surface, hit.position.xz));
+    let m = snow_deformable(surface, hit, hf, in.face, sky_tint());
+    var c = shade(m, hit.position, hit.shadow);
+    switch frame.options.x {
+        case DEBUG_MATERIALS: {
+            c = mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
+        }
+        case DEBUG_DEPRESSION: {
+            c = debug_ramp(hf.x);
+        }
+        case DEBUG_OCCLUSION: {
+            c = vec3<f32>(m.ao);
+        }
+        case DEBUG_NORMALS: {
+            c = m.normal * 0.5 + 0.5;
+        }
+        case DEBUG_TAPS: {
+            c = debug_ramp(f32(hit.taps) / 48.0);
+        }
+        default: {}
+    }
+    var out: SnowOut;
+    out.color = vec4<f32>(c, 1.0);
+    let world = surface.local_to_world * vec4<f32>(hit.position, 1.0);
+    let clip = frame.view_proj * world;
+    out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
+    return out;
+}
+
+// The basic snow material (the talk's first material): untouched snow, no heightmap, no search.
+@fragment
+fn fs_basic(in: SurfaceVarying) -> @location(0) vec4<f32> {
+    let m = snow_basic(surface, in.local, in.face, sky_tint());
+    var c = shade(m, in.local, 1.0);
+    switch frame.options.x {
+        case DEBUG_MATERIALS: {
+            c = vec3<f32>(0.15, 0.8, 0.3) * (0.5 + 0.5 * m.normal.y);
+        }
+        case DEBUG_DEPRESSION: {
+            c = debug_ramp(0.0);
+        }
+        case DEBUG_OCCLUSION: {
+            c = vec3<f32>(m.ao);
+        }
+        case DEBUG_NORMALS: {
+            c = m.normal * 0.5 + 0.5;
+        }
+        case DEBUG_TAPS: {
+            c = debug_ramp(0.0);
+        }
+        default: {}
+    }
+    return vec4<f32>(c, 1.0);
+}
