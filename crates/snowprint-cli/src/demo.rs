@@ -1,12 +1,69 @@
-//! `snowprint demo`: the built-in demo.
+//! `snowprint demo`: the built-in demo world, simulated and rendered.
+//!
+//! Writes into `--out` (default `out/`): numbered frames `frame_0000.png`..., an animation
+//! `demo.gif` (and `demo.mp4` when `ffmpeg` is on the PATH), `contact_sheet.png` of six frames, and
+//! `report.json` (adapter, resolution, frames, tier, camera, per-pass GPU times or why there are
+//! none, and which surfaces were drawn with the basic material). Everything is written to a
+//! scratch folder first and moved into place at the end, the report last: a run that fails leaves
+//! no output that looks complete.
+//!
+//! The world comes from one function, [`build_scene`], returning a [`DemoScene`]: swap it for
+//! another world (the library's `snowprint::demo` once it lands) without touching the rest.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-use snowprint::GpuOptions;
-use snowprint::scene::Scene;
+use indicatif::{ProgressBar, ProgressStyle};
+use snowprint::render::{DebugView, Environment, Instance, PointLight, RenderConfig, RenderFrame, Renderer, Tier};
+use snowprint::{Camera, Deformer, GpuContext, GpuOptions, GroundMaterial, SnowWorld, SurfaceId, WorldConfig};
 
-/// The scene the demo runs.
-pub const DEMO_SCENE: &str = include_str!("../../../scenes/walker.toml");
+#[path = "contact_sheet.rs"]
+mod contact_sheet;
+#[path = "standin.rs"]
+mod standin;
+
+
+/// A world the demo can simulate and draw. Built once (surfaces into the world, meshes into the
+/// renderer), then asked what happens at each moment.
+pub trait DemoScene {
+    /// A short description for the report.
+    fn name(&self) -> &str;
+    /// Snow surfaces with the ground under each.
+    fn surfaces(&self) -> &[(SurfaceId, GroundMaterial)];
+    /// Street lamps and other point lights.
+    fn lights(&self) -> &[PointLight];
+    /// Moon, sky and haze.
+    fn environment(&self) -> Environment;
+    /// Everything pressing the snow while time goes from `t0` to `t1` (poses at both ends).
+    fn deformers(&self, t0: f32, t1: f32) -> Vec<Deformer>;
+    /// Meshes to draw at time `t`.
+    fn instances(&self, t: f32) -> Vec<Instance>;
+    /// Names of the cameras.
+    fn cameras(&self) -> &[&'static str];
+    /// Seconds of the action a camera's clip covers.
+    fn span(&self, camera: &str) -> (f32, f32);
+    /// A camera at time `t`; `None` for an unknown name.
+    fn camera(&self, name: &str, t: f32) -> Option<Camera>;
+}
+
+/// The demo world. Until the library's demo world (`snowprint::demo`) lands, the stand-in.
+pub fn build_scene(world: &mut SnowWorld, renderer: &mut Renderer) -> Result<Box<dyn DemoScene>, String> {
+    Ok(Box::new(standin::StandIn::new(world, renderer)?))
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size {s:?} is not WIDTHxHEIGHT, such as 1280x720"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (16..=8192).contains(&n))
+            .ok_or_else(|| format!("size {s:?}: {v:?} must be a whole number of pixels from 16 to 8192"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
 
 /// Arguments of `snowprint demo`.
 #[derive(clap::Args, Debug)]
@@ -14,29 +71,371 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Frames to run (default: the whole walk).
+    /// Frames to render (default: 240 on a GPU, 36 on a software adapter). One frame shows the end
+    /// of the camera's clip.
     #[arg(long)]
     pub frames: Option<u32>,
-    /// Which demo: `rooftops` or `city` (several hundred surfaces under the manager's budget).
-    #[arg(long, default_value = "rooftops")]
-    pub scene: String,
+    /// Frame size, WIDTHxHEIGHT (default: 1280x720 on a GPU, 480x270 on a software adapter).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Camera: flythrough, closeup, overview, street or angel.
+    #[arg(long, default_value = "flythrough")]
+    pub camera: String,
+    /// Snow tracing: relief (the talk's relief mapping) or pom (parallax occlusion mapping).
+    #[arg(long, default_value = "relief")]
+    pub tier: Tier,
+    /// Samples per pixel along each axis, 1 to 4 (default: 2 on a GPU, 1 on a software adapter).
+    #[arg(long)]
+    pub supersample: Option<u32>,
+    /// What the frames show: shaded, materials, depression, occlusion, normals or taps.
+    #[arg(long, default_value = "shaded")]
+    pub debug_view: DebugView,
+    /// No falling snow.
+    #[arg(long)]
+    pub no_snowfall: bool,
+    /// Start of the clip, seconds of action (default: the camera's).
+    #[arg(long)]
+    pub from: Option<f32>,
+    /// End of the clip, seconds of action (default: the camera's).
+    #[arg(long)]
+    pub to: Option<f32>,
+    /// Simulation steps per second, whatever the frame count (default: 60 on a GPU, 30 on a
+    /// software adapter; deformers are swept between steps, so trails stay continuous).
+    #[arg(long)]
+    pub sim_hz: Option<u32>,
 }
 
-/// Run the built-in walker scene and write its heightmaps.
-pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
-    if args.scene == "city" {
-        return crate::city::run(gpu, &args.out, args.frames);
+/// Statistics of one pass over the frames.
+#[derive(serde::Serialize)]
+struct PassStats {
+    pass: &'static str,
+    median_ms: f64,
+    mean_ms: f64,
+    max_ms: f64,
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
     }
-    let scene =
-        Scene::parse(DEMO_SCENE, Path::new("scenes/walker.toml")).map_err(|e| e.to_string())?;
-    let dt = 1.0 / 60.0;
-    let frames = args
-        .frames
-        .unwrap_or(((scene.duration() / dt).ceil() as u32).max(1) + 30);
-    crate::simulate::simulate(gpu, &scene, frames, dt, &args.out)?;
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+}
+
+/// Files written by a run, in the scratch folder until published.
+struct Staging {
+    dir: PathBuf,
+    out: PathBuf,
+    files: Vec<String>,
+}
+
+impl Staging {
+    fn new(out: &Path) -> Result<Self, String> {
+        std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+        let dir = out.join(format!(".snowprint-demo-partial-{}", std::process::id()));
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(|e| format!("cannot clear {}: {e}", dir.display()))?;
+        }
+        std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        Ok(Self {
+            dir,
+            out: out.to_owned(),
+            files: Vec::new(),
+        })
+    }
+
+    fn path(&mut self, name: &str) -> PathBuf {
+        self.files.push(name.to_owned());
+        self.dir.join(name)
+    }
+
+    /// Move everything into the output folder, replacing the outputs of an earlier run; the report
+    /// goes last so that its presence means the run finished.
+    fn publish(mut self) -> Result<Vec<String>, String> {
+        let stale = std::fs::read_dir(&self.out)
+            .map_err(|e| format!("cannot list {}: {e}", self.out.display()))?
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| {
+                (n.starts_with("frame_") && n.ends_with(".png"))
+                    || ["demo.gif", "demo.mp4", "contact_sheet.png", "report.json"].contains(&n.as_str())
+            });
+        for name in stale {
+            let p = self.out.join(&name);
+            std::fs::remove_file(&p).map_err(|e| format!("cannot replace {}: {e}", p.display()))?;
+        }
+        self.files.sort_by_key(|n| n == "report.json");
+        for name in &self.files {
+            let (from, to) = (self.dir.join(name), self.out.join(name));
+            std::fs::rename(&from, &to).map_err(|e| format!("cannot move {} to {}: {e}", from.display(), to.display()))?;
+        }
+        let _ = std::fs::remove_dir_all(&self.dir);
+        Ok(std::mem::take(&mut self.files))
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        // After a failure (or after publishing) the scratch folder goes.
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// Run the demo and write its outputs.
+pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
+    let wall = Instant::now();
+    let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
+    let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
+    let (default_frames, default_size, default_ss) = if software { (36, (480, 270), 1) } else { (240, (1280, 720), 2) };
+    let frames = args.frames.unwrap_or(default_frames);
+    if frames == 0 {
+        return Err("--frames 0 renders nothing; give at least 1".into());
+    }
+    let (width, height) = args.size.unwrap_or(default_size);
+    let supersample = args.supersample.unwrap_or(default_ss);
+    let sim_hz = args.sim_hz.unwrap_or(if software { 30 } else { 60 });
+    if !(1..=1000).contains(&sim_hz) {
+        return Err(format!("--sim-hz {sim_hz}: give 1 to 1000 steps per second"));
+    }
+    let sim_dt = 1.0 / sim_hz as f32;
+    let mut notes = Vec::new();
+    if software && (args.frames.is_none() || args.size.is_none() || args.supersample.is_none()) {
+        let note = format!(
+            "{} is a software adapter: defaults scaled down to {frames} frames of {width}x{height}, no supersampling, 30 simulation steps per second (a GPU gets 240 frames of 1280x720, 2x2 supersampled, 60 steps per second); pass --frames/--size/--supersample/--sim-hz to change",
+            ctx.info.name
+        );
+        eprintln!("snowprint: {note}");
+        notes.push(note);
+    }
+
+    let mut world = SnowWorld::new(&ctx, WorldConfig::default()).map_err(|e| e.to_string())?;
+    let mut config = RenderConfig::new(width, height, args.tier);
+    config.supersample = supersample;
+    config.debug_view = args.debug_view;
+    if software {
+        config.snowflakes = 3000;
+    }
+    let mut renderer = Renderer::new(&ctx, config).map_err(|e| e.to_string())?;
+    let scene = build_scene(&mut world, &mut renderer)?;
+    if !scene.cameras().contains(&args.camera.as_str()) {
+        return Err(format!(
+            "unknown camera {:?}; this demo has {}",
+            args.camera,
+            scene.cameras().join(", ")
+        ));
+    }
+    let (mut t0, mut t1) = scene.span(&args.camera);
+    if let Some(f) = args.from {
+        t0 = f;
+    }
+    if let Some(t) = args.to {
+        t1 = t;
+    }
+    if !(t0.is_finite() && t1.is_finite() && t0 >= 0.0 && t1 >= t0) {
+        return Err(format!("--from {t0} / --to {t1}: give 0 <= from <= to seconds"));
+    }
+    let times: Vec<f32> = (0..frames)
+        .map(|k| {
+            if frames == 1 {
+                t1
+            } else {
+                t0 + (t1 - t0) * k as f32 / (frames - 1) as f32
+            }
+        })
+        .collect();
+
+    let mut staging = Staging::new(&args.out)?;
+    let sheet_frames = contact_sheet::pick(frames as usize, 6);
+    let mut sheet_images = Vec::new();
+    let gif_path = staging.path("demo.gif");
+    let delay_ms = if frames > 1 {
+        ((t1 - t0) / (frames - 1) as f32 * 1000.0).clamp(20.0, 200.0) as u32
+    } else {
+        1000
+    };
+    let mut gif = contact_sheet::GifWriter::create(&gif_path, width, height, delay_ms)?;
+
+    let bar = ProgressBar::new(frames as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:12} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, about {eta} left")
+            .map_err(|e| e.to_string())?
+            .progress_chars("=> "),
+    );
+    bar.set_message("simulating");
+
+    let mut sim_t = 0.0f32;
+    let mut sim_ms = 0.0;
+    let mut render_ms = Vec::new();
+    let mut pass_ms: Vec<(&'static str, Vec<f64>)> = Vec::new();
+    let mut first_surfaces = None;
+    let mut last_surfaces = Vec::new();
+    let instances_count;
+    {
+        let mut last_instances = 0;
+        for (k, &t) in times.iter().enumerate() {
+            bar.set_message("simulating");
+            let start = Instant::now();
+            while sim_t + sim_dt <= t + 1e-4 {
+                let d = scene.deformers(sim_t, sim_t + sim_dt);
+                world.step(sim_dt, &d).map_err(|e| e.to_string())?;
+                sim_t += sim_dt;
+            }
+            sim_ms += start.elapsed().as_secs_f64() * 1e3;
+            bar.set_message("rendering");
+            let camera = scene
+                .camera(&args.camera, t)
+                .ok_or_else(|| format!("camera {:?} has no view at {t} s", args.camera))?;
+            let instances = scene.instances(t);
+            last_instances = instances.len();
+            let frame = RenderFrame {
+                camera,
+                time: t,
+                surfaces: scene.surfaces(),
+                instances: &instances,
+                lights: scene.lights(),
+                environment: scene.environment(),
+                snowfall: !args.no_snowfall,
+            };
+            let out = renderer.render(&world, &frame).map_err(|e| e.to_string())?;
+            render_ms.push(out.cpu_ms);
+            for p in &out.pass_times {
+                match pass_ms.iter_mut().find(|(n, _)| *n == p.name) {
+                    Some((_, v)) => v.push(p.gpu_ms),
+                    None => pass_ms.push((p.name, vec![p.gpu_ms])),
+                }
+            }
+            if first_surfaces.is_none() {
+                first_surfaces = Some(out.surfaces.clone());
+            }
+            last_surfaces = out.surfaces.clone();
+            let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
+                .ok_or("the renderer returned a frame of the wrong size")?;
+            let name = format!("frame_{k:04}.png");
+            let path = staging.path(&name);
+            image
+                .save(&path)
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            gif.add(&image)?;
+            if sheet_frames.contains(&k) {
+                sheet_images.push((k, t, image));
+            }
+            bar.inc(1);
+        }
+        instances_count = last_instances;
+    }
+    bar.set_message("encoding");
+    gif.finish()?;
+    let sheet = contact_sheet::compose(&sheet_images);
+    let sheet_path = staging.path("contact_sheet.png");
+    sheet
+        .save(&sheet_path)
+        .map_err(|e| format!("cannot write {}: {e}", sheet_path.display()))?;
+    let mp4 = if frames > 1 {
+        let mp4_path = staging.dir.join("demo.mp4");
+        let fps = (1000.0 / delay_ms as f32).round().max(1.0);
+        let made = contact_sheet::encode_mp4(&staging.dir, &mp4_path, fps);
+        if made {
+            staging.files.push("demo.mp4".into());
+        } else {
+            notes.push("ffmpeg is not on the PATH (or failed): no demo.mp4".into());
+        }
+        made
+    } else {
+        false
+    };
+    bar.finish_and_clear();
+
+    let surfaces_json: Vec<serde_json::Value> = scene
+        .surfaces()
+        .iter()
+        .map(|(id, ground)| {
+            let desc = world.surface(*id).ok();
+            let first = first_surfaces
+                .as_ref()
+                .and_then(|v| v.iter().find(|s| s.surface == *id))
+                .map(|s| s.material);
+            let last = last_surfaces.iter().find(|s| s.surface == *id);
+            serde_json::json!({
+                "index": id.index(),
+                "name": desc.map(|d| d.name.clone()),
+                "size_m": desc.map(|d| d.size.to_array()),
+                "snow_depth_m": desc.map(|d| d.snow_depth),
+                "heightmap": world.layout(*id).ok().map(|l| [l.width, l.height]),
+                "ground": ground,
+                "material_first_frame": first,
+                "material_last_frame": last.map(|s| s.material),
+                "deepest_print_last_frame": last.map(|s| s.deepest),
+            })
+        })
+        .collect();
+    let basic_last: Vec<u32> = last_surfaces
+        .iter()
+        .filter(|s| s.material == snowprint::render::SnowMaterialKind::Basic)
+        .map(|s| s.surface.index())
+        .collect();
+    let gpu_times: Vec<PassStats> = pass_ms
+        .iter_mut()
+        .map(|(name, v)| PassStats {
+            pass: name,
+            mean_ms: v.iter().sum::<f64>() / v.len().max(1) as f64,
+            max_ms: v.iter().copied().fold(0.0, f64::max),
+            median_ms: median(v),
+        })
+        .collect();
+    let timestamps_note = if renderer.has_timestamps() {
+        serde_json::Value::Null
+    } else {
+        serde_json::json!(format!("{} has no GPU timestamp queries: per-pass GPU times are unavailable; CPU times per frame are reported instead", ctx.info.name))
+    };
+    let mut outputs: Vec<String> = staging.files.clone();
+    outputs.push("report.json".into());
+    let report = serde_json::json!({
+        "adapter": {
+            "name": ctx.info.name,
+            "backend": format!("{:?}", ctx.info.backend),
+            "device_type": format!("{:?}", ctx.info.device_type),
+            "driver": format!("{} {}", ctx.info.driver, ctx.info.driver_info),
+            "software": software,
+        },
+        "resolution": [width, height],
+        "supersample": supersample,
+        "frames": frames,
+        "tier": args.tier,
+        "camera": args.camera,
+        "debug_view": args.debug_view,
+        "scene": scene.name(),
+        "clip_seconds": [t0, t1],
+        "simulation_hz": sim_hz,
+        "instances_last_frame": instances_count,
+        "search": renderer.config().search_settings(),
+        "passes": renderer.passes(),
+        "gpu_pass_times_ms": gpu_times,
+        "gpu_pass_times_note": timestamps_note,
+        "cpu_ms": {
+            "simulation_total": sim_ms,
+            "render_median_per_frame": median(&mut render_ms.clone()),
+            "render_total": render_ms.iter().sum::<f64>(),
+        },
+        "surfaces": surfaces_json,
+        "basic_material_surfaces_last_frame": basic_last,
+        "notes": notes,
+        "outputs": outputs,
+        "mp4": mp4,
+        "wall_seconds": wall.elapsed().as_secs_f64(),
+    });
+    let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
+    let report_path = staging.path("report.json");
+    std::fs::write(&report_path, text).map_err(|e| format!("cannot write {}: {e}", report_path.display()))?;
+    let files = staging.publish()?;
     eprintln!(
-        "snowprint: wrote the heightmaps of {} surface(s) to {}",
-        scene.surfaces.len(),
+        "snowprint: {} frames of {width}x{height} ({}, camera {}) in {:.0} s on {}: {} files in {}",
+        frames,
+        args.tier,
+        args.camera,
+        wall.elapsed().as_secs_f64(),
+        ctx.info.name,
+        files.len(),
         args.out.display()
     );
     Ok(())

@@ -124,9 +124,11 @@ pub fn relief_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, ta
 }
 
 /// Parallax occlusion mapping: the same linear taps, then the crossing of the straight line through
-/// the last tap above the snow and the first below it (exact for a planar heightfield, within the
-/// bracket `t_max / taps` otherwise). Must match `snow_pom_search` in `snow.wgsl`.
-pub fn pom_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, taps: u32) -> Option<f32> {
+/// the last tap above the snow and the first below it, repeated `refine` times on the bracket that
+/// keeps the crossing (false position): exact for a planar heightfield, always within the bracket
+/// `t_max / taps`, and converging fast on a smooth one (without it, the layers of the linear taps
+/// show as bands on the walls of prints). Must match `snow_pom_search` in `snow.wgsl`.
+pub fn pom_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, taps: u32, refine: u32) -> Option<f32> {
     // Signed height of the ray over the snow, minus the slack: <= 0 means inside.
     let above = |t: f32| {
         let p = ray.at(t);
@@ -142,7 +144,20 @@ pub fn pom_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, taps:
         let t = dt * i as f32;
         let f = above(t);
         if f <= 0.0 {
-            return Some(lo + (t - lo) * f_lo / (f_lo - f));
+            let (mut hi, mut f_hi) = (t, f);
+            let mut x = lo + (hi - lo) * f_lo / (f_lo - f_hi);
+            for _ in 0..refine {
+                let fx = above(x);
+                if fx <= 0.0 {
+                    hi = x;
+                    f_hi = fx;
+                } else {
+                    lo = x;
+                    f_lo = fx;
+                }
+                x = lo + (hi - lo) * f_lo / (f_lo - f_hi);
+            }
+            return Some(x);
         }
         lo = t;
         f_lo = f;
@@ -161,6 +176,43 @@ pub fn sobel_normal(depression: impl Fn(i32, i32) -> f32, col: i32, row: i32, sn
     let dhdx = gx / (8.0 * texel.x);
     let dhdz = gz / (8.0 * texel.y);
     Vec3::new(-dhdx, 1.0, -dhdz).normalize()
+}
+
+/// Width of the soft shadow's penumbra per metre travelled towards the light, and at the start.
+/// Must match `PENUMBRA_SLOPE` and `PENUMBRA_BASE` in `heightfield.wgsl`.
+pub const PENUMBRA_SLOPE: f32 = 0.12;
+/// See [`PENUMBRA_SLOPE`].
+pub const PENUMBRA_BASE: f32 = 0.01;
+/// Most taps of [`light_visibility`] (must match `LIGHT_TAPS` in `heightfield.wgsl`).
+pub const LIGHT_TAPS: u32 = 16;
+
+/// How much of a light in local direction `light` (unit, pointing to the light) reaches the snow
+/// at local `(x, z)`: march from the snow there up to the top of the slab, a tap per texel crossed
+/// (at most [`LIGHT_TAPS`]); each tap compares the ray's height with the snow's, over a penumbra
+/// that widens with the distance travelled (`0.5 + (ray - snow) / (2 * width)`, clamped), and the
+/// darkest tap wins. 1 in the open, 0 at the bottom of a print the light cannot see into.
+/// `height(x, z)` is the snow's height above the ground in metres. Must match `light_visibility`
+/// in `heightfield.wgsl`.
+pub fn light_visibility(height: impl Fn(f32, f32) -> f32, x: f32, z: f32, light: Vec3, snow_depth: f32, texel: f32) -> f32 {
+    if light.y <= 0.02 {
+        return 0.0;
+    }
+    let h0 = height(x, z);
+    let t_top = (snow_depth - h0) / light.y;
+    if t_top <= 0.0 {
+        return 1.0;
+    }
+    let across = Vec2::new(light.x, light.z).length() * t_top / texel;
+    let taps = across.ceil().clamp(1.0, LIGHT_TAPS as f32) as u32;
+    let mut visible = 1.0f32;
+    for i in 1..=taps {
+        let t = t_top * i as f32 / taps as f32;
+        let p = Vec3::new(x, h0, z) + light * t;
+        let width = PENUMBRA_BASE + PENUMBRA_SLOPE * t;
+        let v = (0.5 + (p.y - height(p.x, p.z)) / (2.0 * width)).clamp(0.0, 1.0);
+        visible = visible.min(v);
+    }
+    visible
 }
 
 /// Directions of the horizon search of [`horizon_ao`] (must match `AO_DIRS` in `heightfield.wgsl`).
@@ -308,7 +360,7 @@ mod tests {
         for dir in [Vec3::new(1.0, -0.3, 0.2), Vec3::new(0.3, -1.0, -0.1), Vec3::new(2.0, -0.25, 1.0)] {
             let (h, r, exact) = plane_case(dir);
             let (t_max, _) = slab_exit(&r, HALF, DEPTH);
-            let t = pom_search(&h, &r, t_max, 8).expect("hit");
+            let t = pom_search(&h, &r, t_max, 8, 0).expect("hit");
             // The secant of a linear function is exact; the slack shifts it by eps / |d(above)/dt|.
             let bound = INSIDE_EPSILON / (r.dir.y - 0.04 * r.dir.x).abs() + 1e-5;
             assert!((t - exact).abs() <= bound, "{dir}: {t} vs {exact}");
@@ -351,10 +403,15 @@ mod tests {
                 let t = relief_search(&h, &r, t_max, taps, 5).expect("hit");
                 let bound = t_max / taps as f32 / 64.0 + slack;
                 assert!((t - exact).abs() <= bound, "relief {dir} {taps}: {t} vs {exact} (bound {bound})");
-                let t = pom_search(&h, &r, t_max, taps).expect("hit");
+                let t = pom_search(&h, &r, t_max, taps, 0).expect("hit");
                 // The secant lies inside the bracket of one tap.
                 let bound = t_max / taps as f32 + slack;
                 assert!((t - exact).abs() <= bound, "pom {dir} {taps}: {t} vs {exact} (bound {bound})");
+                // False position keeps the crossing bracketed and closes in on it: three steps
+                // land within a hundredth of a tap here (the dent is smooth at the crossing).
+                let refined = pom_search(&h, &r, t_max, taps, 3).expect("hit");
+                let bound = t_max / taps as f32 * 0.01 + slack;
+                assert!((refined - exact).abs() <= bound, "pom+3 {dir} {taps}: {refined} vs {exact} (bound {bound})");
             }
         }
     }
@@ -364,14 +421,14 @@ mod tests {
         let flat = |_: Vec2| DEPTH;
         let r = ray(Vec3::new(0.0, DEPTH, 0.0), Vec3::new(1.0, -0.5, 0.0));
         assert_eq!(relief_search(flat, &r, 1.0, 8, 5), Some(0.0));
-        assert_eq!(pom_search(flat, &r, 1.0, 8), Some(0.0));
+        assert_eq!(pom_search(flat, &r, 1.0, 8, 3), Some(0.0));
         // A trench open at the +x edge: the ray leaves through the side without meeting snow.
         let trench = |p: Vec2| if p.x > 1.0 { 0.0 } else { DEPTH };
         let r = ray(Vec3::new(1.5, DEPTH, 0.0), Vec3::new(1.0, -0.2, 0.0));
         let (t_max, ground) = slab_exit(&r, HALF, DEPTH);
         assert!(!ground);
         assert_eq!(relief_search(trench, &r, t_max, 8, 5), None);
-        assert_eq!(pom_search(trench, &r, t_max, 8), None);
+        assert_eq!(pom_search(trench, &r, t_max, 8, 3), None);
     }
 
     #[test]
@@ -391,6 +448,22 @@ mod tests {
         let n = sobel_normal(dep, 5, 5, 0.3, Vec2::splat(0.04));
         let slope = 0.03 / 0.04;
         assert!(close(n, Vec3::new(slope, 1.0, 0.0).normalize(), 1e-5), "{n}");
+    }
+
+    #[test]
+    fn light_reaches_flat_snow_and_not_the_bottom_of_a_trench() {
+        let light = Vec3::new(0.8, 0.45, 0.0).normalize();
+        assert_eq!(light_visibility(|_, _| 0.2, 0.0, 0.0, light, 0.2, 0.04), 1.0);
+        // A trench 0.4 m wide and 0.18 m deep along z: its floor near the wall towards the light
+        // sees the wall (dark); the wall facing the light and the far floor are lit.
+        let trench = |x: f32, _z: f32| if x.abs() < 0.2 { 0.02 } else { 0.2 };
+        let near_wall = light_visibility(trench, 0.12, 0.0, light, 0.2, 0.04);
+        assert!(near_wall < 0.05, "{near_wall}");
+        // Far from the wall that casts the shadow: the ray rises 0.18 m within 0.32 m, clear.
+        let open = light_visibility(trench, -0.19, 0.0, light, 0.2, 0.04);
+        assert!(open > near_wall, "{open}");
+        // The moon below the horizon lights nothing.
+        assert_eq!(light_visibility(|_, _| 0.2, 0.0, 0.0, Vec3::new(1.0, -0.1, 0.0), 0.2, 0.04), 0.0);
     }
 
     #[test]

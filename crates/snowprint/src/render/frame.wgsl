@@ -20,6 +20,7 @@ struct Frame {
     sky_horizon: vec4<f32>,     // rgb: sky at the horizon; w: fog density per metre
     ground_bounce: vec4<f32>,   // rgb: light bounced from below; w: city glow on the horizon
     sss_tint: vec4<f32>,        // rgb: the sky tint of the snow's transition zone (luminance about 1); w: its strength
+    sky_ambient: vec4<f32>,     // rgb: light from the whole sky on a surface facing up; w unused
     viewport: vec4<f32>,        // internal (supersampled) width, height, and their reciprocals
     options: vec4<u32>,         // x: debug view, y: point lights in use, z: tier, w: snowflakes
     lights: array<PointLight, 8>,
@@ -61,8 +62,7 @@ fn sky_radiance(dir: vec3<f32>) -> vec3<f32> {
 
 // Light from the sky and the ground reaching a surface facing `n` (hemisphere lighting).
 fn ambient_light(n: vec3<f32>) -> vec3<f32> {
-    let sky = 0.5 * (frame.sky_zenith.rgb + frame.sky_horizon.rgb);
-    return mix(frame.ground_bounce.rgb, sky, clamp(n.y * 0.5 + 0.5, 0.0, 1.0));
+    return mix(frame.ground_bounce.rgb, frame.sky_ambient.rgb, clamp(n.y * 0.5 + 0.5, 0.0, 1.0));
 }
 
 // Moon shadow at a world point with normal `n`: 3x3 PCF on the shadow map, offset along the normal

@@ -58,6 +58,8 @@ pub struct FrameUniform {
     pub ground_bounce: [f32; 4],
     /// Sky tint of the snow's transition zone; w: strength.
     pub sss_tint: [f32; 4],
+    /// Light from the whole sky on a surface facing up; w unused.
+    pub sky_ambient: [f32; 4],
     /// Internal width, height and reciprocals.
     pub viewport: [f32; 4],
     /// Debug view, point lights, tier, snowflakes.
@@ -128,6 +130,8 @@ pub struct HeightfieldParams {
     pub texel_z: f32,
     /// Padding.
     pub _pad2: f32,
+    /// Unit direction towards the moon in the surface's local frame; w unused.
+    pub light: [f32; 4],
 }
 
 /// A mesh vertex. Must match `MeshVertex` in `mesh.wgsl`.
@@ -219,6 +223,7 @@ mod tests {
             ("sky_horizon", std::mem::offset_of!(FrameUniform, sky_horizon)),
             ("ground_bounce", std::mem::offset_of!(FrameUniform, ground_bounce)),
             ("sss_tint", std::mem::offset_of!(FrameUniform, sss_tint)),
+            ("sky_ambient", std::mem::offset_of!(FrameUniform, sky_ambient)),
             ("viewport", std::mem::offset_of!(FrameUniform, viewport)),
             ("options", std::mem::offset_of!(FrameUniform, options)),
             ("lights", std::mem::offset_of!(FrameUniform, lights)),

@@ -1,10 +1,12 @@
 // heightfield.wgsl: turns one surface's heightmap in the pool into the texture the snow material
 // samples with filtering: (depression, normal.x, normal.z, ambient occlusion) per texel. Normals
 // by a 3x3 Sobel filter, occlusion from the horizon of the snow around each texel (the talk's
-// "derive parametric AO from the heightmap"). Dispatched indirectly: zero workgroups for a surface
-// on the basic material.
-// Reads: the heightmap pool. Writes: the surface's heightfield texture.
-// CPU reference: render::cpu::{sobel_normal, horizon_ao}.
+// "derive parametric AO from the heightmap"), and a second texture with the moon's visibility
+// over the snow of each texel (a soft shadow of the prints' walls on their floors, computed once
+// per texel instead of per pixel). Dispatched indirectly: zero workgroups for a surface on the
+// basic material.
+// Reads: the heightmap pool. Writes: the surface's heightfield and light textures.
+// CPU reference: render::cpu::{sobel_normal, horizon_ao, light_visibility}.
 
 // Must match `HeightfieldParams` in src/render/gpu.rs.
 struct HeightfieldParams {
@@ -16,11 +18,18 @@ struct HeightfieldParams {
     texel_x: f32,
     texel_z: f32,
     _pad2: f32,
+    light: vec4<f32>,   // xyz: unit direction towards the moon in the surface's local frame
 }
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
 @group(0) @binding(1) var<uniform> params: HeightfieldParams;
 @group(0) @binding(2) var out_texture: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(3) var out_light: texture_storage_2d<rgba16float, write>;
+
+// Must match PENUMBRA_SLOPE, PENUMBRA_BASE and LIGHT_TAPS in cpu.rs.
+const PENUMBRA_SLOPE: f32 = 0.12;
+const PENUMBRA_BASE: f32 = 0.01;
+const LIGHT_TAPS: u32 = 16u;
 
 // Must match AO_DIRECTIONS and AO_RADII in cpu.rs.
 const AO_DIRS: u32 = 8u;
@@ -37,6 +46,45 @@ fn height_at(c: i32, r: i32, dx: f32, dz: f32) -> f32 {
     let oc = i32(round(dx / params.texel_x));
     let orow = i32(round(dz / params.texel_z));
     return params.snow_depth * (1.0 - depression(c + oc, r + orow));
+}
+
+// Snow height at a local offset (metres) from texel (c, r), bilinear between texel centres.
+fn height_bilinear(c: i32, r: i32, dx: f32, dz: f32) -> f32 {
+    let fx = dx / params.texel_x;
+    let fz = dz / params.texel_z;
+    let ix = floor(fx);
+    let iz = floor(fz);
+    let wx = fx - ix;
+    let wz = fz - iz;
+    let x0 = c + i32(ix);
+    let z0 = r + i32(iz);
+    let a = mix(depression(x0, z0), depression(x0 + 1, z0), wx);
+    let b = mix(depression(x0, z0 + 1), depression(x0 + 1, z0 + 1), wx);
+    return params.snow_depth * (1.0 - mix(a, b, wz));
+}
+
+// Must match `light_visibility` in cpu.rs.
+fn light_visibility(c: i32, r: i32) -> f32 {
+    let l = params.light.xyz;
+    if l.y <= 0.02 {
+        return 0.0;
+    }
+    let h0 = height_bilinear(c, r, 0.0, 0.0);
+    let t_top = (params.snow_depth - h0) / l.y;
+    if t_top <= 0.0 {
+        return 1.0;
+    }
+    let across = length(l.xz) * t_top / max(params.texel_x, params.texel_z);
+    let taps = u32(clamp(ceil(across), 1.0, f32(LIGHT_TAPS)));
+    var visible = 1.0;
+    for (var i = 1u; i <= taps; i++) {
+        let t = t_top * f32(i) / f32(taps);
+        let p = vec3<f32>(0.0, h0, 0.0) + l * t;
+        let width = PENUMBRA_BASE + PENUMBRA_SLOPE * t;
+        let v = clamp(0.5 + (p.y - height_bilinear(c, r, p.x, p.z)) / (2.0 * width), 0.0, 1.0);
+        visible = min(visible, v);
+    }
+    return visible;
 }
 
 // Must match `sobel_normal` in cpu.rs.
@@ -84,4 +132,5 @@ fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = sobel_normal(c, r);
     let ao = horizon_ao(c, r);
     textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(depression(c, r), n.x, n.z, ao));
+    textureStore(out_light, vec2<i32>(c, r), vec4<f32>(light_visibility(c, r), 0.0, 0.0, 1.0));
 }

@@ -12,6 +12,10 @@ fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
     return vec4<f32>(0.0, 0.0, 0.0, 1.0);
 }
 
+fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    return 1.0;
+}
+
 // Must match `MeshMaterial` in src/render/mod.rs.
 const MATERIAL_PLAIN: u32 = 0u;
 const MATERIAL_BRICK: u32 = 1u;
@@ -84,20 +88,23 @@ struct MeshSurface {
     f0: f32,
 }
 
-// Brick courses of 7.5 cm, bricks 22 cm long, mortar lines 1 cm.
-fn brick(p: vec2<f32>, base: vec3<f32>, seed: f32) -> vec3<f32> {
+// Brick courses of 7.5 cm, bricks 22 cm long, mortar lines 1 cm; mortar and brick-to-brick variation
+// fade to their average once they are smaller than a pixel (`pixel`, metres), so walls do not
+// shimmer or show moire in the distance.
+fn brick(p: vec2<f32>, base: vec3<f32>, seed: f32, pixel: f32) -> vec3<f32> {
     let course = floor(p.y / 0.075);
     let x = p.x / 0.225 + 0.5 * (course - 2.0 * floor(course * 0.5));
     let id = vec2<i32>(i32(floor(x)), i32(course) + i32(seed * 97.0));
     let fx = fract(x);
     let fy = fract(p.y / 0.075);
     let mortar = smoothstep(0.0, 0.05, fx) * smoothstep(0.0, 0.05, 1.0 - fx) * smoothstep(0.0, 0.13, fy) * smoothstep(0.0, 0.13, 1.0 - fy);
-    let v = snow_hash2(id);
+    let v = mix(snow_hash2(id), 0.5, smoothstep(0.02, 0.06, pixel));
     let b = base * (0.7 + 0.6 * v) * (0.85 + 0.3 * snow_noise(p * 3.0).x);
-    return mix(vec3<f32>(0.22, 0.21, 0.2), b, mortar);
+    let m = mix(mortar, 0.78, smoothstep(0.003, 0.012, pixel));
+    return mix(vec3<f32>(0.22, 0.21, 0.2), b, m);
 }
 
-fn material(in: MeshVarying, n: vec3<f32>) -> MeshSurface {
+fn material(in: MeshVarying, n: vec3<f32>, pixel: f32) -> MeshSurface {
     let kind = u32(in.albedo_material.w + 0.5);
     let base = in.albedo_material.rgb;
     var s: MeshSurface;
@@ -109,12 +116,12 @@ fn material(in: MeshVarying, n: vec3<f32>) -> MeshSurface {
     let w = wall_coords(in.world, n);
     switch kind {
         case MATERIAL_BRICK: {
-            s.albedo = brick(w, base, in.params.w);
+            s.albedo = brick(w, base, in.params.w, pixel);
         }
         case MATERIAL_FACADE: {
             // Brick with a grid of windows: 1.1 m x 1.5 m, every 3 m, floors 3.2 m high. A third
             // of them are lit, warm.
-            s.albedo = brick(w, base, in.params.w);
+            s.albedo = brick(w, base, in.params.w, pixel);
             let cell = vec2<f32>(w.x / 3.0, (w.y - 0.9) / 3.2);
             let id = vec2<i32>(floor(cell)) + vec2<i32>(i32(in.params.w * 131.0), 0);
             let f = fract(cell) * vec2<f32>(3.0, 3.2);
@@ -130,7 +137,7 @@ fn material(in: MeshVarying, n: vec3<f32>) -> MeshSurface {
             }
         }
         case MATERIAL_CONCRETE: {
-            s.albedo = base * (0.75 + 0.5 * snow_fbm(w, 0.9).x);
+            s.albedo = base * (0.75 + 0.5 * snow_fbm(w, 0.9, pixel).x);
         }
         case MATERIAL_METAL: {
             // Painted metal with rust streaks running down.
@@ -152,7 +159,7 @@ fn material(in: MeshVarying, n: vec3<f32>) -> MeshSurface {
     let cover = in.params.z * smoothstep(0.55, 0.85, n.y + 0.15 * (snow_noise(in.world.xz * 4.0).x - 0.5));
     if cover > 0.0 {
         let q = in.world.xz;
-        let sn = snow_ts_to_local(snow_rnm(snow_macro_normal(q), snow_detail_normal(q, 1.0)));
+        let sn = snow_ts_to_local(snow_rnm(snow_macro_normal(q), snow_detail_normal(q, 1.0, pixel)));
         s.albedo = mix(s.albedo, SNOW_FRESH, cover);
         s.roughness = mix(s.roughness, 0.62, cover);
         s.normal = normalize(mix(s.normal, normalize(vec3<f32>(sn.x * 0.5, 1.0, sn.z * 0.5)), cover));
@@ -164,7 +171,7 @@ fn material(in: MeshVarying, n: vec3<f32>) -> MeshSurface {
 @fragment
 fn fs_mesh(in: MeshVarying) -> @location(0) vec4<f32> {
     let n = normalize(in.normal);
-    let s = material(in, n);
+    let s = material(in, n, length(fwidth(in.world)));
     let shadow = moon_shadow(in.world, n);
     var c = light_surface(s.albedo, s.roughness, s.f0, s.normal, in.world, 1.0, 0.0, shadow) + s.emission;
     if frame.options.x == DEBUG_NORMALS {

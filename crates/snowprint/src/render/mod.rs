@@ -235,7 +235,8 @@ pub struct SearchSettings {
     pub min_taps: u32,
     /// Most linear taps.
     pub max_taps: u32,
-    /// Binary refinement taps (relief mapping).
+    /// Refinement taps after the linear search: binary steps (relief mapping) or false-position
+    /// steps (POM).
     pub refine_taps: u32,
     /// Self-shadow taps towards the moon (parallax occlusion mapping).
     pub shadow_taps: u32,
@@ -243,7 +244,7 @@ pub struct SearchSettings {
 
 impl SearchSettings {
     /// The defaults of a tier: relief mapping takes a tap every two texels (4 to 12) and 5 binary
-    /// steps; POM a tap per texel (8 to 40) and 8 self-shadow taps.
+    /// steps; POM a tap per texel (8 to 40), 3 false-position steps and 10 self-shadow taps.
     pub fn for_tier(tier: Tier) -> Self {
         match tier {
             Tier::Relief => Self {
@@ -257,8 +258,8 @@ impl SearchSettings {
                 taps_per_texel: 1.0,
                 min_taps: 8,
                 max_taps: 40,
-                refine_taps: 0,
-                shadow_taps: 8,
+                refine_taps: 3,
+                shadow_taps: 10,
             },
         }
     }
@@ -278,8 +279,8 @@ pub struct SnowLook {
 impl Default for SnowLook {
     fn default() -> Self {
         Self {
-            ground_from: 0.72,
-            ground_full: 0.94,
+            ground_from: 0.66,
+            ground_full: 0.9,
             occlusion: 0.85,
         }
     }
@@ -395,6 +396,8 @@ pub struct Environment {
     pub ground_bounce: Vec3,
     /// Strength of the city's orange glow on the horizon.
     pub city_glow: f32,
+    /// Light from the whole sky on a surface facing up (what lights the snow in shadow).
+    pub sky_ambient: Vec3,
     /// Tint of the snow's transition zone (the fake subsurface scattering), luminance about 1.
     pub sss_tint: Vec3,
     /// Strength of that tint (0 to 1).
@@ -409,16 +412,17 @@ impl Environment {
     /// A clear, cold night with a low moon.
     pub fn moonlit_night() -> Self {
         Self {
-            moon_direction: Vec3::new(-0.55, 0.42, -0.72).normalize(),
-            moon_color: Vec3::new(0.50, 0.60, 0.85),
+            moon_direction: Vec3::new(-0.85, 0.42, 0.3).normalize(),
+            moon_color: Vec3::new(0.55, 0.68, 1.0),
             moon_radius_degrees: 1.6,
             sky_zenith: Vec3::new(0.010, 0.018, 0.045),
             sky_horizon: Vec3::new(0.040, 0.055, 0.090),
             ground_bounce: Vec3::new(0.030, 0.032, 0.040),
             city_glow: 0.05,
-            sss_tint: Vec3::new(0.62, 0.85, 1.35),
-            sss_strength: 0.8,
-            exposure: 1.9,
+            sky_ambient: Vec3::new(0.07, 0.10, 0.19),
+            sss_tint: Vec3::new(0.72, 0.9, 1.25),
+            sss_strength: 0.6,
+            exposure: 0.75,
             fog_density: 0.012,
         }
     }
@@ -672,10 +676,13 @@ impl Growable {
     }
 }
 
+/// A deformed surface's shading textures, written by the heightfield pass.
 struct HeightfieldTexture {
     size: (u32, u32),
-    storage_view: wgpu::TextureView,
-    sample_view: wgpu::TextureView,
+    /// Depression, normal x and z, ambient occlusion.
+    shape: wgpu::TextureView,
+    /// Moon visibility.
+    light: wgpu::TextureView,
 }
 
 struct Targets {
@@ -803,6 +810,19 @@ fn texture_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::Bi
     }
 }
 
+fn storage_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: HEIGHTFIELD_FORMAT,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
 fn depth_state(compare: wgpu::CompareFunction, write: bool) -> Option<wgpu::DepthStencilState> {
     Some(wgpu::DepthStencilState {
         format: DEPTH_FORMAT,
@@ -906,6 +926,7 @@ impl Renderer {
             entries: &[
                 uniform_entry(0, vf),
                 texture_entry(1, wgpu::TextureSampleType::Float { filterable }),
+                texture_entry(2, wgpu::TextureSampleType::Float { filterable }),
             ],
         });
         let tonemap_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -924,16 +945,8 @@ impl Renderer {
             entries: &[
                 storage_entry(0, true),
                 uniform_entry(1, wgpu::ShaderStages::COMPUTE),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: HEIGHTFIELD_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                storage_texture_entry(2),
+                storage_texture_entry(3),
             ],
         });
 
@@ -1674,28 +1687,30 @@ impl Renderer {
     fn heightfield_texture(&mut self, id: SurfaceId, size: (u32, u32)) -> &HeightfieldTexture {
         let stale = self.heightfields.get(&id).is_none_or(|t| t.size != size);
         if stale {
-            let texture = self.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("snow heightfield"),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: HEIGHTFIELD_FORMAT,
-                usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            self.heightfields.insert(
-                id,
-                HeightfieldTexture {
-                    size,
-                    storage_view: texture.create_view(&Default::default()),
-                    sample_view: texture.create_view(&Default::default()),
-                },
-            );
+            let texture = |label| {
+                self.device
+                    .create_texture(&wgpu::TextureDescriptor {
+                        label: Some(label),
+                        size: wgpu::Extent3d {
+                            width: size.0,
+                            height: size.1,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: HEIGHTFIELD_FORMAT,
+                        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    })
+                    .create_view(&Default::default())
+            };
+            let entry = HeightfieldTexture {
+                size,
+                shape: texture("snow heightfield"),
+                light: texture("snow heightfield light"),
+            };
+            self.heightfields.insert(id, entry);
         }
         &self.heightfields[&id]
     }
@@ -1737,6 +1752,7 @@ impl Renderer {
             sky_horizon: v4(e.sky_horizon, e.fog_density),
             ground_bounce: v4(e.ground_bounce, e.city_glow),
             sss_tint: v4(e.sss_tint, e.sss_strength),
+            sky_ambient: v4(e.sky_ambient, 0.0),
             viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
             options: [
                 cfg.debug_view.code(),
@@ -1808,6 +1824,13 @@ impl Renderer {
                 texel_x,
                 texel_z,
                 _pad2: 0.0,
+                light: {
+                    let l = local_to_world
+                        .inverse()
+                        .transform_vector3(frame.environment.moon_direction)
+                        .normalize();
+                    [l.x, l.y, l.z, 0.0]
+                },
             };
             hf_bytes[o..o + std::mem::size_of::<HeightfieldParams>()].copy_from_slice(bytemuck::bytes_of(&p));
             records.push(ClassifyRecord {
@@ -1944,7 +1967,11 @@ impl Renderer {
                     },
                     wgpu::BindGroupEntry {
                         binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&tex.storage_view),
+                        resource: wgpu::BindingResource::TextureView(&tex.shape),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&tex.light),
                     },
                 ],
             }));
@@ -1958,7 +1985,11 @@ impl Renderer {
                     },
                     wgpu::BindGroupEntry {
                         binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&tex.sample_view),
+                        resource: wgpu::BindingResource::TextureView(&tex.shape),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&tex.light),
                     },
                 ],
             }));

@@ -10,6 +10,9 @@
 //   // (depression, normal.x, normal.z, ambient occlusion) at `uv`, as smooth as you can afford
 //   // (the renderer uses a 4-tap bicubic B-spline). Called once per pixel, at the hit.
 //   fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32>
+//   // How much of the moon reaches the snow at `uv` past the walls of the prints (1 = all), or
+//   // 1.0 if you have no such term. Called once per pixel.
+//   fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32
 //
 // UVs run 0..1 across the surface: u along local +x, v along local +z (texel column 0 / row 0 at the
 // smallest x / z, as the heightmap pool stores them). The snowprint renderer fills both from a
@@ -57,7 +60,7 @@ struct SnowHit {
     found: u32,             // 0: the ray left the slab without meeting snow (discard)
     taps: u32,              // heightfield taps spent (debug view)
     side: u32,              // 1: met at the entry on a side face (a cut through the snow)
-    shadow: f32,            // self-shadow of the heightfield towards the light (POM tier), 1 = lit
+    shadow: f32,            // self-shadow of the heightfield towards the light, 1 = lit
 }
 
 // What the material gives to lighting.
@@ -104,8 +107,9 @@ fn snow_noise(p: vec2<f32>) -> vec3<f32> {
 }
 
 // Three octaves of value noise at `freq` cycles per metre, each rotated to hide the lattice:
-// (value in about [0, 1], gradient per metre).
-fn snow_fbm(p: vec2<f32>, freq: f32) -> vec3<f32> {
+// (value in about [0, 1], gradient per metre). Octaves finer than about three pixels (`pixel` is the
+// pixel's footprint in metres) fade out, so that distant snow does not sparkle and crawl.
+fn snow_fbm(p: vec2<f32>, freq: f32, pixel: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     var q = p * freq;
     var f = freq;
@@ -115,7 +119,8 @@ fn snow_fbm(p: vec2<f32>, freq: f32) -> vec3<f32> {
     var back = mat2x2<f32>(1.0, 0.0, 0.0, 1.0);
     for (var o = 0; o < 3; o++) {
         let n = snow_noise(q);
-        sum += vec3<f32>(amp * n.x, amp * f * (back * n.yz));
+        let keep = 1.0 - smoothstep(0.15, 0.35, pixel * f);
+        sum += vec3<f32>(amp * mix(0.5, n.x, keep), amp * keep * f * (back * n.yz));
         q = r * q * 2.03 + vec2<f32>(17.1, 9.3);
         back = back * transpose(r);
         f *= 2.03;
@@ -231,9 +236,9 @@ fn snow_relief_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, ta
     return vec2<f32>(0.5 * (lo + hi), 1.0);
 }
 
-// Parallax occlusion mapping: linear taps, then the secant through the last two. Returns
-// (t, found). Must match `pom_search` in cpu.rs.
-fn snow_pom_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, taps: u32) -> vec2<f32> {
+// Parallax occlusion mapping: linear taps, then the secant through the last two, refined `refine`
+// times by false position. Returns (t, found). Must match `pom_search` in cpu.rs.
+fn snow_pom_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, taps: u32, refine: u32) -> vec2<f32> {
     let f0 = o.y - snow_height(s, o.xz) - SNOW_EPSILON;
     if f0 <= 0.0 {
         return vec2<f32>(0.0, 1.0);
@@ -246,7 +251,22 @@ fn snow_pom_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, taps:
         let p = o + d * t;
         let f = p.y - snow_height(s, p.xz) - SNOW_EPSILON;
         if f <= 0.0 {
-            return vec2<f32>(lo + (t - lo) * f_lo / (f_lo - f), 1.0);
+            var hi = t;
+            var f_hi = f;
+            var x = lo + (hi - lo) * f_lo / (f_lo - f_hi);
+            for (var k = 0u; k < refine; k++) {
+                let q = o + d * x;
+                let fx = q.y - snow_height(s, q.xz) - SNOW_EPSILON;
+                if fx <= 0.0 {
+                    hi = x;
+                    f_hi = fx;
+                } else {
+                    lo = x;
+                    f_lo = fx;
+                }
+                x = lo + (hi - lo) * f_lo / (f_lo - f_hi);
+            }
+            return vec2<f32>(x, 1.0);
         }
         lo = t;
         f_lo = f;
@@ -254,23 +274,25 @@ fn snow_pom_search(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t_max: f32, taps:
     return vec2<f32>(t_max, 0.0);
 }
 
-// Soft self-shadow of the heightfield towards a local light direction `l` (POM tier): march from
-// the hit up to the snow top; the deepest the ray goes under the snow, relative to how far it has
-// travelled, sets the penumbra.
+// Per-pixel soft self-shadow of the heightfield towards a local light direction `l` (POM tier,
+// refining the per-texel visibility): march from the hit up to the snow top, with the penumbra of
+// `light_visibility` (heightfield.wgsl). The march starts a texel's height above the hit, so that
+// the wall the hit lies on does not shadow itself (N.L does that).
 fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f32 {
     if l.y <= 0.02 || taps == 0u {
         return 1.0;
     }
-    let t_top = (s.snow_depth - p.y) / l.y;
-    if t_top <= s.texel * 0.25 {
+    let start = p + vec3<f32>(0.0, 0.5 * s.texel, 0.0);
+    let t_top = (s.snow_depth - start.y) / l.y;
+    if t_top <= 0.0 {
         return 1.0;
     }
     var lit = 1.0;
     for (var i = 1u; i <= taps; i++) {
-        let t = t_top * (f32(i) - 0.5) / f32(taps);
-        let q = p + l * t;
-        let under = snow_height(s, q.xz) - q.y;
-        lit = min(lit, 1.0 - clamp(under / (0.08 * t + 0.004), 0.0, 1.0));
+        let t = t_top * f32(i) / f32(taps);
+        let q = start + l * t;
+        let width = 0.01 + 0.12 * t;
+        lit = min(lit, clamp(0.5 + (q.y - snow_height(s, q.xz)) / (2.0 * width), 0.0, 1.0));
     }
     return lit;
 }
@@ -285,24 +307,27 @@ fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_lo
     let exit = snow_slab_exit(s, o, d);
     let taps = snow_linear_taps(s, d, exit.x);
     var r: vec2<f32>;
+    let refine = u32(s.search.w);
     if tier == SNOW_TIER_POM {
-        r = snow_pom_search(s, o, d, exit.x, taps);
-        hit.taps = taps + 1u;
+        r = snow_pom_search(s, o, d, exit.x, taps, refine);
     } else {
-        let refine = u32(s.search.w);
         r = snow_relief_search(s, o, d, exit.x, taps, refine);
-        hit.taps = taps + refine + 1u;
     }
+    hit.taps = taps + refine + 1u;
     hit.t = r.x;
     hit.found = u32(r.y);
     hit.position = o + d * r.x;
     if r.x == 0.0 && o.y < s.snow_depth - 1e-3 {
         hit.side = 1u;
     }
-    if tier == SNOW_TIER_POM && hit.found == 1u && hit.side == 0u {
-        let shadow_taps = u32(s.look.w);
-        hit.shadow = snow_self_shadow(s, hit.position, light_local, shadow_taps);
-        hit.taps += shadow_taps;
+    if hit.found == 1u && hit.side == 0u {
+        hit.shadow = snow_light_visibility(s, snow_uv(s, hit.position.xz));
+        hit.taps += 1u;
+        if tier == SNOW_TIER_POM {
+            let shadow_taps = u32(s.look.w);
+            hit.shadow = min(hit.shadow, snow_self_shadow(s, hit.position, light_local, shadow_taps));
+            hit.taps += shadow_taps;
+        }
     }
     return hit;
 }
@@ -327,8 +352,8 @@ fn snow_macro_normal(p: vec2<f32>) -> vec3<f32> {
 }
 
 // Grain of the snow: a few millimetres over a few centimetres.
-fn snow_detail_normal(p: vec2<f32>, strength: f32) -> vec3<f32> {
-    let n = snow_fbm(p, 14.0);
+fn snow_detail_normal(p: vec2<f32>, strength: f32, pixel: f32) -> vec3<f32> {
+    let n = snow_fbm(p, 14.0, pixel);
     return snow_normal_from_gradient(n.yz * 0.004 * strength);
 }
 
@@ -341,7 +366,7 @@ struct SnowLayer {
 
 // Clay roof tiles in staggered rows along local z: each tile rises towards the row above (where it
 // hides under the next one) and is curved across; dark gaps between tiles.
-fn snow_roof_tiles(p: vec2<f32>) -> SnowLayer {
+fn snow_roof_tiles(p: vec2<f32>, pixel: f32) -> SnowLayer {
     let row_pitch = 0.30;
     let tile_w = 0.22;
     let row = floor(p.y / row_pitch);
@@ -354,29 +379,32 @@ fn snow_roof_tiles(p: vec2<f32>) -> SnowLayer {
     // Height profile and its gradient (per metre).
     let dhdz = 0.014 / row_pitch;
     let dhdx = 0.007 * SNOW_PI * cos(SNOW_PI * fx) / tile_w;
-    let grain = snow_fbm(p, 40.0);
-    var n = snow_normal_from_gradient(vec2<f32>(dhdx, dhdz) + grain.yz * 0.0008);
+    let grain = snow_fbm(p, 40.0, pixel);
+    // Gaps fade to their average once they are thinner than a pixel.
+    let blur = smoothstep(0.004, 0.02, pixel);
+    let shape = 1.0 - smoothstep(0.01, 0.05, pixel);
+    var n = snow_normal_from_gradient(vec2<f32>(dhdx, dhdz) * shape + grain.yz * 0.0008);
     // Gaps: the lower edge of each row (a shadowed step) and the joints between tiles.
-    let edge_z = smoothstep(0.0, 0.06, fz);
-    let edge_x = smoothstep(0.0, 0.05, fx) * smoothstep(0.0, 0.05, 1.0 - fx);
+    let edge_z = mix(smoothstep(0.0, 0.06, fz), 0.8, blur);
+    let edge_x = mix(smoothstep(0.0, 0.05, fx) * smoothstep(0.0, 0.05, 1.0 - fx), 0.85, blur);
     let gap = edge_z * edge_x;
     let clay = mix(vec3<f32>(0.30, 0.085, 0.05), vec3<f32>(0.42, 0.16, 0.08), v);
     let weathered = mix(clay, vec3<f32>(0.16, 0.12, 0.10), 0.35 * snow_noise(p * 1.3).x);
     var layer: SnowLayer;
     layer.albedo = weathered * (0.25 + 0.75 * gap) * (0.85 + 0.3 * grain.x);
     layer.roughness = mix(0.75, 0.45, gap);
-    layer.normal = normalize(mix(vec3<f32>(0.0, -0.6, 0.8), n, 0.3 + 0.7 * edge_z));
+    layer.normal = normalize(mix(vec3<f32>(0.0, -0.6, 0.8), n, mix(0.3 + 0.7 * edge_z, 1.0, blur)));
     layer.f0 = 0.04;
     return layer;
 }
 
 // Concrete: blotchy grey with a fine grain and expansion joints every 2 m.
-fn snow_concrete(p: vec2<f32>) -> SnowLayer {
-    let blotch = snow_fbm(p, 0.8);
-    let grain = snow_fbm(p, 35.0);
+fn snow_concrete(p: vec2<f32>, pixel: f32) -> SnowLayer {
+    let blotch = snow_fbm(p, 0.8, pixel);
+    let grain = snow_fbm(p, 35.0, pixel);
     let cell = p / 2.0;
     let f = abs(cell - round(cell)) * 2.0;            // 0 on a joint
-    let joint = smoothstep(0.0, 0.012, min(f.x, f.y));
+    let joint = mix(smoothstep(0.0, 0.012, min(f.x, f.y)), 0.97, smoothstep(0.005, 0.02, pixel));
     var layer: SnowLayer;
     let base = vec3<f32>(0.30, 0.30, 0.29) * (0.75 + 0.5 * blotch.x) * (0.9 + 0.2 * grain.x);
     layer.albedo = base * (0.35 + 0.65 * joint);
@@ -386,17 +414,17 @@ fn snow_concrete(p: vec2<f32>) -> SnowLayer {
     let groove = vec2<f32>(
         select(0.0, s.x * 0.35, f.x < 0.012),
         select(0.0, s.y * 0.35, f.y < 0.012),
-    );
+    ) * (1.0 - smoothstep(0.005, 0.02, pixel));
     layer.normal = snow_normal_from_gradient(grain.yz * 0.0012 + groove);
     layer.f0 = 0.04;
     return layer;
 }
 
-fn snow_ground_layer(s: SnowSurface, p: vec2<f32>) -> SnowLayer {
+fn snow_ground_layer(s: SnowSurface, p: vec2<f32>, pixel: f32) -> SnowLayer {
     if s.ground == SNOW_GROUND_CONCRETE {
-        return snow_concrete(p);
+        return snow_concrete(p, pixel);
     }
-    return snow_roof_tiles(p);
+    return snow_roof_tiles(p, pixel);
 }
 
 // Fresh snow: bright, faintly blue; packed snow at the bottom of prints: greyer and smoother.
@@ -410,8 +438,9 @@ fn snow_sss_tint(albedo: vec3<f32>, transition: f32, sky: vec3<f32>) -> vec3<f32
 }
 
 // The basic snow material: fresh, untouched snow, no heightmap at all (the talk's cheaper material
-// for surfaces nothing has pressed). `face` is the box face's local normal.
-fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>) -> SnowSample {
+// for surfaces nothing has pressed). `face` is the box face's local normal, `pixel` the pixel's
+// footprint on the surface in metres (detail finer than a few pixels fades out).
+fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>, pixel: f32) -> SnowSample {
     var m: SnowSample;
     let q = p.xz + s.pattern.xy;
     m.ao = 1.0;
@@ -419,7 +448,7 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>) -> 
     m.f0 = 0.02;
     m.wrap = 0.35;
     if face.y > 0.5 {
-        let n = snow_rnm(snow_macro_normal(q), snow_detail_normal(q, 1.0));
+        let n = snow_rnm(snow_macro_normal(q), snow_detail_normal(q, 1.0, pixel));
         m.normal = snow_ts_to_local(n);
         m.albedo = SNOW_FRESH;
         m.roughness = 0.62;
@@ -440,16 +469,18 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>) -> 
 
 // The deformable snow material: the two stages of the talk (untouched snow, flattened ground)
 // blended by the heightmap at the relief hit. `hf` is `snow_heightfield` at the hit, `face` the
-// entry face's local normal.
-fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>, sky: vec3<f32>) -> SnowSample {
+// entry face's local normal, `pixel` the pixel's footprint in metres.
+fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>, sky: vec3<f32>, pixel: f32) -> SnowSample {
     if hit.side == 1u {
-        var cut = snow_basic(s, hit.position, face, sky);
+        var cut = snow_basic(s, hit.position, face, sky, pixel);
         cut.ao = min(cut.ao, mix(1.0, hf.w, s.look.z));
         return cut;
     }
     let p = hit.position;
     let q = p.xz + s.pattern.xy;
-    let dep = clamp(hf.x, 0.0, 1.0);
+    // The depression where the ray met the snow is the hit's own depth: it drives the stages (the
+    // filtered `hf.x` is smoother but rounds off the bottoms of narrow prints).
+    let dep = clamp(max(hf.x, 1.0 - p.y / s.snow_depth), 0.0, 1.0);
     // Stage weights: how much ground shows, and the transition (walls and rims of prints).
     let ground = smoothstep(s.look.x, s.look.y, dep);
     let rim = smoothstep(0.01, 0.12, dep);
@@ -460,10 +491,10 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     let hn = vec3<f32>(hf.y, hf.z, sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)));
     let flatten = 1.0 - smoothstep(0.0, 0.5, dep);
     let wave = normalize(mix(vec3<f32>(0.0, 0.0, 1.0), snow_macro_normal(q), flatten));
-    let snow_n = snow_rnm(wave, snow_detail_normal(q, mix(1.0, 0.45, dep)));
+    let snow_n = snow_rnm(wave, snow_detail_normal(q, mix(1.0, 0.45, dep), pixel));
     var ground_layer: SnowLayer;
     if ground > 0.0 {
-        ground_layer = snow_ground_layer(s, q);
+        ground_layer = snow_ground_layer(s, q, pixel);
     } else {
         ground_layer.albedo = vec3<f32>(0.0);
         ground_layer.roughness = 1.0;

@@ -9,6 +9,7 @@
 
 @group(1) @binding(0) var<uniform> surface: SnowSurface;
 @group(1) @binding(1) var heightfield: texture_2d<f32>;
+@group(1) @binding(2) var heightfield_light: texture_2d<f32>;
 
 // Set when the device cannot filter Rgba16Float: bilinear filtering is then done by hand.
 override MANUAL_FILTER: bool = false;
@@ -125,6 +126,15 @@ fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
     return mix(b, a, g0.y);
 }
 
+// ... and the moon's visibility over the prints (heightfield.wgsl), one bilinear tap.
+fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    if MANUAL_FILTER {
+        let size = vec2<i32>(s.grid);
+        return textureLoad(heightfield_light, clamp(vec2<i32>(uv * s.grid), vec2<i32>(0), size - 1), 0).x;
+    }
+    return textureSampleLevel(heightfield_light, linear_sampler, uv, 0.0).x;
+}
+
 fn sky_tint() -> vec3<f32> {
     return mix(vec3<f32>(1.0), frame.sss_tint.rgb, frame.sss_tint.w);
 }
@@ -145,6 +155,8 @@ struct SnowOut {
 // stages blended by the heightmap, RNM normals, fake SSS, occlusion from the heightmap.
 @fragment
 fn fs_deformable(in: SurfaceVarying) -> SnowOut {
+    // Footprint of the pixel on the surface, before any non-uniform control flow.
+    let pixel = length(fwidth(in.local));
     let eye = (surface.world_to_local * vec4<f32>(frame.eye.xyz, 1.0)).xyz;
     let d = normalize(in.local - eye);
     let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
@@ -153,7 +165,7 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
         discard;
     }
     let hf = snow_heightfield(surface, snow_uv(surface, hit.position.xz));
-    let m = snow_deformable(surface, hit, hf, in.face, sky_tint());
+    let m = snow_deformable(surface, hit, hf, in.face, sky_tint(), pixel);
     var c = shade(m, hit.position, hit.shadow);
     switch frame.options.x {
         case DEBUG_MATERIALS: {
@@ -184,7 +196,7 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
 // The basic snow material (the talk's first material): untouched snow, no heightmap, no search.
 @fragment
 fn fs_basic(in: SurfaceVarying) -> @location(0) vec4<f32> {
-    let m = snow_basic(surface, in.local, in.face, sky_tint());
+    let m = snow_basic(surface, in.local, in.face, sky_tint(), length(fwidth(in.local)));
     var c = shade(m, in.local, 1.0);
     switch frame.options.x {
         case DEBUG_MATERIALS: {
