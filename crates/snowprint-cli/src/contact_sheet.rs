@@ -72,7 +72,11 @@ pub fn compose(frames: &[(usize, f32, RgbaImage)]) -> RgbaImage {
     let cols = frames.len().clamp(1, 3) as u32;
     let rows = (frames.len() as u32).div_ceil(cols);
     let pad = 8;
-    let mut sheet = RgbaImage::from_pixel(cols * (tw + pad) + pad, rows * (th + pad) + pad, Rgba([12, 13, 18, 255]));
+    let mut sheet = RgbaImage::from_pixel(
+        cols * (tw + pad) + pad,
+        rows * (th + pad) + pad,
+        Rgba([12, 13, 18, 255]),
+    );
     for (i, (k, t, img)) in frames.iter().enumerate() {
         let thumb = imageops::resize(img, tw, th, imageops::FilterType::Triangle);
         let (c, r) = (i as u32 % cols, i as u32 / cols);
@@ -80,7 +84,14 @@ pub fn compose(frames: &[(usize, f32, RgbaImage)]) -> RgbaImage {
         imageops::overlay(&mut sheet, &thumb, x as i64, y as i64);
         let label = format!("#{k} t={t:.2}s");
         draw_text(&mut sheet, &label, x + 7, y + 7, 2, Rgba([0, 0, 0, 255]));
-        draw_text(&mut sheet, &label, x + 6, y + 6, 2, Rgba([255, 255, 255, 255]));
+        draw_text(
+            &mut sheet,
+            &label,
+            x + 6,
+            y + 6,
+            2,
+            Rgba([255, 255, 255, 255]),
+        );
     }
     sheet
 }
@@ -95,8 +106,10 @@ pub struct GifWriter {
 impl GifWriter {
     /// Start a looping GIF at `path`.
     pub fn create(path: &Path, width: u32, height: u32, delay_ms: u32) -> Result<Self, String> {
-        let file = std::fs::File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
-        let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+        let file = std::fs::File::create(path)
+            .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+        let mut encoder =
+            image::codecs::gif::GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
         encoder
             .set_repeat(image::codecs::gif::Repeat::Infinite)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
@@ -114,9 +127,19 @@ impl GifWriter {
         let img = if img.dimensions() == self.size {
             img.clone()
         } else {
-            imageops::resize(img, self.size.0, self.size.1, imageops::FilterType::Triangle)
+            imageops::resize(
+                img,
+                self.size.0,
+                self.size.1,
+                imageops::FilterType::Triangle,
+            )
         };
-        let frame = image::Frame::from_parts(img, 0, 0, image::Delay::from_numer_denom_ms(self.delay_ms, 1));
+        let frame = image::Frame::from_parts(
+            img,
+            0,
+            0,
+            image::Delay::from_numer_denom_ms(self.delay_ms, 1),
+        );
         self.encoder
             .encode_frame(frame)
             .map_err(|e| format!("GIF encoding failed: {e}"))
@@ -138,7 +161,14 @@ pub fn encode_mp4(dir: &Path, out: &Path, fps: f32) -> bool {
         .args(["-framerate", &format!("{fps}")])
         .arg("-i")
         .arg(dir.join("frame_%04d.png"))
-        .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2"])
+        .args([
+            "-c:v",
+            "libx264",
+            "-pix_fmt",
+            "yuv420p",
+            "-vf",
+            "scale=trunc(iw/2)*2:trunc(ih/2)*2",
+        ])
         .arg(out)
         .stdin(std::process::Stdio::null())
         .stdout(std::process::Stdio::null())
@@ -161,7 +191,12 @@ mod tests {
     #[test]
     fn sheet_has_a_cell_per_frame() {
         let img = RgbaImage::from_pixel(64, 36, Rgba([200, 0, 0, 255]));
-        let s = compose(&[(0, 0.0, img.clone()), (5, 1.5, img.clone()), (9, 3.0, img.clone()), (12, 4.0, img)]);
+        let s = compose(&[
+            (0, 0.0, img.clone()),
+            (5, 1.5, img.clone()),
+            (9, 3.0, img.clone()),
+            (12, 4.0, img),
+        ]);
         assert_eq!(s.dimensions(), (3 * 72 + 8, 2 * 44 + 8));
     }
 }

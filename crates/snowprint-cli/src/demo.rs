@@ -14,14 +14,17 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use snowprint::render::{DebugView, Environment, Instance, PointLight, RenderConfig, RenderFrame, Renderer, Tier};
-use snowprint::{Camera, Deformer, GpuContext, GpuOptions, GroundMaterial, SnowWorld, SurfaceId, WorldConfig};
+use snowprint::render::{
+    DebugView, Environment, Instance, PointLight, RenderConfig, RenderFrame, Renderer, Tier,
+};
+use snowprint::{
+    Camera, Deformer, GpuContext, GpuOptions, GroundMaterial, SnowWorld, SurfaceId, WorldConfig,
+};
 
 #[path = "contact_sheet.rs"]
 mod contact_sheet;
 #[path = "standin.rs"]
 mod standin;
-
 
 /// A world the demo can simulate and draw. Built once (surfaces into the world, meshes into the
 /// renderer), then asked what happens at each moment.
@@ -47,7 +50,10 @@ pub trait DemoScene {
 }
 
 /// The demo world. Until the library's demo world (`snowprint::demo`) lands, the stand-in.
-pub fn build_scene(world: &mut SnowWorld, renderer: &mut Renderer) -> Result<Box<dyn DemoScene>, String> {
+pub fn build_scene(
+    world: &mut SnowWorld,
+    renderer: &mut Renderer,
+) -> Result<Box<dyn DemoScene>, String> {
     Ok(Box::new(standin::StandIn::new(world, renderer)?))
 }
 
@@ -60,7 +66,9 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .parse::<u32>()
             .ok()
             .filter(|&n| (16..=8192).contains(&n))
-            .ok_or_else(|| format!("size {s:?}: {v:?} must be a whole number of pixels from 16 to 8192"))
+            .ok_or_else(|| {
+                format!("size {s:?}: {v:?} must be a whole number of pixels from 16 to 8192")
+            })
     };
     Ok((parse(w)?, parse(h)?))
 }
@@ -120,7 +128,11 @@ fn median(v: &mut [f64]) -> f64 {
     }
     v.sort_by(f64::total_cmp);
     let n = v.len();
-    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
 }
 
 /// Files written by a run, in the scratch folder until published.
@@ -132,12 +144,15 @@ struct Staging {
 
 impl Staging {
     fn new(out: &Path) -> Result<Self, String> {
-        std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+        std::fs::create_dir_all(out)
+            .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
         let dir = out.join(format!(".snowprint-demo-partial-{}", std::process::id()));
         if dir.exists() {
-            std::fs::remove_dir_all(&dir).map_err(|e| format!("cannot clear {}: {e}", dir.display()))?;
+            std::fs::remove_dir_all(&dir)
+                .map_err(|e| format!("cannot clear {}: {e}", dir.display()))?;
         }
-        std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         Ok(Self {
             dir,
             out: out.to_owned(),
@@ -159,7 +174,8 @@ impl Staging {
             .map(|e| e.file_name().to_string_lossy().into_owned())
             .filter(|n| {
                 (n.starts_with("frame_") && n.ends_with(".png"))
-                    || ["demo.gif", "demo.mp4", "contact_sheet.png", "report.json"].contains(&n.as_str())
+                    || ["demo.gif", "demo.mp4", "contact_sheet.png", "report.json"]
+                        .contains(&n.as_str())
             });
         for name in stale {
             let p = self.out.join(&name);
@@ -168,7 +184,8 @@ impl Staging {
         self.files.sort_by_key(|n| n == "report.json");
         for name in &self.files {
             let (from, to) = (self.dir.join(name), self.out.join(name));
-            std::fs::rename(&from, &to).map_err(|e| format!("cannot move {} to {}: {e}", from.display(), to.display()))?;
+            std::fs::rename(&from, &to)
+                .map_err(|e| format!("cannot move {} to {}: {e}", from.display(), to.display()))?;
         }
         let _ = std::fs::remove_dir_all(&self.dir);
         Ok(std::mem::take(&mut self.files))
@@ -187,7 +204,11 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let wall = Instant::now();
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
-    let (default_frames, default_size, default_ss) = if software { (36, (480, 270), 1) } else { (240, (1280, 720), 2) };
+    let (default_frames, default_size, default_ss) = if software {
+        (36, (480, 270), 1)
+    } else {
+        (240, (1280, 720), 2)
+    };
     let frames = args.frames.unwrap_or(default_frames);
     if frames == 0 {
         return Err("--frames 0 renders nothing; give at least 1".into());
@@ -196,7 +217,9 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let supersample = args.supersample.unwrap_or(default_ss);
     let sim_hz = args.sim_hz.unwrap_or(if software { 30 } else { 60 });
     if !(1..=1000).contains(&sim_hz) {
-        return Err(format!("--sim-hz {sim_hz}: give 1 to 1000 steps per second"));
+        return Err(format!(
+            "--sim-hz {sim_hz}: give 1 to 1000 steps per second"
+        ));
     }
     let sim_dt = 1.0 / sim_hz as f32;
     let mut notes = Vec::new();
@@ -233,7 +256,9 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         t1 = t;
     }
     if !(t0.is_finite() && t1.is_finite() && t0 >= 0.0 && t1 >= t0) {
-        return Err(format!("--from {t0} / --to {t1}: give 0 <= from <= to seconds"));
+        return Err(format!(
+            "--from {t0} / --to {t1}: give 0 <= from <= to seconds"
+        ));
     }
     let times: Vec<f32> = (0..frames)
         .map(|k| {
@@ -258,9 +283,11 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
 
     let bar = ProgressBar::new(frames as u64);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} {msg:12} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, about {eta} left")
-            .map_err(|e| e.to_string())?
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{spinner} {msg:12} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, about {eta} left",
+        )
+        .map_err(|e| e.to_string())?
+        .progress_chars("=> "),
     );
     bar.set_message("simulating");
 
@@ -386,7 +413,10 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let timestamps_note = if renderer.has_timestamps() {
         serde_json::Value::Null
     } else {
-        serde_json::json!(format!("{} has no GPU timestamp queries: per-pass GPU times are unavailable; CPU times per frame are reported instead", ctx.info.name))
+        serde_json::json!(format!(
+            "{} has no GPU timestamp queries: per-pass GPU times are unavailable; CPU times per frame are reported instead",
+            ctx.info.name
+        ))
     };
     let mut outputs: Vec<String> = staging.files.clone();
     outputs.push("report.json".into());
@@ -426,7 +456,8 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     });
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
     let report_path = staging.path("report.json");
-    std::fs::write(&report_path, text).map_err(|e| format!("cannot write {}: {e}", report_path.display()))?;
+    std::fs::write(&report_path, text)
+        .map_err(|e| format!("cannot write {}: {e}", report_path.display()))?;
     let files = staging.publish()?;
     eprintln!(
         "snowprint: {} frames of {width}x{height} ({}, camera {}) in {:.0} s on {}: {} files in {}",

@@ -7,7 +7,9 @@
 
 use glam::{Mat4, Quat, Vec3};
 use snowprint::render::{Environment, Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
-use snowprint::{Camera, Deformer, GroundMaterial, Mesh, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId};
+use snowprint::{
+    Camera, Deformer, GroundMaterial, Mesh, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
+};
 
 use crate::demo::DemoScene;
 
@@ -129,13 +131,22 @@ impl Skeleton {
             let block = |along: f32, lift: f32, half: Vec3| {
                 (
                     Shape::Box { half_extents: half },
-                    Pose { position: heel + fwd * along + up * (lift + half.y), rotation },
+                    Pose {
+                        position: heel + fwd * along + up * (lift + half.y),
+                        rotation,
+                    },
                 )
             };
             v.push(block(0.045, 0.0, Vec3::new(0.045, 0.02, 0.045)));
             v.push(block(0.185, 0.0, Vec3::new(0.065, 0.02, 0.05)));
             v.push(block(0.115, 0.015, Vec3::new(0.04, 0.015, 0.035)));
-            v.push((Shape::Sphere { radius: 0.045 }, Pose { position: heel + fwd * 0.235 + up * 0.045, rotation: Quat::IDENTITY }));
+            v.push((
+                Shape::Sphere { radius: 0.045 },
+                Pose {
+                    position: heel + fwd * 0.235 + up * 0.045,
+                    rotation: Quat::IDENTITY,
+                },
+            ));
         }
         v
     }
@@ -147,12 +158,21 @@ impl Skeleton {
             .into_iter()
             .map(|(a, b, r)| {
                 (
-                    Shape::Capsule { radius: r, half_height: 0.5 * a.distance(b) },
+                    Shape::Capsule {
+                        radius: r,
+                        half_height: 0.5 * a.distance(b),
+                    },
                     segment_pose(a, b),
                 )
             })
             .collect();
-        v.push((Shape::Sphere { radius: 0.11 }, Pose { position: self.head, rotation: Quat::IDENTITY }));
+        v.push((
+            Shape::Sphere { radius: 0.11 },
+            Pose {
+                position: self.head,
+                rotation: Quat::IDENTITY,
+            },
+        ));
         v.extend(self.foot_shapes());
         v
     }
@@ -160,7 +180,8 @@ impl Skeleton {
     fn instances(&self, m: &BodyMeshes, coat: [f32; 3], trousers: [f32; 3]) -> Vec<Instance> {
         let skin = [0.55, 0.38, 0.3];
         let boot = [0.05, 0.04, 0.035];
-        let part = |mesh, a, b, albedo| Instance::new(mesh, pose_matrix(&segment_pose(a, b)), albedo);
+        let part =
+            |mesh, a, b, albedo| Instance::new(mesh, pose_matrix(&segment_pose(a, b)), albedo);
         let mut v = vec![
             part(m.torso, self.pelvis, self.neck, coat),
             Instance::new(m.head, Mat4::from_translation(self.head), skin),
@@ -242,7 +263,8 @@ impl Gait {
         // Where the foot is planted in cycle k: under the body at mid-stance.
         let plant = |k: f32| {
             let t_mid = (k - 0.5 * i as f32 + 0.5 * self.stance) * self.period;
-            self.start + self.dir * (self.speed * t_mid.max(0.0)) + lateral - self.dir * (FOOT * 0.45)
+            self.start + self.dir * (self.speed * t_mid.max(0.0)) + lateral
+                - self.dir * (FOOT * 0.45)
         };
         let (mut heel, pitch_heel, pitch_ball) = if phase < self.stance {
             let u = phase / self.stance;
@@ -295,7 +317,10 @@ impl Gait {
             pelvis,
             neck,
             head: neck + up * 0.17,
-            shoulders: [neck - side * 0.19 - Vec3::Y * 0.04, neck + side * 0.19 - Vec3::Y * 0.04],
+            shoulders: [
+                neck - side * 0.19 - Vec3::Y * 0.04,
+                neck + side * 0.19 - Vec3::Y * 0.04,
+            ],
             elbows: [Vec3::ZERO; 2],
             hands: [Vec3::ZERO; 2],
             hips: [pelvis - side * 0.1, pelvis + side * 0.1],
@@ -303,8 +328,7 @@ impl Gait {
             ankles: [Vec3::ZERO; 2],
             feet,
         };
-        for i in 0..2 {
-            let (heel, fwd, up) = feet[i];
+        for (i, &(heel, fwd, up)) in feet.iter().enumerate() {
             s.ankles[i] = heel + fwd * 0.06 + up * 0.09;
             s.knees[i] = knee(s.hips[i], s.ankles[i], self.dir);
             let a = if i == 0 { swing } else { -swing };
@@ -326,7 +350,10 @@ fn standing(ground: Vec3, dir: Vec3, arms_out: f32, legs_out: f32) -> Skeleton {
         pelvis,
         neck,
         head: neck + Vec3::Y * 0.17,
-        shoulders: [neck - side * 0.19 - Vec3::Y * 0.04, neck + side * 0.19 - Vec3::Y * 0.04],
+        shoulders: [
+            neck - side * 0.19 - Vec3::Y * 0.04,
+            neck + side * 0.19 - Vec3::Y * 0.04,
+        ],
         elbows: [Vec3::ZERO; 2],
         hands: [Vec3::ZERO; 2],
         hips: [pelvis - side * 0.1, pelvis + side * 0.1],
@@ -353,11 +380,25 @@ fn standing(ground: Vec3, dir: Vec3, arms_out: f32, legs_out: f32) -> Skeleton {
 enum Act {
     Walk(Gait),
     /// Lying on the back, sliding feet-first from `from` to `to` between t0 and t1.
-    Slide { from: Vec3, to: Vec3, t0: f32, t1: f32 },
+    Slide {
+        from: Vec3,
+        to: Vec3,
+        t0: f32,
+        t1: f32,
+    },
     /// Standing at `at` facing `dir`, falling backwards onto the back at `t_fall`.
-    Fall { at: Vec3, dir: Vec3, t_fall: f32 },
+    Fall {
+        at: Vec3,
+        dir: Vec3,
+        t_fall: f32,
+    },
     /// Lying on the back at `at`, head towards `dir`, sweeping arms and legs between t0 and t1.
-    Angel { at: Vec3, dir: Vec3, t0: f32, t1: f32 },
+    Angel {
+        at: Vec3,
+        dir: Vec3,
+        t0: f32,
+        t1: f32,
+    },
 }
 
 /// A lying skeleton: a standing one, turned onto its back about the heels, head towards
@@ -434,43 +475,84 @@ impl StandIn {
             surfaces.push((world.add_surface(desc).map_err(err)?, ground));
             Ok(())
         };
-        add(SurfaceDesc::new("roof_a", [0.0, ROOF_A, 0.0], [12.0, 8.0], 0.16), GroundMaterial::Concrete)?;
-        add(SurfaceDesc::new("roof_b", [11.3, ROOF_B, 0.5], [9.0, 7.0], 0.14), GroundMaterial::RoofTiles)?;
-        add(SurfaceDesc::new("roof_c", [-11.5, ROOF_C, 0.0], [8.0, 7.0], 0.25), GroundMaterial::RoofTiles)?;
-        add(SurfaceDesc::new("street", [2.0, 0.0, 9.5], [44.0, 8.0], 0.12), GroundMaterial::Concrete)?;
+        add(
+            SurfaceDesc::new("roof_a", [0.0, ROOF_A, 0.0], [12.0, 8.0], 0.16),
+            GroundMaterial::Concrete,
+        )?;
+        add(
+            SurfaceDesc::new("roof_b", [11.3, ROOF_B, 0.5], [9.0, 7.0], 0.14),
+            GroundMaterial::RoofTiles,
+        )?;
+        add(
+            SurfaceDesc::new("roof_c", [-11.5, ROOF_C, 0.0], [8.0, 7.0], 0.25),
+            GroundMaterial::RoofTiles,
+        )?;
+        add(
+            SurfaceDesc::new("street", [2.0, 0.0, 9.5], [44.0, 8.0], 0.12),
+            GroundMaterial::Concrete,
+        )?;
 
-        let unit_box = renderer.add_mesh(&Mesh::cuboid(Vec3::splat(0.5))).map_err(rerr)?;
+        let unit_box = renderer
+            .add_mesh(&Mesh::cuboid(Vec3::splat(0.5)))
+            .map_err(rerr)?;
         let tank = renderer.add_mesh(&cylinder(1.25, 2.3, 32)).map_err(rerr)?;
         let tank_roof = renderer.add_mesh(&cone(1.4, 0.9, 32)).map_err(rerr)?;
         let pole = renderer.add_mesh(&cylinder(0.07, 4.6, 10)).map_err(rerr)?;
-        let bulb = renderer.add_mesh(&Mesh::uv_sphere(0.16, 8, 16)).map_err(rerr)?;
+        let bulb = renderer
+            .add_mesh(&Mesh::uv_sphere(0.16, 8, 16))
+            .map_err(rerr)?;
         let capsule = |r: f32, len: f32| Mesh::capsule(r, len * 0.5, 8, 12);
         let body = BodyMeshes {
             torso: renderer.add_mesh(&capsule(0.16, TORSO)).map_err(rerr)?,
-            head: renderer.add_mesh(&Mesh::uv_sphere(0.11, 10, 16)).map_err(rerr)?,
+            head: renderer
+                .add_mesh(&Mesh::uv_sphere(0.11, 10, 16))
+                .map_err(rerr)?,
             upper_arm: renderer.add_mesh(&capsule(0.05, UPPER_ARM)).map_err(rerr)?,
             forearm: renderer.add_mesh(&capsule(0.045, FOREARM)).map_err(rerr)?,
             thigh: renderer.add_mesh(&capsule(0.075, THIGH)).map_err(rerr)?,
             shin: renderer.add_mesh(&capsule(0.06, SHIN)).map_err(rerr)?,
-            boot: renderer.add_mesh(&Mesh::cuboid(Vec3::new(FOOT * 0.5, 0.045, 0.05))).map_err(rerr)?,
+            boot: renderer
+                .add_mesh(&Mesh::cuboid(Vec3::new(FOOT * 0.5, 0.045, 0.05)))
+                .map_err(rerr)?,
         };
 
         let brick = [0.36, 0.16, 0.11];
         let dark_brick = [0.24, 0.14, 0.11];
         let stone = [0.42, 0.40, 0.37];
         let mut statics = Vec::new();
-        let block = |center: Vec3, half: Vec3, albedo: [f32; 3], material: MeshMaterial, seed: f32| {
-            Instance::new(unit_box, boxed(center, half), albedo)
-                .with_material(material)
-                .with_seed(seed)
-        };
+        let block =
+            |center: Vec3, half: Vec3, albedo: [f32; 3], material: MeshMaterial, seed: f32| {
+                Instance::new(unit_box, boxed(center, half), albedo)
+                    .with_material(material)
+                    .with_seed(seed)
+            };
         // Building A under roof A (12 x 8 of snow inside 0.3 m parapets).
-        statics.push(block(Vec3::new(0.0, ROOF_A * 0.5, 0.0), Vec3::new(6.3, ROOF_A * 0.5, 4.3), brick, MeshMaterial::Facade, 0.1));
+        statics.push(block(
+            Vec3::new(0.0, ROOF_A * 0.5, 0.0),
+            Vec3::new(6.3, ROOF_A * 0.5, 4.3),
+            brick,
+            MeshMaterial::Facade,
+            0.1,
+        ));
         // Building B under roof B, building C under roof C.
-        statics.push(block(Vec3::new(11.3, ROOF_B * 0.5, 0.5), Vec3::new(4.8, ROOF_B * 0.5, 3.8), dark_brick, MeshMaterial::Facade, 0.4));
-        statics.push(block(Vec3::new(-11.5, ROOF_C * 0.5, 0.0), Vec3::new(4.3, ROOF_C * 0.5, 3.8), [0.3, 0.22, 0.17], MeshMaterial::Facade, 0.7));
+        statics.push(block(
+            Vec3::new(11.3, ROOF_B * 0.5, 0.5),
+            Vec3::new(4.8, ROOF_B * 0.5, 3.8),
+            dark_brick,
+            MeshMaterial::Facade,
+            0.4,
+        ));
+        statics.push(block(
+            Vec3::new(-11.5, ROOF_C * 0.5, 0.0),
+            Vec3::new(4.3, ROOF_C * 0.5, 3.8),
+            [0.3, 0.22, 0.17],
+            MeshMaterial::Facade,
+            0.7,
+        ));
         // Parapets.
-        let parapet = |cx: f32, cz: f32, y: f32, hx: f32, hz: f32| (Vec3::new(cx, y + 0.45, cz), Vec3::new(hx, 0.45, hz));
+        let parapet = |cx: f32, cz: f32, y: f32, hx: f32, hz: f32| {
+            (Vec3::new(cx, y + 0.45, cz), Vec3::new(hx, 0.45, hz))
+        };
         for (c, h) in [
             parapet(0.0, -4.15, ROOF_A, 6.3, 0.15),
             parapet(0.0, 4.15, ROOF_A, 6.3, 0.15),
@@ -487,30 +569,98 @@ impl StandIn {
             statics.push(block(c, h, stone, MeshMaterial::Concrete, 0.0));
         }
         // Sidewalks along the fronts, and the buildings across the street.
-        statics.push(block(Vec3::new(2.0, 0.08, 5.0), Vec3::new(22.0, 0.08, 0.5), [0.35, 0.35, 0.34], MeshMaterial::Concrete, 0.0));
-        statics.push(block(Vec3::new(2.0, 0.08, 14.0), Vec3::new(22.0, 0.08, 0.5), [0.35, 0.35, 0.34], MeshMaterial::Concrete, 0.0));
-        statics.push(block(Vec3::new(-10.0, 9.0, 20.5), Vec3::new(8.0, 9.0, 6.0), [0.3, 0.2, 0.15], MeshMaterial::Facade, 0.2));
-        statics.push(block(Vec3::new(6.0, 12.0, 20.5), Vec3::new(8.0, 12.0, 6.0), [0.4, 0.25, 0.18], MeshMaterial::Facade, 0.5));
-        statics.push(block(Vec3::new(19.0, 7.5, 20.5), Vec3::new(5.0, 7.5, 6.0), [0.28, 0.26, 0.24], MeshMaterial::Facade, 0.9));
+        statics.push(block(
+            Vec3::new(2.0, 0.08, 5.0),
+            Vec3::new(22.0, 0.08, 0.5),
+            [0.35, 0.35, 0.34],
+            MeshMaterial::Concrete,
+            0.0,
+        ));
+        statics.push(block(
+            Vec3::new(2.0, 0.08, 14.0),
+            Vec3::new(22.0, 0.08, 0.5),
+            [0.35, 0.35, 0.34],
+            MeshMaterial::Concrete,
+            0.0,
+        ));
+        statics.push(block(
+            Vec3::new(-10.0, 9.0, 20.5),
+            Vec3::new(8.0, 9.0, 6.0),
+            [0.3, 0.2, 0.15],
+            MeshMaterial::Facade,
+            0.2,
+        ));
+        statics.push(block(
+            Vec3::new(6.0, 12.0, 20.5),
+            Vec3::new(8.0, 12.0, 6.0),
+            [0.4, 0.25, 0.18],
+            MeshMaterial::Facade,
+            0.5,
+        ));
+        statics.push(block(
+            Vec3::new(19.0, 7.5, 20.5),
+            Vec3::new(5.0, 7.5, 6.0),
+            [0.28, 0.26, 0.24],
+            MeshMaterial::Facade,
+            0.9,
+        ));
         // Beyond: a dark wall of the city.
-        statics.push(block(Vec3::new(2.0, 15.0, -14.0), Vec3::new(30.0, 15.0, 6.0), [0.2, 0.15, 0.13], MeshMaterial::Facade, 0.3));
+        statics.push(block(
+            Vec3::new(2.0, 15.0, -14.0),
+            Vec3::new(30.0, 15.0, 6.0),
+            [0.2, 0.15, 0.13],
+            MeshMaterial::Facade,
+            0.3,
+        ));
         // A vent and a chimney on roof A (clear of the walkers' paths).
-        statics.push(block(Vec3::new(4.6, ROOF_A + 0.6, -2.9), Vec3::new(0.6, 0.6, 0.5), [0.35, 0.36, 0.38], MeshMaterial::Metal, 0.0));
-        statics.push(block(Vec3::new(-5.2, ROOF_A + 1.1, 3.2), Vec3::new(0.35, 1.1, 0.35), brick, MeshMaterial::Brick, 0.6));
+        statics.push(block(
+            Vec3::new(4.6, ROOF_A + 0.6, -2.9),
+            Vec3::new(0.6, 0.6, 0.5),
+            [0.35, 0.36, 0.38],
+            MeshMaterial::Metal,
+            0.0,
+        ));
+        statics.push(block(
+            Vec3::new(-5.2, ROOF_A + 1.1, 3.2),
+            Vec3::new(0.35, 1.1, 0.35),
+            brick,
+            MeshMaterial::Brick,
+            0.6,
+        ));
 
         // The water tower on roof A: legs standing in the snow, a tank, a conical roof.
         let tower = Vec3::new(-3.6, ROOF_A, -2.3);
         for (dx, dz) in [(-0.9, -0.9), (0.9, -0.9), (-0.9, 0.9), (0.9, 0.9)] {
-            statics.push(block(tower + Vec3::new(dx, 1.3, dz), Vec3::new(0.08, 1.3, 0.08), [0.18, 0.16, 0.15], MeshMaterial::Metal, 0.0));
+            statics.push(block(
+                tower + Vec3::new(dx, 1.3, dz),
+                Vec3::new(0.08, 1.3, 0.08),
+                [0.18, 0.16, 0.15],
+                MeshMaterial::Metal,
+                0.0,
+            ));
         }
-        statics.push(block(tower + Vec3::new(0.0, 2.65, 0.0), Vec3::new(1.3, 0.06, 1.3), [0.2, 0.17, 0.15], MeshMaterial::Metal, 0.0));
+        statics.push(block(
+            tower + Vec3::new(0.0, 2.65, 0.0),
+            Vec3::new(1.3, 0.06, 1.3),
+            [0.2, 0.17, 0.15],
+            MeshMaterial::Metal,
+            0.0,
+        ));
         statics.push(
-            Instance::new(tank, Mat4::from_translation(tower + Vec3::Y * 2.7), [0.32, 0.2, 0.14])
-                .with_material(MeshMaterial::Metal),
+            Instance::new(
+                tank,
+                Mat4::from_translation(tower + Vec3::Y * 2.7),
+                [0.32, 0.2, 0.14],
+            )
+            .with_material(MeshMaterial::Metal),
         );
         statics.push(
-            Instance::new(tank_roof, Mat4::from_translation(tower + Vec3::Y * 5.0), [0.22, 0.16, 0.12])
-                .with_material(MeshMaterial::Metal),
+            Instance::new(
+                tank_roof,
+                Mat4::from_translation(tower + Vec3::Y * 5.0),
+                [0.22, 0.16, 0.12],
+            )
+            .with_material(MeshMaterial::Metal),
         );
 
         // Street lamps: sodium orange.
@@ -518,10 +668,17 @@ impl StandIn {
         for x in [-13.0, -3.0, 7.0, 17.0] {
             let base = Vec3::new(x, 0.0, 5.6);
             statics.push(
-                Instance::new(pole, Mat4::from_translation(base), [0.08, 0.08, 0.09]).with_material(MeshMaterial::Metal),
+                Instance::new(pole, Mat4::from_translation(base), [0.08, 0.08, 0.09])
+                    .with_material(MeshMaterial::Metal),
             );
             let head = base + Vec3::new(0.0, 4.6, 0.5);
-            statics.push(block(base + Vec3::new(0.0, 4.65, 0.25), Vec3::new(0.05, 0.04, 0.3), [0.08, 0.08, 0.09], MeshMaterial::Metal, 0.0));
+            statics.push(block(
+                base + Vec3::new(0.0, 4.65, 0.25),
+                Vec3::new(0.05, 0.04, 0.3),
+                [0.08, 0.08, 0.09],
+                MeshMaterial::Metal,
+                0.0,
+            ));
             statics.push(
                 Instance::new(bulb, Mat4::from_translation(head), [1.0, 0.62, 0.28])
                     .with_material(MeshMaterial::Emissive)
@@ -627,7 +784,10 @@ fn catmull_rom(points: &[Vec3], u: f32) -> Vec3 {
     let t = f - i as f32;
     let p = |k: isize| points[(i as isize + k).clamp(0, n as isize - 1) as usize];
     let (p0, p1, p2, p3) = (p(-1), p(0), p(1), p(2));
-    0.5 * ((2.0 * p1) + (p2 - p0) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t * t * t)
+    0.5 * ((2.0 * p1)
+        + (p2 - p0) * t
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t * t
+        + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t * t * t)
 }
 
 /// Cameras of the stand-in world.
@@ -714,9 +874,17 @@ impl DemoScene for StandIn {
             "closeup" => {
                 // A slow dolly along the walker's prints on roof A.
                 let x = -3.4 + 2.4 * u;
-                cam(Vec3::new(x, ROOF_A + 2.3, 3.6), Vec3::new(x + 0.9, ROOF_A + 0.1, 1.0), 45.0)
+                cam(
+                    Vec3::new(x, ROOF_A + 2.3, 3.6),
+                    Vec3::new(x + 0.9, ROOF_A + 0.1, 1.0),
+                    45.0,
+                )
             }
-            "angel" => cam(Vec3::new(0.6, ROOF_A + 2.6, 0.4), Vec3::new(2.7, ROOF_A, -2.0), 50.0),
+            "angel" => cam(
+                Vec3::new(0.6, ROOF_A + 2.6, 0.4),
+                Vec3::new(2.7, ROOF_A, -2.0),
+                50.0,
+            ),
             "overview" => cam(Vec3::new(0.0, 34.0, 16.0), Vec3::new(2.0, 8.0, 1.0), 50.0),
             "street" => cam(Vec3::new(-13.0, 1.7, 12.2), Vec3::new(2.0, 0.8, 8.0), 55.0),
             _ => return None,
@@ -742,7 +910,11 @@ mod tests {
         };
         // Mid-stance of the left foot in cycle 2: flat on the ground.
         let (heel, fwd, up) = g.foot(0, 1.1 * 2.3);
-        assert!(heel.y.abs() < 1e-4 && (fwd - Vec3::X).length() < 1e-4 && (up - Vec3::Y).length() < 1e-4);
+        assert!(
+            heel.y.abs() < 1e-4
+                && (fwd - Vec3::X).length() < 1e-4
+                && (up - Vec3::Y).length() < 1e-4
+        );
         // Mid-swing: in the air.
         let (heel, _, _) = g.foot(0, 1.1 * 2.8);
         assert!(heel.y > 0.3);
@@ -760,7 +932,11 @@ mod tests {
                 .indices
                 .chunks(3)
                 .map(|t| {
-                    let (a, b, c) = (m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]);
+                    let (a, b, c) = (
+                        m.positions[t[0] as usize],
+                        m.positions[t[1] as usize],
+                        m.positions[t[2] as usize],
+                    );
                     a.dot(b.cross(c)) / 6.0
                 })
                 .sum();

@@ -94,7 +94,13 @@ fn inside(height: &impl Fn(Vec2) -> f32, ray: &SlabRay, t: f32) -> bool {
 /// hit's `t` (the bracket's middle), or `None` when the ray leaves the slab without entering the
 /// snow. With one crossing in the bracket the error is at most `t_max / taps / 2^(refine + 1)`.
 /// Must match `snow_relief_search` in `snow.wgsl`.
-pub fn relief_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, taps: u32, refine: u32) -> Option<f32> {
+pub fn relief_search(
+    height: impl Fn(Vec2) -> f32,
+    ray: &SlabRay,
+    t_max: f32,
+    taps: u32,
+    refine: u32,
+) -> Option<f32> {
     if inside(&height, ray, 0.0) {
         return Some(0.0);
     }
@@ -128,7 +134,13 @@ pub fn relief_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, ta
 /// keeps the crossing (false position): exact for a planar heightfield, always within the bracket
 /// `t_max / taps`, and converging fast on a smooth one (without it, the layers of the linear taps
 /// show as bands on the walls of prints). Must match `snow_pom_search` in `snow.wgsl`.
-pub fn pom_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, taps: u32, refine: u32) -> Option<f32> {
+pub fn pom_search(
+    height: impl Fn(Vec2) -> f32,
+    ray: &SlabRay,
+    t_max: f32,
+    taps: u32,
+    refine: u32,
+) -> Option<f32> {
     // Signed height of the ray over the snow, minus the slack: <= 0 means inside.
     let above = |t: f32| {
         let p = ray.at(t);
@@ -169,7 +181,13 @@ pub fn pom_search(height: impl Fn(Vec2) -> f32, ray: &SlabRay, t_max: f32, taps:
 /// than central differences, which matters at 4 cm texels). `depression(col, row)` is the fraction
 /// of the snow depth pressed down (clamped at the edges by the caller). Returns a unit local normal.
 /// Must match `sobel_normal` in `heightfield.wgsl`.
-pub fn sobel_normal(depression: impl Fn(i32, i32) -> f32, col: i32, row: i32, snow_depth: f32, texel: Vec2) -> Vec3 {
+pub fn sobel_normal(
+    depression: impl Fn(i32, i32) -> f32,
+    col: i32,
+    row: i32,
+    snow_depth: f32,
+    texel: Vec2,
+) -> Vec3 {
     let h = |dx: i32, dy: i32| -depression(col + dx, row + dy) * snow_depth;
     let gx = (h(1, -1) + 2.0 * h(1, 0) + h(1, 1)) - (h(-1, -1) + 2.0 * h(-1, 0) + h(-1, 1));
     let gz = (h(-1, 1) + 2.0 * h(0, 1) + h(1, 1)) - (h(-1, -1) + 2.0 * h(0, -1) + h(1, -1));
@@ -193,7 +211,14 @@ pub const LIGHT_TAPS: u32 = 16;
 /// darkest tap wins. 1 in the open, 0 at the bottom of a print the light cannot see into.
 /// `height(x, z)` is the snow's height above the ground in metres. Must match `light_visibility`
 /// in `heightfield.wgsl`.
-pub fn light_visibility(height: impl Fn(f32, f32) -> f32, x: f32, z: f32, light: Vec3, snow_depth: f32, texel: f32) -> f32 {
+pub fn light_visibility(
+    height: impl Fn(f32, f32) -> f32,
+    x: f32,
+    z: f32,
+    light: Vec3,
+    snow_depth: f32,
+    texel: f32,
+) -> f32 {
     if light.y <= 0.02 {
         return 0.0;
     }
@@ -258,7 +283,11 @@ mod tests {
             for j in 0..6 {
                 let phi = std::f32::consts::TAU * i as f32 / 12.0;
                 let theta = 1.3 * j as f32 / 6.0;
-                v.push(Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()));
+                v.push(Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                ));
             }
         }
         v
@@ -284,7 +313,11 @@ mod tests {
             let q = Quat::from_rotation_arc(Vec3::Z, base);
             for detail in normals() {
                 let r = rnm(base, detail);
-                assert!(close(r, q * detail, 2e-5), "base {base} detail {detail}: {r} vs {}", q * detail);
+                assert!(
+                    close(r, q * detail, 2e-5),
+                    "base {base} detail {detail}: {r} vs {}",
+                    q * detail
+                );
             }
         }
     }
@@ -294,7 +327,11 @@ mod tests {
         let pack = |n: Vec3| n * 0.5 + Vec3::splat(0.5);
         for base in normals() {
             for detail in normals().into_iter().step_by(5) {
-                assert!(close(rnm_packed(pack(base), pack(detail)), rnm(base, detail), 1e-5));
+                assert!(close(
+                    rnm_packed(pack(base), pack(detail)),
+                    rnm(base, detail),
+                    1e-5
+                ));
             }
         }
     }
@@ -341,23 +378,35 @@ mod tests {
 
     #[test]
     fn relief_search_meets_an_analytic_plane_within_its_bound() {
-        for dir in [Vec3::new(1.0, -0.3, 0.2), Vec3::new(0.3, -1.0, -0.1), Vec3::new(2.0, -0.25, 1.0)] {
+        for dir in [
+            Vec3::new(1.0, -0.3, 0.2),
+            Vec3::new(0.3, -1.0, -0.1),
+            Vec3::new(2.0, -0.25, 1.0),
+        ] {
             let (h, r, exact) = plane_case(dir);
             let (t_max, _) = slab_exit(&r, HALF, DEPTH);
             for (taps, refine) in [(4, 5), (8, 5), (16, 3), (12, 6)] {
-                let t = relief_search(&h, &r, t_max, taps, refine).expect("the plane is inside the slab");
+                let t = relief_search(&h, &r, t_max, taps, refine)
+                    .expect("the plane is inside the slab");
                 // One crossing in the bracket: at most half the last bracket, plus the slack of the
                 // inside test measured along the ray.
                 let bound = t_max / taps as f32 / 2f32.powi(refine as i32 + 1)
                     + INSIDE_EPSILON / (r.dir.y - 0.04 * r.dir.x).abs();
-                assert!((t - exact).abs() <= bound * 1.001, "{dir} {taps}/{refine}: {t} vs {exact}, bound {bound}");
+                assert!(
+                    (t - exact).abs() <= bound * 1.001,
+                    "{dir} {taps}/{refine}: {t} vs {exact}, bound {bound}"
+                );
             }
         }
     }
 
     #[test]
     fn pom_search_is_exact_on_a_plane() {
-        for dir in [Vec3::new(1.0, -0.3, 0.2), Vec3::new(0.3, -1.0, -0.1), Vec3::new(2.0, -0.25, 1.0)] {
+        for dir in [
+            Vec3::new(1.0, -0.3, 0.2),
+            Vec3::new(0.3, -1.0, -0.1),
+            Vec3::new(2.0, -0.25, 1.0),
+        ] {
             let (h, r, exact) = plane_case(dir);
             let (t_max, _) = slab_exit(&r, HALF, DEPTH);
             let t = pom_search(&h, &r, t_max, 8, 0).expect("hit");
@@ -391,10 +440,17 @@ mod tests {
 
     #[test]
     fn relief_and_pom_meet_an_analytic_sphere_dent() {
-        for dir in [Vec3::new(0.4, -1.0, 0.1), Vec3::new(1.0, -0.7, -0.3), Vec3::new(-0.3, -1.0, 0.6)] {
+        for dir in [
+            Vec3::new(0.4, -1.0, 0.1),
+            Vec3::new(1.0, -0.7, -0.3),
+            Vec3::new(-0.3, -1.0, 0.6),
+        ] {
             let (h, r, exact) = dent_case(dir);
             let p = r.at(exact);
-            assert!(p.y > 0.0 && p.y < DEPTH, "the case must hit the dent floor: {p}");
+            assert!(
+                p.y > 0.0 && p.y < DEPTH,
+                "the case must hit the dent floor: {p}"
+            );
             let (t_max, _) = slab_exit(&r, HALF, DEPTH);
             // Near the hit the ray crosses the dent floor at an angle: the inside slack moves the
             // hit by at most eps / |d(above)/dt|, bounded here by eps / 0.1.
@@ -402,16 +458,25 @@ mod tests {
             for taps in [6u32, 12, 24] {
                 let t = relief_search(&h, &r, t_max, taps, 5).expect("hit");
                 let bound = t_max / taps as f32 / 64.0 + slack;
-                assert!((t - exact).abs() <= bound, "relief {dir} {taps}: {t} vs {exact} (bound {bound})");
+                assert!(
+                    (t - exact).abs() <= bound,
+                    "relief {dir} {taps}: {t} vs {exact} (bound {bound})"
+                );
                 let t = pom_search(&h, &r, t_max, taps, 0).expect("hit");
                 // The secant lies inside the bracket of one tap.
                 let bound = t_max / taps as f32 + slack;
-                assert!((t - exact).abs() <= bound, "pom {dir} {taps}: {t} vs {exact} (bound {bound})");
+                assert!(
+                    (t - exact).abs() <= bound,
+                    "pom {dir} {taps}: {t} vs {exact} (bound {bound})"
+                );
                 // False position keeps the crossing bracketed and closes in on it: three steps
                 // land within a hundredth of a tap here (the dent is smooth at the crossing).
                 let refined = pom_search(&h, &r, t_max, taps, 3).expect("hit");
                 let bound = t_max / taps as f32 * 0.01 + slack;
-                assert!((refined - exact).abs() <= bound, "pom+3 {dir} {taps}: {refined} vs {exact} (bound {bound})");
+                assert!(
+                    (refined - exact).abs() <= bound,
+                    "pom+3 {dir} {taps}: {refined} vs {exact} (bound {bound})"
+                );
             }
         }
     }
@@ -437,7 +502,10 @@ mod tests {
         assert_eq!(linear_taps(down, 0.3, 0.04, 0.5, 4.0, 16.0), 4);
         let grazing = Vec3::new(1.0, -0.2, 0.0).normalize();
         // 0.3 m of snow at this angle: 1.5 m across, 37.5 texels of 4 cm, a tap every 2 texels.
-        assert_eq!(linear_taps(grazing, 0.3 / 0.2f32.atan().sin(), 0.04, 0.5, 4.0, 32.0), 19);
+        assert_eq!(
+            linear_taps(grazing, 0.3 / 0.2f32.atan().sin(), 0.04, 0.5, 4.0, 32.0),
+            19
+        );
         assert_eq!(linear_taps(grazing, 10.0, 0.04, 0.5, 4.0, 16.0), 16);
     }
 
@@ -447,13 +515,19 @@ mod tests {
         let dep = |c: i32, _r: i32| 0.1 * c as f32;
         let n = sobel_normal(dep, 5, 5, 0.3, Vec2::splat(0.04));
         let slope = 0.03 / 0.04;
-        assert!(close(n, Vec3::new(slope, 1.0, 0.0).normalize(), 1e-5), "{n}");
+        assert!(
+            close(n, Vec3::new(slope, 1.0, 0.0).normalize(), 1e-5),
+            "{n}"
+        );
     }
 
     #[test]
     fn light_reaches_flat_snow_and_not_the_bottom_of_a_trench() {
         let light = Vec3::new(0.8, 0.45, 0.0).normalize();
-        assert_eq!(light_visibility(|_, _| 0.2, 0.0, 0.0, light, 0.2, 0.04), 1.0);
+        assert_eq!(
+            light_visibility(|_, _| 0.2, 0.0, 0.0, light, 0.2, 0.04),
+            1.0
+        );
         // A trench 0.4 m wide and 0.18 m deep along z: its floor near the wall towards the light
         // sees the wall (dark); the wall facing the light and the far floor are lit.
         let trench = |x: f32, _z: f32| if x.abs() < 0.2 { 0.02 } else { 0.2 };
@@ -463,7 +537,10 @@ mod tests {
         let open = light_visibility(trench, -0.19, 0.0, light, 0.2, 0.04);
         assert!(open > near_wall, "{open}");
         // The moon below the horizon lights nothing.
-        assert_eq!(light_visibility(|_, _| 0.2, 0.0, 0.0, Vec3::new(1.0, -0.1, 0.0), 0.2, 0.04), 0.0);
+        assert_eq!(
+            light_visibility(|_, _| 0.2, 0.0, 0.0, Vec3::new(1.0, -0.1, 0.0), 0.2, 0.04),
+            0.0
+        );
     }
 
     #[test]

@@ -65,8 +65,16 @@ fn ambient_light(n: vec3<f32>) -> vec3<f32> {
     return mix(frame.ground_bounce.rgb, frame.sky_ambient.rgb, clamp(n.y * 0.5 + 0.5, 0.0, 1.0));
 }
 
-// Moon shadow at a world point with normal `n`: 3x3 PCF on the shadow map, offset along the normal
-// by a texel to avoid acne.
+// Taps of the shadow filter: a Poisson disc of radius 1 (Vogel spiral).
+const SHADOW_TAPS: array<vec2<f32>, 8> = array<vec2<f32>, 8>(
+    vec2<f32>(0.2500, 0.0000), vec2<f32>(-0.3077, 0.3381), vec2<f32>(0.0386, -0.5577),
+    vec2<f32>(0.4342, 0.5166), vec2<f32>(-0.7623, -0.1303), vec2<f32>(0.6913, -0.4669),
+    vec2<f32>(-0.2207, 0.8718), vec2<f32>(-0.4697, -0.8431),
+);
+
+// Moon shadow at a world point with normal `n`: eight taps on a disc 1.8 texels wide, each a
+// bilinear comparison (so the edge is smooth, not a staircase of texels), offset along the normal
+// by a texel and a half against acne.
 fn moon_shadow(p: vec3<f32>, n: vec3<f32>) -> f32 {
     let texel = frame.moon_color.w;
     let q = frame.shadow_view_proj * vec4<f32>(p + n * (1.5 * texel), 1.0);
@@ -76,14 +84,13 @@ fn moon_shadow(p: vec3<f32>, n: vec3<f32>) -> f32 {
         return 1.0;
     }
     let size = vec2<f32>(textureDimensions(shadow_map));
+    var taps = SHADOW_TAPS;
     var lit = 0.0;
-    for (var y = -1; y <= 1; y++) {
-        for (var x = -1; x <= 1; x++) {
-            let o = vec2<f32>(f32(x), f32(y)) / size;
-            lit += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, ndc.z - 0.0005);
-        }
+    for (var i = 0; i < 8; i++) {
+        let o = taps[i] * 1.8 / size;
+        lit += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, ndc.z - 0.0005);
     }
-    return lit / 9.0;
+    return lit / 8.0;
 }
 
 // GGX specular (normalized so that it multiplies the same light as the diffuse term).

@@ -25,7 +25,11 @@ pub fn shade_normals(mesh: &Mesh, crease_degrees: f32) -> (Vec<MeshVertexRaw>, V
     let face: Vec<Vec3> = tris
         .iter()
         .map(|t| {
-            let (a, b, c) = (mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
+            let (a, b, c) = (
+                mesh.positions[t[0]],
+                mesh.positions[t[1]],
+                mesh.positions[t[2]],
+            );
             (b - a).cross(c - a)
         })
         .collect();

@@ -160,7 +160,8 @@ pub struct InstanceRaw {
 
 /// Vertex buffer layouts of the mesh pipelines.
 pub fn mesh_vertex_layouts() -> [wgpu::VertexBufferLayout<'static>; 2] {
-    const VERTEX: [wgpu::VertexAttribute; 2] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+    const VERTEX: [wgpu::VertexAttribute; 2] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
     const INSTANCE: [wgpu::VertexAttribute; 9] = wgpu::vertex_attr_array![
         2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4,
         6 => Float32x4, 7 => Float32x4, 8 => Float32x4, 9 => Float32x4, 10 => Float32x4
@@ -186,8 +187,12 @@ mod tests {
 
     /// Size and member offsets of a WGSL struct, from naga.
     fn layout(source: &str, name: &str) -> (u32, Vec<(String, u32)>) {
-        let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
-        let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+        let module = naga::front::wgsl::parse_str(source)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        );
         validator
             .validate(&module)
             .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
@@ -214,22 +219,40 @@ mod tests {
         assert_eq!(size as usize, std::mem::size_of::<FrameUniform>());
         let offsets = [
             ("view_proj", std::mem::offset_of!(FrameUniform, view_proj)),
-            ("inv_view_proj", std::mem::offset_of!(FrameUniform, inv_view_proj)),
-            ("shadow_view_proj", std::mem::offset_of!(FrameUniform, shadow_view_proj)),
+            (
+                "inv_view_proj",
+                std::mem::offset_of!(FrameUniform, inv_view_proj),
+            ),
+            (
+                "shadow_view_proj",
+                std::mem::offset_of!(FrameUniform, shadow_view_proj),
+            ),
             ("eye", std::mem::offset_of!(FrameUniform, eye)),
             ("moon_dir", std::mem::offset_of!(FrameUniform, moon_dir)),
             ("moon_color", std::mem::offset_of!(FrameUniform, moon_color)),
             ("sky_zenith", std::mem::offset_of!(FrameUniform, sky_zenith)),
-            ("sky_horizon", std::mem::offset_of!(FrameUniform, sky_horizon)),
-            ("ground_bounce", std::mem::offset_of!(FrameUniform, ground_bounce)),
+            (
+                "sky_horizon",
+                std::mem::offset_of!(FrameUniform, sky_horizon),
+            ),
+            (
+                "ground_bounce",
+                std::mem::offset_of!(FrameUniform, ground_bounce),
+            ),
             ("sss_tint", std::mem::offset_of!(FrameUniform, sss_tint)),
-            ("sky_ambient", std::mem::offset_of!(FrameUniform, sky_ambient)),
+            (
+                "sky_ambient",
+                std::mem::offset_of!(FrameUniform, sky_ambient),
+            ),
             ("viewport", std::mem::offset_of!(FrameUniform, viewport)),
             ("options", std::mem::offset_of!(FrameUniform, options)),
             ("lights", std::mem::offset_of!(FrameUniform, lights)),
         ];
         for (name, offset) in offsets {
-            let m = members.iter().find(|m| m.0 == name).unwrap_or_else(|| panic!("no member {name}"));
+            let m = members
+                .iter()
+                .find(|m| m.0 == name)
+                .unwrap_or_else(|| panic!("no member {name}"));
             assert_eq!(m.1 as usize, offset, "{name}");
         }
     }
@@ -239,10 +262,19 @@ mod tests {
         let (size, members) = layout(&shaders::surface(), "SnowSurface");
         assert_eq!(size as usize, std::mem::size_of::<SurfaceUniform>());
         let offsets = [
-            ("local_to_world", std::mem::offset_of!(SurfaceUniform, local_to_world)),
-            ("world_to_local", std::mem::offset_of!(SurfaceUniform, world_to_local)),
+            (
+                "local_to_world",
+                std::mem::offset_of!(SurfaceUniform, local_to_world),
+            ),
+            (
+                "world_to_local",
+                std::mem::offset_of!(SurfaceUniform, world_to_local),
+            ),
             ("half_size", std::mem::offset_of!(SurfaceUniform, half_size)),
-            ("snow_depth", std::mem::offset_of!(SurfaceUniform, snow_depth)),
+            (
+                "snow_depth",
+                std::mem::offset_of!(SurfaceUniform, snow_depth),
+            ),
             ("texel", std::mem::offset_of!(SurfaceUniform, texel)),
             ("grid", std::mem::offset_of!(SurfaceUniform, grid)),
             ("ground", std::mem::offset_of!(SurfaceUniform, ground)),
@@ -252,7 +284,10 @@ mod tests {
             ("pattern", std::mem::offset_of!(SurfaceUniform, pattern)),
         ];
         for (name, offset) in offsets {
-            let m = members.iter().find(|m| m.0 == name).unwrap_or_else(|| panic!("no member {name}"));
+            let m = members
+                .iter()
+                .find(|m| m.0 == name)
+                .unwrap_or_else(|| panic!("no member {name}"));
             assert_eq!(m.1 as usize, offset, "{name}");
         }
     }
@@ -269,10 +304,14 @@ mod tests {
     #[test]
     fn every_pass_shader_validates() {
         for (name, source) in shaders::all() {
-            let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-                .validate(&module)
+            let module = naga::front::wgsl::parse_str(&source)
                 .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         }
     }
 

@@ -34,7 +34,10 @@ impl Resource {
     pub fn is_external(self) -> bool {
         matches!(
             self,
-            Resource::HeightmapPool | Resource::Instances | Resource::FrameUniforms | Resource::SurfaceTable
+            Resource::HeightmapPool
+                | Resource::Instances
+                | Resource::FrameUniforms
+                | Resource::SurfaceTable
         )
     }
 }
@@ -113,7 +116,14 @@ pub const PASSES: [PassInfo; 8] = [
     PassInfo {
         name: "snow",
         kind: PassKind::Render,
-        reads: &[R::SurfaceTable, R::SurfaceState, R::Heightfields, R::FrameUniforms, R::ShadowMap, R::SceneDepth],
+        reads: &[
+            R::SurfaceTable,
+            R::SurfaceState,
+            R::Heightfields,
+            R::FrameUniforms,
+            R::ShadowMap,
+            R::SceneDepth,
+        ],
         writes: &[R::SceneColor, R::SceneDepth],
     },
     PassInfo {
@@ -142,12 +152,18 @@ pub fn validate(passes: &[PassInfo]) -> Result<(), String> {
     for p in passes {
         for r in p.reads {
             if !r.is_external() && !written.contains(r) {
-                return Err(format!("pass {} reads {r:?} before any pass writes it", p.name));
+                return Err(format!(
+                    "pass {} reads {r:?} before any pass writes it",
+                    p.name
+                ));
             }
         }
         for w in p.writes {
             if w.is_external() {
-                return Err(format!("pass {} writes {w:?}, which comes from outside the frame", p.name));
+                return Err(format!(
+                    "pass {} writes {w:?}, which comes from outside the frame",
+                    p.name
+                ));
             }
             written.push(*w);
         }

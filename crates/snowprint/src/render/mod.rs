@@ -71,12 +71,12 @@ use crate::surface::SurfaceId;
 use crate::view::{Camera, GroundMaterial};
 use crate::world::SnowWorld;
 use gpu::{
-    BOX_VERTICES, ClassifyRecord, FrameUniform, HeightfieldParams, InstanceRaw, MAX_POINT_LIGHTS, PointLightRaw,
-    STATE_BASIC_DRAW, STATE_DEEPEST, STATE_DEFORMABLE_DRAW, STATE_HEIGHTFIELD_DISPATCH, STATE_TOUCHED, STATE_WORDS,
-    SurfaceUniform, UNIFORM_STRIDE,
+    BOX_VERTICES, ClassifyRecord, FrameUniform, HeightfieldParams, InstanceRaw, MAX_POINT_LIGHTS,
+    PointLightRaw, STATE_BASIC_DRAW, STATE_DEEPEST, STATE_DEFORMABLE_DRAW,
+    STATE_HEIGHTFIELD_DISPATCH, STATE_TOUCHED, STATE_WORDS, SurfaceUniform, UNIFORM_STRIDE,
 };
-pub use graph::{PASSES, PassInfo, PassKind, Resource};
 use graph::pass;
+pub use graph::{PASSES, PassInfo, PassKind, Resource};
 
 /// The snow material as a WGSL module (no bindings, no entry points), for renderers of your own.
 pub const SNOW_WGSL: &str = shaders::SNOW;
@@ -119,7 +119,9 @@ pub enum RenderError {
         index: u32,
     },
     /// The target view given to [`Renderer::render_to_view`] does not have the configured size.
-    #[error("the target is {got:?} pixels but the renderer is configured for {expected:?}; call Renderer::resize first")]
+    #[error(
+        "the target is {got:?} pixels but the renderer is configured for {expected:?}; call Renderer::resize first"
+    )]
     TargetSize {
         /// The target's size.
         got: (u32, u32),
@@ -139,7 +141,9 @@ pub type RenderResult<T> = Result<T, RenderError>;
 
 /// How snow surfaces are traced: the talk's relief mapping, or parallax occlusion mapping (the
 /// talk's "replace with POM?"), which takes more taps, interpolates the hit and self-shadows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Tier {
     /// Relief mapping: few linear taps, binary refinement.
@@ -177,7 +181,9 @@ impl std::fmt::Display for Tier {
 }
 
 /// What the image shows: the shaded frame, or one of the material's terms.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum DebugView {
     /// The shaded frame.
@@ -328,7 +334,8 @@ impl RenderConfig {
 
     /// The search in use.
     pub fn search_settings(&self) -> SearchSettings {
-        self.search.unwrap_or_else(|| SearchSettings::for_tier(self.tier))
+        self.search
+            .unwrap_or_else(|| SearchSettings::for_tier(self.tier))
     }
 
     fn validate(&self, device: &wgpu::Device) -> RenderResult<()> {
@@ -360,7 +367,11 @@ impl RenderConfig {
             );
         }
         let s = self.search_settings();
-        if !(s.taps_per_texel.is_finite() && s.taps_per_texel > 0.0) || s.min_taps == 0 || s.min_taps > s.max_taps || s.max_taps > 256 {
+        if !(s.taps_per_texel.is_finite() && s.taps_per_texel > 0.0)
+            || s.min_taps == 0
+            || s.min_taps > s.max_taps
+            || s.max_taps > 256
+        {
             return bad(
                 "search",
                 format!("{s:?}"),
@@ -368,7 +379,10 @@ impl RenderConfig {
             );
         }
         let l = self.look;
-        if !(0.0..1.0).contains(&l.ground_from) || l.ground_full <= l.ground_from || l.ground_full > 1.0 {
+        if !(0.0..1.0).contains(&l.ground_from)
+            || l.ground_full <= l.ground_from
+            || l.ground_full > 1.0
+        {
             return bad(
                 "look",
                 format!("{l:?}"),
@@ -447,7 +461,9 @@ pub struct PointLight {
 
 /// The procedural material of a mesh instance. Every material but `Plain` and `Emissive` gathers
 /// snow on faces that look up (see [`Instance::snow_cover`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum MeshMaterial {
     /// The albedo as given (people, clothes, props).
@@ -659,14 +675,23 @@ struct Growable {
 }
 
 impl Growable {
-    fn new(device: &wgpu::Device, label: &'static str, usage: wgpu::BufferUsages, size: u64) -> Self {
+    fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        usage: wgpu::BufferUsages,
+        size: u64,
+    ) -> Self {
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: size.max(16),
             usage,
             mapped_at_creation: false,
         });
-        Self { buffer, usage, label }
+        Self {
+            buffer,
+            usage,
+            label,
+        }
     }
 
     fn ensure(&mut self, device: &wgpu::Device, size: u64) {
@@ -852,9 +877,27 @@ fn create_targets(device: &wgpu::Device, width: u32, height: u32, supersample: u
     };
     use wgpu::TextureUsages as U;
     let (iw, ih) = (width * supersample, height * supersample);
-    let color = texture("scene colour", iw, ih, HDR_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING);
-    let depth = texture("scene depth", iw, ih, DEPTH_FORMAT, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING);
-    let output = texture("output", width, height, OUTPUT_FORMAT, U::RENDER_ATTACHMENT | U::COPY_SRC);
+    let color = texture(
+        "scene colour",
+        iw,
+        ih,
+        HDR_FORMAT,
+        U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+    );
+    let depth = texture(
+        "scene depth",
+        iw,
+        ih,
+        DEPTH_FORMAT,
+        U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+    );
+    let output = texture(
+        "output",
+        width,
+        height,
+        OUTPUT_FORMAT,
+        U::RENDER_ATTACHMENT | U::COPY_SRC,
+    );
     let padded_row = (width * 4).div_ceil(256) * 256;
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("output readback"),
@@ -938,17 +981,22 @@ impl Renderer {
         });
         let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("classify"),
-            entries: &[storage_entry(0, true), storage_entry(1, true), storage_entry(2, false)],
-        });
-        let heightfield_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("heightfield"),
             entries: &[
                 storage_entry(0, true),
-                uniform_entry(1, wgpu::ShaderStages::COMPUTE),
-                storage_texture_entry(2),
-                storage_texture_entry(3),
+                storage_entry(1, true),
+                storage_entry(2, false),
             ],
         });
+        let heightfield_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("heightfield"),
+                entries: &[
+                    storage_entry(0, true),
+                    uniform_entry(1, wgpu::ShaderStages::COMPUTE),
+                    storage_texture_entry(2),
+                    storage_texture_entry(3),
+                ],
+            });
 
         let module = |label: &str, source: String| {
             device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -965,14 +1013,18 @@ impl Renderer {
         let heightfield_module = module("heightfield.wgsl", shaders::HEIGHTFIELD.to_owned());
 
         let layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
-            let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+            let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+                groups.iter().map(|g| Some(*g)).collect();
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(label),
                 bind_group_layouts: &groups,
                 immediate_size: 0,
             })
         };
-        let compute = |label: &str, module: &wgpu::ShaderModule, entry: &str, groups: &[&wgpu::BindGroupLayout]| {
+        let compute = |label: &str,
+                       module: &wgpu::ShaderModule,
+                       entry: &str,
+                       groups: &[&wgpu::BindGroupLayout]| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: Some(&layout(label, groups)),
@@ -982,8 +1034,18 @@ impl Renderer {
                 cache: None,
             })
         };
-        let classify_pipeline = compute("classify", &classify_module, "classify", &[&classify_layout]);
-        let heightfield_pipeline = compute("heightfield", &heightfield_module, "heightfield", &[&heightfield_layout]);
+        let classify_pipeline = compute(
+            "classify",
+            &classify_module,
+            "classify",
+            &[&classify_layout],
+        );
+        let heightfield_pipeline = compute(
+            "heightfield",
+            &heightfield_module,
+            "heightfield",
+            &[&heightfield_layout],
+        );
 
         let hdr_target = [Some(wgpu::ColorTargetState {
             format: HDR_FORMAT,
@@ -1000,7 +1062,8 @@ impl Renderer {
             ..Default::default()
         };
         let mesh_buffers = gpu::mesh_vertex_layouts();
-        let mesh_buffers: Vec<Option<wgpu::VertexBufferLayout>> = mesh_buffers.into_iter().map(Some).collect();
+        let mesh_buffers: Vec<Option<wgpu::VertexBufferLayout>> =
+            mesh_buffers.into_iter().map(Some).collect();
 
         let shadow_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow"),
@@ -1076,7 +1139,11 @@ impl Renderer {
             &hdr_target,
             &[],
         );
-        let manual: &[(&str, f64)] = if filterable { &[] } else { &[("MANUAL_FILTER", 1.0)] };
+        let manual: &[(&str, f64)] = if filterable {
+            &[]
+        } else {
+            &[("MANUAL_FILTER", 1.0)]
+        };
         let basic_pipeline = render(
             "snow basic",
             &surface_module,
@@ -1165,7 +1232,8 @@ impl Renderer {
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
                 format: DEPTH_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
                 view_formats: &[],
             })
             .create_view(&Default::default());
@@ -1199,16 +1267,36 @@ impl Renderer {
         };
         let targets = create_targets(&device, config.width, config.height, config.supersample);
         Ok(Self {
-            surface_buffer: Growable::new(&device, "snow surfaces", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 8),
-            classify_buffer: Growable::new(&device, "classify records", U::STORAGE | U::COPY_DST, 16 * 8),
+            surface_buffer: Growable::new(
+                &device,
+                "snow surfaces",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 8,
+            ),
+            classify_buffer: Growable::new(
+                &device,
+                "classify records",
+                U::STORAGE | U::COPY_DST,
+                16 * 8,
+            ),
             state_buffer: Growable::new(
                 &device,
                 "surface state",
                 U::STORAGE | U::INDIRECT | U::COPY_SRC,
                 STATE_WORDS * 4 * 8,
             ),
-            heightfield_params: Growable::new(&device, "heightfield params", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 8),
-            instance_buffer: Growable::new(&device, "mesh instances", U::VERTEX | U::COPY_DST, 144 * 64),
+            heightfield_params: Growable::new(
+                &device,
+                "heightfield params",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 8,
+            ),
+            instance_buffer: Growable::new(
+                &device,
+                "mesh instances",
+                U::VERTEX | U::COPY_DST,
+                144 * 64,
+            ),
             queue: gpu.queue.clone(),
             device,
             config,
@@ -1304,29 +1392,40 @@ impl Renderer {
         let (vertices, indices) = geometry::shade_normals(mesh, geometry::CREASE_DEGREES);
         use wgpu::util::DeviceExt;
         Ok(GpuMesh {
-            vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("render mesh vertices"),
-                contents: bytemuck::cast_slice(&vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            }),
-            indices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("render mesh indices"),
-                contents: bytemuck::cast_slice(&indices),
-                usage: wgpu::BufferUsages::INDEX,
-            }),
+            vertices: self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("render mesh vertices"),
+                    contents: bytemuck::cast_slice(&vertices),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+            indices: self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("render mesh indices"),
+                    contents: bytemuck::cast_slice(&indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                }),
             index_count: indices.len() as u32,
             radius: mesh.bounding_radius(),
         })
     }
 
     /// Render a frame offscreen and read it back (waits for the GPU).
-    pub fn render(&mut self, world: &SnowWorld, frame: &RenderFrame<'_>) -> RenderResult<RenderOutput> {
+    pub fn render(
+        &mut self,
+        world: &SnowWorld,
+        frame: &RenderFrame<'_>,
+    ) -> RenderResult<RenderOutput> {
         let start = Instant::now();
         // A pending report readback of an earlier `render_to_view` must finish first: the buffer is
         // reused.
         self.finish_stats(true)?;
         let output_view = self.targets.output_view.clone();
-        let Encoded { mut encoder, surfaces } = self.encode(world, frame, &output_view, OUTPUT_FORMAT)?;
+        let Encoded {
+            mut encoder,
+            surfaces,
+        } = self.encode(world, frame, &output_view, OUTPUT_FORMAT)?;
         let (w, h) = self.targets.size;
         encoder.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
@@ -1407,7 +1506,10 @@ impl Renderer {
             });
         }
         self.finish_stats(false)?;
-        let Encoded { mut encoder, surfaces } = self.encode(world, frame, target, format)?;
+        let Encoded {
+            mut encoder,
+            surfaces,
+        } = self.encode(world, frame, target, format)?;
         let copied = self.stats.state.load(Ordering::Acquire) == MAP_IDLE;
         if copied {
             self.copy_stats(&mut encoder, surfaces);
@@ -1441,11 +1543,23 @@ impl Renderer {
             });
         }
         if state_bytes > 0 {
-            encoder.copy_buffer_to_buffer(&self.state_buffer.buffer, 0, &self.stats.buffer, 0, state_bytes);
+            encoder.copy_buffer_to_buffer(
+                &self.state_buffer.buffer,
+                0,
+                &self.stats.buffer,
+                0,
+                state_bytes,
+            );
         }
         if let Some(ts) = &self.timestamps {
             encoder.resolve_query_set(&ts.set, 0..2 * PASSES.len() as u32, &ts.resolve, 0);
-            encoder.copy_buffer_to_buffer(&ts.resolve, 0, &self.stats.buffer, state_bytes, ts_bytes);
+            encoder.copy_buffer_to_buffer(
+                &ts.resolve,
+                0,
+                &self.stats.buffer,
+                state_bytes,
+                ts_bytes,
+            );
         }
         self.stats.surfaces = surfaces;
         self.stats.timestamps = self.timestamps.is_some();
@@ -1454,9 +1568,15 @@ impl Renderer {
     fn start_stats_map(&mut self) {
         let state = self.stats.state.clone();
         state.store(MAP_PENDING, Ordering::Release);
-        self.stats.buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            state.store(if r.is_ok() { MAP_READY } else { MAP_FAILED }, Ordering::Release);
-        });
+        self.stats
+            .buffer
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                state.store(
+                    if r.is_ok() { MAP_READY } else { MAP_FAILED },
+                    Ordering::Release,
+                );
+            });
     }
 
     /// Read the stats readback when it has arrived (waiting for it when `wait`).
@@ -1476,7 +1596,9 @@ impl Renderer {
             MAP_READY => {}
             MAP_FAILED => {
                 self.stats.state.store(MAP_IDLE, Ordering::Release);
-                return Err(RenderError::Readback("mapping the frame report failed".into()));
+                return Err(RenderError::Readback(
+                    "mapping the frame report failed".into(),
+                ));
             }
             _ => return Ok(()),
         }
@@ -1519,7 +1641,10 @@ impl Renderer {
                     });
                 }
             }
-            FrameReport { pass_times, surfaces }
+            FrameReport {
+                pass_times,
+                surfaces,
+            }
         };
         self.stats.buffer.unmap();
         self.stats.state.store(MAP_IDLE, Ordering::Release);
@@ -1539,7 +1664,11 @@ impl Renderer {
         if !(c.eye.is_finite() && c.target.is_finite()) || c.eye.distance(c.target) < 1e-4 {
             return bad(
                 "camera".into(),
-                format!("eye {:?}, target {:?}", c.eye.to_array(), c.target.to_array()),
+                format!(
+                    "eye {:?}, target {:?}",
+                    c.eye.to_array(),
+                    c.target.to_array()
+                ),
                 "two finite, distinct points",
             );
         }
@@ -1558,11 +1687,19 @@ impl Renderer {
                 return Err(RenderError::StaleMesh { index: inst.mesh.0 });
             }
             if !finite_mat(&inst.transform) {
-                return bad(format!("instance {i} transform"), format!("{:?}", inst.transform), "finite");
+                return bad(
+                    format!("instance {i} transform"),
+                    format!("{:?}", inst.transform),
+                    "finite",
+                );
             }
         }
         for (i, l) in frame.lights.iter().enumerate() {
-            if !(l.position.is_finite() && l.color.is_finite() && l.radius.is_finite() && l.radius > 0.0) {
+            if !(l.position.is_finite()
+                && l.color.is_finite()
+                && l.radius.is_finite()
+                && l.radius > 0.0)
+            {
                 return bad(
                     format!("light {i}"),
                     format!("{l:?}"),
@@ -1571,7 +1708,11 @@ impl Renderer {
             }
         }
         let e = &frame.environment;
-        if !(e.moon_direction.is_finite() && e.moon_direction.length() > 1e-3 && e.exposure.is_finite() && e.exposure > 0.0) {
+        if !(e.moon_direction.is_finite()
+            && e.moon_direction.length() > 1e-3
+            && e.exposure.is_finite()
+            && e.exposure > 0.0)
+        {
             return bad(
                 "environment".into(),
                 format!("{e:?}"),
@@ -1591,7 +1732,11 @@ impl Renderer {
     }
 
     /// The moon's shadow projection fitted around everything drawn, and its texel in metres.
-    fn shadow_projection(&self, world: &SnowWorld, frame: &RenderFrame<'_>) -> RenderResult<(Mat4, f32)> {
+    fn shadow_projection(
+        &self,
+        world: &SnowWorld,
+        frame: &RenderFrame<'_>,
+    ) -> RenderResult<(Mat4, f32)> {
         let mut lo = Vec3::splat(f32::MAX);
         let mut hi = Vec3::splat(f32::MIN);
         for (id, _) in frame.surfaces {
@@ -1641,7 +1786,14 @@ impl Renderer {
             vlo = vlo.min(v);
             vhi = vhi.max(v);
         }
-        let proj = glam::camera::rh::proj::directx::orthographic(vlo.x, vhi.x, vlo.y, vhi.y, -vhi.z - 1.0, -vlo.z + 1.0);
+        let proj = glam::camera::rh::proj::directx::orthographic(
+            vlo.x,
+            vhi.x,
+            vlo.y,
+            vhi.y,
+            -vhi.z - 1.0,
+            -vlo.z + 1.0,
+        );
         let texel = (vhi.x - vlo.x).max(vhi.y - vlo.y) / self.shadow_size as f32;
         Ok((proj * view, texel))
     }
@@ -1651,36 +1803,42 @@ impl Renderer {
         if let Some(p) = self.tonemap_pipelines.get(&(format, ss)) {
             return p.clone();
         }
-        let constants = [("SUPERSAMPLE", ss as f64), ("ENCODE_SRGB", if format.is_srgb() { 0.0 } else { 1.0 })];
-        let pipeline = self.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("tonemap"),
-            layout: Some(&self.tonemap_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &self.tonemap_module,
-                entry_point: Some("vs_tonemap"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &self.tonemap_module,
-                entry_point: Some("fs_tonemap"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
+        let constants = [
+            ("SUPERSAMPLE", ss as f64),
+            ("ENCODE_SRGB", if format.is_srgb() { 0.0 } else { 1.0 }),
+        ];
+        let pipeline = self
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("tonemap"),
+                layout: Some(&self.tonemap_pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &self.tonemap_module,
+                    entry_point: Some("vs_tonemap"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
                 },
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        self.tonemap_pipelines.insert((format, ss), pipeline.clone());
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &self.tonemap_module,
+                    entry_point: Some("fs_tonemap"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        self.tonemap_pipelines
+            .insert((format, ss), pipeline.clone());
         pipeline
     }
 
@@ -1700,7 +1858,8 @@ impl Renderer {
                         sample_count: 1,
                         dimension: wgpu::TextureDimension::D2,
                         format: HEIGHTFIELD_FORMAT,
-                        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+                        usage: wgpu::TextureUsages::STORAGE_BINDING
+                            | wgpu::TextureUsages::TEXTURE_BINDING,
                         view_formats: &[],
                     })
                     .create_view(&Default::default())
@@ -1746,7 +1905,10 @@ impl Renderer {
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             shadow_view_proj: shadow.0.to_cols_array_2d(),
             eye: v4(frame.camera.eye, frame.time),
-            moon_dir: v4(e.moon_direction.normalize(), e.moon_radius_degrees.to_radians().cos()),
+            moon_dir: v4(
+                e.moon_direction.normalize(),
+                e.moon_radius_degrees.to_radians().cos(),
+            ),
             moon_color: v4(e.moon_color, shadow.1),
             sky_zenith: v4(e.sky_zenith, e.exposure),
             sky_horizon: v4(e.sky_horizon, e.fog_density),
@@ -1775,7 +1937,8 @@ impl Renderer {
         self.check_frame(frame)?;
         let shadow = self.shadow_projection(world, frame)?;
         let uniform = self.frame_uniform(frame, shadow);
-        self.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
+        self.queue
+            .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
 
         // Surface tables.
         let search = self.config.search_settings();
@@ -1810,11 +1973,17 @@ impl Renderer {
                     search.max_taps as f32,
                     search.refine_taps as f32,
                 ],
-                look: [look.ground_from, look.ground_full, look.occlusion, search.shadow_taps as f32],
+                look: [
+                    look.ground_from,
+                    look.ground_full,
+                    look.occlusion,
+                    search.shadow_taps as f32,
+                ],
                 pattern: [desc.center.x, desc.center.z, 0.0, 0.0],
             };
             let o = s * UNIFORM_STRIDE as usize;
-            surface_bytes[o..o + std::mem::size_of::<SurfaceUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
+            surface_bytes[o..o + std::mem::size_of::<SurfaceUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
             let p = HeightfieldParams {
                 heights,
                 width: layout.width,
@@ -1832,7 +2001,8 @@ impl Renderer {
                     [l.x, l.y, l.z, 0.0]
                 },
             };
-            hf_bytes[o..o + std::mem::size_of::<HeightfieldParams>()].copy_from_slice(bytemuck::bytes_of(&p));
+            hf_bytes[o..o + std::mem::size_of::<HeightfieldParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&p));
             records.push(ClassifyRecord {
                 heights,
                 width: layout.width,
@@ -1841,15 +2011,24 @@ impl Renderer {
             });
             sizes.push((layout.width, layout.height));
         }
-        self.surface_buffer.ensure(&self.device, surface_bytes.len() as u64);
-        self.queue.write_buffer(&self.surface_buffer.buffer, 0, &surface_bytes);
-        self.heightfield_params.ensure(&self.device, hf_bytes.len() as u64);
-        self.queue.write_buffer(&self.heightfield_params.buffer, 0, &hf_bytes);
+        self.surface_buffer
+            .ensure(&self.device, surface_bytes.len() as u64);
+        self.queue
+            .write_buffer(&self.surface_buffer.buffer, 0, &surface_bytes);
+        self.heightfield_params
+            .ensure(&self.device, hf_bytes.len() as u64);
+        self.queue
+            .write_buffer(&self.heightfield_params.buffer, 0, &hf_bytes);
         if n > 0 {
             self.classify_buffer.ensure(&self.device, (n * 16) as u64);
-            self.queue.write_buffer(&self.classify_buffer.buffer, 0, bytemuck::cast_slice(&records));
+            self.queue.write_buffer(
+                &self.classify_buffer.buffer,
+                0,
+                bytemuck::cast_slice(&records),
+            );
         }
-        self.state_buffer.ensure(&self.device, n.max(1) as u64 * STATE_WORDS * 4);
+        self.state_buffer
+            .ensure(&self.device, n.max(1) as u64 * STATE_WORDS * 4);
 
         // Instances: all of them grouped by mesh, then the shadow casters grouped by mesh.
         let mut order: Vec<usize> = (0..frame.instances.len()).collect();
@@ -1860,11 +2039,17 @@ impl Renderer {
             InstanceRaw {
                 model: inst.transform.to_cols_array_2d(),
                 normal: [c(normal.x_axis), c(normal.y_axis), c(normal.z_axis)],
-                albedo_material: [inst.albedo[0], inst.albedo[1], inst.albedo[2], inst.material.code()],
+                albedo_material: [
+                    inst.albedo[0],
+                    inst.albedo[1],
+                    inst.albedo[2],
+                    inst.material.code(),
+                ],
                 params: [inst.roughness, inst.emission, inst.snow_cover, inst.seed],
             }
         };
-        let mut instances: Vec<InstanceRaw> = order.iter().map(|&i| raw(&frame.instances[i])).collect();
+        let mut instances: Vec<InstanceRaw> =
+            order.iter().map(|&i| raw(&frame.instances[i])).collect();
         let casters: Vec<usize> = order
             .iter()
             .copied()
@@ -1886,8 +2071,15 @@ impl Renderer {
         let draws = runs(&order, 0);
         let shadow_draws = runs(&casters, order.len() as u32);
         if !instances.is_empty() {
-            self.instance_buffer.ensure(&self.device, std::mem::size_of_val(instances.as_slice()) as u64);
-            self.queue.write_buffer(&self.instance_buffer.buffer, 0, bytemuck::cast_slice(&instances));
+            self.instance_buffer.ensure(
+                &self.device,
+                std::mem::size_of_val(instances.as_slice()) as u64,
+            );
+            self.queue.write_buffer(
+                &self.instance_buffer.buffer,
+                0,
+                bytemuck::cast_slice(&instances),
+            );
         }
 
         // Bind groups.
@@ -1981,7 +2173,11 @@ impl Renderer {
                 entries: &[
                     wgpu::BindGroupEntry {
                         binding: 0,
-                        resource: buffer_slice(&self.surface_buffer.buffer, s, std::mem::size_of::<SurfaceUniform>()),
+                        resource: buffer_slice(
+                            &self.surface_buffer.buffer,
+                            s,
+                            std::mem::size_of::<SurfaceUniform>(),
+                        ),
                     },
                     wgpu::BindGroupEntry {
                         binding: 1,
@@ -2011,9 +2207,11 @@ impl Renderer {
         let tonemap = self.tonemap_pipeline(format);
 
         // The passes, in the order of PASSES.
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("snowprint frame"),
-        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("snowprint frame"),
+            });
         let ts = self.timestamps.as_ref();
         let render_ts = |i: usize| {
             ts.map(|t| wgpu::RenderPassTimestampWrites {
@@ -2149,7 +2347,10 @@ impl Renderer {
                 p.set_pipeline(pipeline);
                 for (s, bg) in surface_bgs.iter().enumerate() {
                     p.set_bind_group(1, bg, &[]);
-                    p.draw_indirect(&self.state_buffer.buffer, (s as u64 * STATE_WORDS + offset) * 4);
+                    p.draw_indirect(
+                        &self.state_buffer.buffer,
+                        (s as u64 * STATE_WORDS + offset) * 4,
+                    );
                 }
             }
         }

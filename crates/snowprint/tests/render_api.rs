@@ -1,0 +1,307 @@
+//! The renderer's contract: what it refuses (with the value that was wrong), what it reports (the
+//! material of each surface, pass times), and rendering into a caller's texture.
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use snowprint::render::{
+    Environment, Instance, PASSES, RenderConfig, RenderError, RenderFrame, Renderer,
+    SnowMaterialKind, Tier,
+};
+use snowprint::{
+    Camera, Deformer, GroundMaterial, Mesh, Pose, Shape, SnowWorld, SurfaceDesc, WorldConfig,
+};
+
+fn world() -> SnowWorld {
+    SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            pool_bytes: 2 << 20,
+            ..Default::default()
+        },
+    )
+    .expect("world")
+}
+
+fn camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.0, 3.0, 3.0),
+        target: Vec3::ZERO,
+        fov_y_degrees: 50.0,
+    }
+}
+
+fn frame<'a>(
+    surfaces: &'a [(snowprint::SurfaceId, GroundMaterial)],
+    instances: &'a [Instance],
+) -> RenderFrame<'a> {
+    RenderFrame {
+        camera: camera(),
+        time: 0.0,
+        surfaces,
+        instances,
+        lights: &[],
+        environment: Environment::moonlit_night(),
+        snowfall: true,
+    }
+}
+
+fn small(tier: Tier) -> RenderConfig {
+    let mut c = RenderConfig::new(64, 36, tier);
+    c.shadow_map_size = 256;
+    c.snowflakes = 200;
+    c
+}
+
+#[test]
+fn a_surface_switches_to_the_deformable_material_when_pressed() {
+    let mut world = world();
+    let a = world
+        .add_surface(SurfaceDesc::new("a", [0.0, 0.0, 0.0], [2.0, 2.0], 0.2))
+        .unwrap();
+    let b = world
+        .add_surface(SurfaceDesc::new("b", [3.0, 0.0, 0.0], [2.0, 2.0], 0.2))
+        .unwrap();
+    let surfaces = [
+        (a, GroundMaterial::Concrete),
+        (b, GroundMaterial::RoofTiles),
+    ];
+    let mut r = Renderer::new(common::gpu(), small(Tier::Relief)).unwrap();
+    let out = r.render(&world, &frame(&surfaces, &[])).unwrap();
+    assert_eq!(out.basic_material_surfaces, vec![a, b]);
+    assert_eq!(out.rgba8.len(), 64 * 36 * 4);
+
+    world
+        .step(
+            1.0 / 30.0,
+            &[Deformer::new(
+                Shape::Sphere { radius: 0.2 },
+                Pose::at([0.0, 0.1, 0.0]),
+            )],
+        )
+        .unwrap();
+    let out = r.render(&world, &frame(&surfaces, &[])).unwrap();
+    assert_eq!(out.basic_material_surfaces, vec![b]);
+    let shading_a = out.surfaces.iter().find(|s| s.surface == a).unwrap();
+    assert_eq!(shading_a.material, SnowMaterialKind::Deformable);
+    // The sphere's bottom is 0.1 m below the ground under 0.2 m of snow: pressed to the ground.
+    assert!(shading_a.deepest > 0.9, "{}", shading_a.deepest);
+
+    if r.has_timestamps() {
+        let names: Vec<&str> = out.pass_times.iter().map(|p| p.name).collect();
+        let expected: Vec<&str> = PASSES.iter().map(|p| p.name).collect();
+        assert_eq!(names, expected);
+        assert!(
+            out.pass_times
+                .iter()
+                .all(|p| p.gpu_ms.is_finite() && p.gpu_ms >= 0.0)
+        );
+    } else {
+        assert!(out.pass_times.is_empty());
+    }
+}
+
+#[test]
+fn mistakes_are_refused_with_the_value() {
+    let gpu = common::gpu();
+    let mut bad = small(Tier::Pom);
+    bad.supersample = 7;
+    let e = Renderer::new(gpu, bad).unwrap_err().to_string();
+    assert!(e.contains("supersample") && e.contains('7'), "{e}");
+
+    let mut bad = small(Tier::Relief);
+    bad.look.ground_full = 0.1;
+    let e = Renderer::new(gpu, bad).unwrap_err().to_string();
+    assert!(e.contains("look"), "{e}");
+
+    let mut world = world();
+    let a = world
+        .add_surface(SurfaceDesc::new("a", [0.0, 0.0, 0.0], [1.0, 1.0], 0.2))
+        .unwrap();
+    let mut r = Renderer::new(gpu, small(Tier::Relief)).unwrap();
+    let mut other = Renderer::new(gpu, small(Tier::Relief)).unwrap();
+    let foreign = other.add_mesh(&Mesh::cuboid(Vec3::ONE)).unwrap();
+    let _ = other.add_mesh(&Mesh::cuboid(Vec3::ONE)).unwrap();
+    let inst = [Instance::new(foreign, Mat4::IDENTITY, [1.0; 3])];
+    match r.render(&world, &frame(&[], &inst)) {
+        Err(RenderError::StaleMesh { index: 0 }) => {}
+        other => panic!("expected a stale mesh, got {other:?}"),
+    }
+
+    let twice = [(a, GroundMaterial::Concrete), (a, GroundMaterial::Concrete)];
+    let e = r
+        .render(&world, &frame(&twice, &[]))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("listed twice"), "{e}");
+
+    world.remove_surface(a).unwrap();
+    let gone = [(a, GroundMaterial::Concrete)];
+    let e = r.render(&world, &frame(&gone, &[])).unwrap_err();
+    assert!(matches!(e, RenderError::World(_)), "{e}");
+
+    let mut f = frame(&[], &[]);
+    f.camera.target = f.camera.eye;
+    let e = r.render(&world, &f).unwrap_err().to_string();
+    assert!(e.contains("camera"), "{e}");
+
+    let m = r.add_mesh(&Mesh::cuboid(Vec3::ONE)).unwrap();
+    let nan = [Instance::new(
+        m,
+        Mat4::from_translation(Vec3::new(f32::NAN, 0.0, 0.0)),
+        [1.0; 3],
+    )];
+    let e = r.render(&world, &frame(&[], &nan)).unwrap_err().to_string();
+    assert!(e.contains("instance 0 transform"), "{e}");
+
+    let broken = Mesh {
+        positions: vec![Vec3::ZERO],
+        indices: vec![0, 1, 2],
+    };
+    let e = r.add_mesh(&broken).unwrap_err().to_string();
+    assert!(e.contains("out of range"), "{e}");
+}
+
+#[test]
+fn renders_into_a_callers_texture() {
+    let gpu = common::gpu();
+    let world = world();
+    let mut r = Renderer::new(gpu, small(Tier::Relief)).unwrap();
+    let cube = r.add_mesh(&Mesh::cuboid(Vec3::splat(0.5))).unwrap();
+    let inst = [Instance::new(cube, Mat4::IDENTITY, [0.6, 0.2, 0.1])];
+    // A window's surface is often Bgra8Unorm (not sRGB): the tonemap pass then encodes sRGB itself.
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("window stand-in"),
+        size: wgpu::Extent3d {
+            width: 64,
+            height: 36,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Bgra8Unorm,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    for _ in 0..3 {
+        r.render_to_view(
+            &world,
+            &frame(&[], &inst),
+            &view,
+            wgpu::TextureFormat::Bgra8Unorm,
+        )
+        .unwrap();
+    }
+    gpu.wait_idle().unwrap();
+    // The offscreen path agrees with the window path on the centre pixel (the cube).
+    let out = r.render(&world, &frame(&[], &inst)).unwrap();
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: 256 * 36,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    r.render_to_view(
+        &world,
+        &frame(&[], &inst),
+        &view,
+        wgpu::TextureFormat::Bgra8Unorm,
+    )
+    .unwrap();
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(256),
+                rows_per_image: Some(36),
+            },
+        },
+        wgpu::Extent3d {
+            width: 64,
+            height: 36,
+            depth_or_array_layers: 1,
+        },
+    );
+    gpu.queue.submit([enc.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    gpu.wait_idle().unwrap();
+    let data = staging.slice(..).get_mapped_range().unwrap().to_vec();
+    let (x, y) = (32usize, 18usize);
+    let bgra = &data[y * 256 + x * 4..y * 256 + x * 4 + 4];
+    let rgba = &out.rgba8[(y * 64 + x) * 4..(y * 64 + x) * 4 + 4];
+    for c in 0..3 {
+        let window = bgra[2 - c] as i32;
+        assert!(
+            (window - rgba[c] as i32).abs() <= 3,
+            "channel {c}: window {window} vs offscreen {}",
+            rgba[c]
+        );
+    }
+    assert!(r.latest_report().is_some());
+
+    // A target of the wrong size is refused.
+    let wrong = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: 32,
+            height: 36,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Bgra8Unorm,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let e = r
+        .render_to_view(
+            &world,
+            &frame(&[], &inst),
+            &wrong.create_view(&Default::default()),
+            wgpu::TextureFormat::Bgra8Unorm,
+        )
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            RenderError::TargetSize {
+                got: (32, 36),
+                expected: (64, 36)
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn supersampling_and_resize() {
+    let gpu = common::gpu();
+    let world = world();
+    let mut r = Renderer::new(gpu, small(Tier::Relief)).unwrap();
+    r.resize(48, 32, 2).unwrap();
+    let mut f = frame(&[], &[]);
+    f.camera = Camera {
+        eye: Vec3::new(0.0, 1.0, 0.0),
+        target: Vec3::new(0.0, 1.25, -1.0),
+        fov_y_degrees: 50.0,
+    };
+    let out = r.render(&world, &f).unwrap();
+    assert_eq!(
+        (out.width, out.height, out.rgba8.len()),
+        (48, 32, 48 * 32 * 4)
+    );
+    // Only sky, looking a little up: the top row is darker than the horizon glow at the bottom.
+    let lum = |row: usize| {
+        out.rgba8[row * 48 * 4..(row + 1) * 48 * 4]
+            .iter()
+            .map(|&v| v as u32)
+            .sum::<u32>()
+    };
+    assert!(lum(0) <= lum(31), "{} {}", lum(0), lum(31));
+}

@@ -1,0 +1,515 @@
+//! The snow material's GPU maths against their CPU references (`snowprint::render::cpu`), on the
+//! same inputs: the heightfield pass (Sobel normals, horizon AO, moon visibility) on a synthetic
+//! heightmap, and the relief search, POM search and RNM of `snow.wgsl` run in a compute harness on
+//! analytic heightfields.
+
+mod common;
+
+use glam::{Vec2, Vec3};
+use snowprint::render::cpu;
+use snowprint::render::gpu::HeightfieldParams;
+use snowprint::render::shaders;
+use wgpu::util::DeviceExt;
+
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let frac = (h & 0x3ff) as f32;
+    sign * match exp {
+        0 => frac * 2f32.powi(-24),
+        31 => f32::INFINITY,
+        _ => (1.0 + frac / 1024.0) * 2f32.powi(exp - 15),
+    }
+}
+
+fn read_buffer(buffer: &wgpu::Buffer) -> Vec<u8> {
+    let gpu = common::gpu();
+    buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    gpu.wait_idle().expect("gpu");
+    let data = buffer
+        .slice(..)
+        .get_mapped_range()
+        .expect("mapped")
+        .to_vec();
+    buffer.unmap();
+    data
+}
+
+/// Depressions of a synthetic 64 x 48 heightmap: two dents, a trench and a ramp.
+fn synthetic(width: u32, height: u32) -> Vec<f32> {
+    let mut d = vec![0.0f32; (width * height) as usize];
+    for r in 0..height {
+        for c in 0..width {
+            let (x, y) = (c as f32, r as f32);
+            let mut v: f32 = 0.0;
+            for (cx, cy, rad, depth) in [(16.0, 14.0, 5.0, 1.0), (44.0, 30.0, 8.0, 0.6)] {
+                let q = ((x - cx).powi(2) + (y - cy).powi(2)).sqrt() / rad;
+                if q < 1.0 {
+                    v = v.max(depth * (1.0 - q * q));
+                }
+            }
+            if (y - 38.0).abs() < 2.5 && x > 6.0 && x < 36.0 {
+                v = v.max(0.9);
+            }
+            v = v.max((x - 54.0).max(0.0) * 0.05);
+            d[(r * width + c) as usize] = v.min(1.0);
+        }
+    }
+    d
+}
+
+#[test]
+fn heightfield_pass_matches_its_cpu_reference() {
+    let gpu = common::gpu();
+    let dev = &gpu.device;
+    let (w, h) = (64u32, 48u32);
+    let depth = 0.2;
+    let texel = Vec2::new(0.04, 0.05);
+    let dep = synthetic(w, h);
+    let units: Vec<u32> = dep.iter().map(|&v| (v * 65535.0).round() as u32).collect();
+    // The heightmap sits at an offset in the pool, as a world's slot does.
+    let offset = 100u32;
+    let mut pool = vec![0u32; offset as usize];
+    pool.extend(&units);
+    let pool = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("pool"),
+        contents: bytemuck::cast_slice(&pool),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let light = Vec3::new(-0.8, 0.42, 0.35).normalize();
+    let params = HeightfieldParams {
+        heights: offset,
+        width: w,
+        height: h,
+        _pad: 0,
+        snow_depth: depth,
+        texel_x: texel.x,
+        texel_z: texel.y,
+        _pad2: 0.0,
+        light: [light.x, light.y, light.z, 0.0],
+    };
+    let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("params"),
+        contents: bytemuck::bytes_of(&params),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let texture = || {
+        dev.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    };
+    let (shape, lit) = (texture(), texture());
+    let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("heightfield.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(shaders::HEIGHTFIELD.into()),
+    });
+    let pipeline = dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: None,
+        layout: None,
+        module: &module,
+        entry_point: Some("heightfield"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: pool.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(
+                    &shape.create_view(&Default::default()),
+                ),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&lit.create_view(&Default::default())),
+            },
+        ],
+    });
+    let row = (w * 8).div_ceil(256) * 256;
+    let readback = |t: &wgpu::Texture, enc: &mut wgpu::CommandEncoder| {
+        let b = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: (row * h) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.copy_texture_to_buffer(
+            t.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &b,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        b
+    };
+    let mut enc = dev.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    }
+    let (shape_rb, lit_rb) = (readback(&shape, &mut enc), readback(&lit, &mut enc));
+    gpu.queue.submit([enc.finish()]);
+    let (shape_bytes, lit_bytes) = (read_buffer(&shape_rb), read_buffer(&lit_rb));
+    let texel_at = |bytes: &[u8], c: u32, r: u32| -> [f32; 4] {
+        let o = (r * row + c * 8) as usize;
+        let v: &[u16] = bytemuck::cast_slice(&bytes[o..o + 8]);
+        [
+            f16_to_f32(v[0]),
+            f16_to_f32(v[1]),
+            f16_to_f32(v[2]),
+            f16_to_f32(v[3]),
+        ]
+    };
+
+    // The same inputs as the GPU read them: depression from the quantized units, clamped at the
+    // edges; nearest texel for the AO's offsets, bilinear for the light march.
+    let d = |c: i32, r: i32| {
+        let (c, r) = (c.clamp(0, w as i32 - 1), r.clamp(0, h as i32 - 1));
+        units[(r as u32 * w + c as u32) as usize] as f32 / 65535.0
+    };
+    let mut worst = [0.0f32; 4];
+    for r in 0..h as i32 {
+        for c in 0..w as i32 {
+            let gpu_texel = texel_at(&shape_bytes, c as u32, r as u32);
+            let n = cpu::sobel_normal(d, c, r, depth, texel);
+            let ao = cpu::horizon_ao(|dx, dz| {
+                let (oc, orow) = ((dx / texel.x).round() as i32, (dz / texel.y).round() as i32);
+                depth * (1.0 - d(c + oc, r + orow))
+            });
+            let vis = cpu::light_visibility(
+                |x, z| {
+                    let (fx, fz) = (x / texel.x, z / texel.y);
+                    let (ix, iz) = (fx.floor(), fz.floor());
+                    let (wx, wz) = (fx - ix, fz - iz);
+                    let (x0, z0) = (c + ix as i32, r + iz as i32);
+                    let a = d(x0, z0) * (1.0 - wx) + d(x0 + 1, z0) * wx;
+                    let b = d(x0, z0 + 1) * (1.0 - wx) + d(x0 + 1, z0 + 1) * wx;
+                    depth * (1.0 - (a * (1.0 - wz) + b * wz))
+                },
+                0.0,
+                0.0,
+                light,
+                depth,
+                texel.x.max(texel.y),
+            );
+            let gpu_vis = texel_at(&lit_bytes, c as u32, r as u32)[0];
+            let errors = [
+                (gpu_texel[0] - d(c, r)).abs(),
+                (gpu_texel[1] - n.x).abs().max((gpu_texel[2] - n.z).abs()),
+                (gpu_texel[3] - ao).abs(),
+                (gpu_vis - vis).abs(),
+            ];
+            for k in 0..4 {
+                worst[k] = worst[k].max(errors[k]);
+            }
+        }
+    }
+    // Half-float storage keeps about three decimal digits: 1e-3 relative, within 2e-3 here.
+    assert!(
+        worst.iter().all(|&e| e < 2e-3),
+        "worst |GPU - CPU| (depression, normal, AO, light): {worst:?}"
+    );
+}
+
+/// A compute harness around snow.wgsl: analytic heightfields as the contract, every search and
+/// RNM on inputs from a buffer.
+const HARNESS: &str = r#"
+struct Case {
+    origin: vec4<f32>,   // xyz, w: which heightfield (0 plane, 1 dent)
+    dir: vec4<f32>,
+}
+@group(0) @binding(0) var<storage, read> cases: array<Case>;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> normals: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> blended: array<vec4<f32>>;
+
+var<private> field: u32;
+const DEPTH: f32 = 0.3;
+
+fn analytic_height(xz: vec2<f32>) -> f32 {
+    if field == 0u {
+        return 0.15 + 0.04 * xz.x;
+    }
+    let c = vec3<f32>(0.3, DEPTH + 0.25 - 0.2, -0.2);
+    let r2 = dot(xz - c.xz, xz - c.xz);
+    if r2 >= 0.0625 {
+        return DEPTH;
+    }
+    return min(DEPTH, c.y - sqrt(0.0625 - r2));
+}
+
+fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    let xz = uv * 2.0 * s.half_size - s.half_size;
+    return 1.0 - analytic_height(xz) / s.snow_depth;
+}
+fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(snow_depression(s, uv), 0.0, 0.0, 1.0);
+}
+fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    return 1.0;
+}
+
+@compute @workgroup_size(64)
+fn search(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&cases) {
+        return;
+    }
+    let c = cases[id.x];
+    field = u32(c.origin.w);
+    var s: SnowSurface;
+    s.half_size = vec2<f32>(2.0, 1.5);
+    s.snow_depth = DEPTH;
+    s.texel = 0.04;
+    s.search = vec4<f32>(0.5, 4.0, 12.0, 5.0);
+    let o = c.origin.xyz;
+    let d = c.dir.xyz;
+    let exit = snow_slab_exit(s, o, d);
+    let taps = snow_linear_taps(s, d, exit.x);
+    let relief = snow_relief_search(s, o, d, exit.x, taps, 5u);
+    let pom = snow_pom_search(s, o, d, exit.x, taps, 3u);
+    results[2u * id.x] = vec4<f32>(relief.x, relief.y, pom.x, pom.y);
+    results[2u * id.x + 1u] = vec4<f32>(exit.x, exit.y, f32(taps), 0.0);
+}
+
+@compute @workgroup_size(64)
+fn blend(@builtin(global_invocation_id) id: vec3<u32>) {
+    if 2u * id.x + 1u >= arrayLength(&normals) {
+        return;
+    }
+    blended[id.x] = vec4<f32>(snow_rnm(normals[2u * id.x].xyz, normals[2u * id.x + 1u].xyz), 0.0);
+}
+"#;
+
+#[test]
+fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
+    let gpu = common::gpu();
+    let dev = &gpu.device;
+    let half = Vec2::new(2.0, 1.5);
+    let depth = 0.3f32;
+    // Rays entering the top over the plane and over the dent, in many directions.
+    let mut cases: Vec<[f32; 8]> = Vec::new();
+    for field in 0..2 {
+        for i in 0..48 {
+            let a = std::f32::consts::TAU * i as f32 / 48.0;
+            let down = 0.25 + 1.5 * ((i * 7) % 11) as f32 / 11.0;
+            let dir = Vec3::new(a.cos(), -down, a.sin()).normalize();
+            let origin = if field == 0 {
+                Vec3::new(-1.0 + 0.03 * i as f32, depth, 0.2)
+            } else {
+                Vec3::new(0.25 + 0.002 * i as f32, depth, -0.15)
+            };
+            cases.push([
+                origin.x,
+                origin.y,
+                origin.z,
+                field as f32,
+                dir.x,
+                dir.y,
+                dir.z,
+                0.0,
+            ]);
+        }
+    }
+    let normals: Vec<Vec3> = (0..40)
+        .map(|i| {
+            let phi = 0.7 * i as f32;
+            let theta = 1.2 * ((i * 5) % 9) as f32 / 9.0;
+            Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            )
+        })
+        .collect();
+    let pairs: Vec<[f32; 4]> = normals
+        .iter()
+        .zip(normals.iter().rev())
+        .flat_map(|(a, b)| [[a.x, a.y, a.z, 0.0], [b.x, b.y, b.z, 0.0]])
+        .collect();
+
+    let source = format!("{}\n{HARNESS}", shaders::SNOW);
+    let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("snow.wgsl harness"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let storage = |contents: &[u8], rw: bool| {
+        dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents,
+            usage: wgpu::BufferUsages::STORAGE
+                | if rw {
+                    wgpu::BufferUsages::COPY_SRC
+                } else {
+                    wgpu::BufferUsages::empty()
+                },
+        })
+    };
+    let case_buf = storage(bytemuck::cast_slice(&cases), false);
+    let result_buf = storage(&vec![0u8; cases.len() * 32], true);
+    let normal_buf = storage(bytemuck::cast_slice(&pairs), false);
+    let blended_buf = storage(&vec![0u8; normals.len() * 16], true);
+    let layout = dev.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &(0..4)
+            .map(|b| wgpu::BindGroupLayoutEntry {
+                binding: b,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage {
+                        read_only: b % 2 == 0,
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            })
+            .collect::<Vec<_>>(),
+    });
+    let pl = dev.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = |entry: &str| {
+        dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: None,
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: case_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: result_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: normal_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: blended_buf.as_entire_binding(),
+            },
+        ],
+    });
+    let copy = |src: &wgpu::Buffer, enc: &mut wgpu::CommandEncoder| {
+        let b = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: src.size(),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.copy_buffer_to_buffer(src, 0, &b, 0, src.size());
+        b
+    };
+    let mut enc = dev.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_bind_group(0, &bg, &[]);
+        pass.set_pipeline(&pipeline("search"));
+        pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
+        pass.set_pipeline(&pipeline("blend"));
+        pass.dispatch_workgroups((normals.len() as u32).div_ceil(64), 1, 1);
+    }
+    let (results_rb, blended_rb) = (copy(&result_buf, &mut enc), copy(&blended_buf, &mut enc));
+    gpu.queue.submit([enc.finish()]);
+    let results: Vec<f32> = bytemuck::cast_slice(&read_buffer(&results_rb)).to_vec();
+    let blended: Vec<f32> = bytemuck::cast_slice(&read_buffer(&blended_rb)).to_vec();
+
+    for (i, c) in cases.iter().enumerate() {
+        let ray = cpu::SlabRay {
+            origin: Vec3::new(c[0], c[1], c[2]),
+            dir: Vec3::new(c[4], c[5], c[6]),
+        };
+        let plane = c[3] == 0.0;
+        let height = |p: Vec2| {
+            if plane {
+                0.15 + 0.04 * p.x
+            } else {
+                let r2 = (p - Vec2::new(0.3, -0.2)).length_squared();
+                if r2 >= 0.0625 {
+                    depth
+                } else {
+                    depth.min(depth + 0.05 - (0.0625 - r2).sqrt())
+                }
+            }
+        };
+        let (t_max, ground) = cpu::slab_exit(&ray, half, depth);
+        let taps = cpu::linear_taps(ray.dir, t_max, 0.04, 0.5, 4.0, 12.0);
+        let g = &results[8 * i..8 * i + 8];
+        assert!(
+            (g[4] - t_max).abs() < 1e-4 && (g[5] == 1.0) == ground,
+            "case {i}: exit {g:?} vs {t_max} {ground}"
+        );
+        assert_eq!(g[6] as u32, taps, "case {i}: taps");
+        // The two sides round differently (the GPU goes through UVs), so a hit may land on the
+        // other side of one tiny bracket: within the bracket's width.
+        let bracket = t_max / taps as f32 / 32.0 + 1e-4;
+        match cpu::relief_search(height, &ray, t_max, taps, 5) {
+            Some(t) => assert!(
+                g[1] == 1.0 && (g[0] - t).abs() <= bracket,
+                "case {i}: relief {} vs {t}",
+                g[0]
+            ),
+            None => assert_eq!(g[1], 0.0, "case {i}: relief found a hit the CPU did not"),
+        }
+        match cpu::pom_search(height, &ray, t_max, taps, 3) {
+            Some(t) => assert!(
+                g[3] == 1.0 && (g[2] - t).abs() <= t_max / taps as f32 * 0.02 + 1e-4,
+                "case {i}: pom {} vs {t}",
+                g[2]
+            ),
+            None => assert_eq!(g[3], 0.0, "case {i}: pom found a hit the CPU did not"),
+        }
+    }
+    for (k, (a, b)) in normals.iter().zip(normals.iter().rev()).enumerate() {
+        let want = cpu::rnm(*a, *b);
+        let got = Vec3::new(blended[4 * k], blended[4 * k + 1], blended[4 * k + 2]);
+        assert!(
+            (got - want).abs().max_element() < 1e-5,
+            "rnm {a} {b}: {got} vs {want}"
+        );
+    }
+}

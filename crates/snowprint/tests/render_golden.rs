@@ -1,0 +1,289 @@
+//! Image tests of the renderer: a fixed small scene (a concrete roof with prints, a trench and a
+//! body-sized dent, a tiled roof with a crater to the tiles, and an untouched roof on the basic
+//! material) rendered at 256x144 for each tier and compared with NVIDIA FLIP against the goldens in
+//! `tests/golden/`. The largest FLIP error each test allows is data, in `tests/golden/tolerances.toml`.
+//!
+//! On failure the FLIP error map and the image rendered are written to `target/golden-diff/`.
+//! `SNOWPRINT_BLESS=1 cargo test --release --test render_golden` writes new goldens instead.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec3};
+use snowprint::render::{
+    Environment, Instance, MeshMaterial, PointLight, RenderConfig, RenderFrame, RenderOutput,
+    Renderer, Tier,
+};
+use snowprint::{
+    Camera, Deformer, GroundMaterial, Mesh, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
+    WorldConfig,
+};
+
+const WIDTH: u32 = 256;
+const HEIGHT: u32 = 144;
+
+fn golden_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+}
+
+fn diff_dir() -> PathBuf {
+    // CARGO_TARGET_TMPDIR is <target>/tmp.
+    Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .parent()
+        .unwrap_or(Path::new("target"))
+        .join("golden-diff")
+}
+
+/// The tolerance of one test, from `tolerances.toml`.
+#[derive(Debug, serde::Deserialize)]
+struct Tolerance {
+    /// Largest mean FLIP error over the image.
+    mean: f64,
+    /// Largest 99th percentile of the FLIP error.
+    p99: f64,
+}
+
+fn tolerance(name: &str) -> Tolerance {
+    let path = golden_dir().join("tolerances.toml");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut table: std::collections::HashMap<String, Tolerance> =
+        toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    table
+        .remove(name)
+        .unwrap_or_else(|| panic!("{} has no [{name}] table", path.display()))
+}
+
+struct Scene {
+    world: SnowWorld,
+    renderer: Renderer,
+    surfaces: Vec<(SurfaceId, GroundMaterial)>,
+    fresh: SurfaceId,
+    instances: Vec<Instance>,
+}
+
+/// The fixed scene: deformed over 8 steps of 1/30 s.
+fn scene() -> Scene {
+    let gpu = common::gpu();
+    let mut world = SnowWorld::new(
+        gpu,
+        WorldConfig {
+            pool_bytes: 4 << 20,
+            ..Default::default()
+        },
+    )
+    .expect("world");
+    let roof = world
+        .add_surface(SurfaceDesc::new("roof", [0.0, 2.0, 0.0], [4.0, 3.0], 0.15))
+        .expect("roof");
+    let tiles = world
+        .add_surface(SurfaceDesc::new("tiles", [3.7, 1.6, 0.0], [3.0, 3.0], 0.12))
+        .expect("tiles");
+    let fresh = world
+        .add_surface(SurfaceDesc::new(
+            "fresh",
+            [-3.6, 1.8, 0.0],
+            [3.0, 3.0],
+            0.15,
+        ))
+        .expect("fresh");
+
+    let mut config = RenderConfig::new(WIDTH, HEIGHT, Tier::Relief);
+    config.shadow_map_size = 1024;
+    let mut renderer = Renderer::new(gpu, config).expect("renderer");
+    let block = renderer
+        .add_mesh(&Mesh::cuboid(Vec3::splat(0.5)))
+        .expect("mesh");
+    let ball = renderer
+        .add_mesh(&Mesh::uv_sphere(0.3, 12, 24))
+        .expect("mesh");
+    let body = renderer
+        .add_mesh(&Mesh::capsule(0.15, 0.55, 8, 16))
+        .expect("mesh");
+
+    let lying = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let steps = 8;
+    for k in 0..steps {
+        let u0 = k as f32 / steps as f32;
+        let u1 = (k + 1) as f32 / steps as f32;
+        let slide = |u: f32| Pose {
+            position: Vec3::new(-1.4 + 2.4 * u, 2.12, -0.7),
+            rotation: lying,
+        };
+        let mut d = vec![
+            // A body sliding feet-first: a trench to the ground.
+            Deformer::moving(
+                Shape::Capsule {
+                    radius: 0.15,
+                    half_height: 0.55,
+                },
+                slide(u0),
+                slide(u1),
+            ),
+            // A ball dropped onto the tiles, pressed to the tiles.
+            Deformer::moving(
+                Shape::Sphere { radius: 0.3 },
+                Pose::at([3.6, 2.3 - 0.4 * u0, 0.3]),
+                Pose::at([3.6, 2.3 - 0.4 * u1, 0.3]),
+            ),
+        ];
+        // Boot prints: flat soles pressed to the ground.
+        for i in 0..5 {
+            let side = if i % 2 == 0 { 0.1 } else { -0.1 };
+            d.push(Deformer::new(
+                Shape::Box {
+                    half_extents: Vec3::new(0.13, 0.03, 0.05),
+                },
+                Pose::at([-1.3 + 0.55 * i as f32, 2.0, 0.6 + side]),
+            ));
+        }
+        world.step(1.0 / 30.0, &d).expect("step");
+    }
+    let instances = vec![
+        Instance::new(
+            block,
+            Mat4::from_scale_rotation_translation(
+                Vec3::new(4.6, 2.0, 3.6),
+                Quat::IDENTITY,
+                Vec3::new(0.0, 1.0, 0.0),
+            ),
+            [0.35, 0.17, 0.12],
+        )
+        .with_material(MeshMaterial::Brick),
+        // The ball, thrown off its crater onto the concrete roof's edge.
+        Instance::new(
+            ball,
+            Mat4::from_translation(Vec3::new(2.3, 2.3, 1.1)),
+            [0.5, 0.08, 0.06],
+        ),
+        Instance::new(
+            body,
+            Mat4::from_rotation_translation(lying, Vec3::new(1.0, 2.12, -0.7)),
+            [0.12, 0.2, 0.4],
+        ),
+    ];
+    Scene {
+        world,
+        renderer,
+        surfaces: vec![
+            (roof, GroundMaterial::Concrete),
+            (tiles, GroundMaterial::RoofTiles),
+            (fresh, GroundMaterial::RoofTiles),
+        ],
+        fresh,
+        instances,
+    }
+}
+
+fn render(scene: &mut Scene, tier: Tier) -> RenderOutput {
+    scene.renderer.set_tier(tier);
+    let lights = [PointLight {
+        position: Vec3::new(-1.5, 3.2, 1.5),
+        color: Vec3::new(1.0, 0.55, 0.22) * 1.5,
+        radius: 6.0,
+    }];
+    let frame = RenderFrame {
+        camera: Camera {
+            eye: Vec3::new(0.6, 4.6, 4.4),
+            target: Vec3::new(0.6, 1.8, -0.1),
+            fov_y_degrees: 52.0,
+        },
+        time: 1.0,
+        surfaces: &scene.surfaces,
+        instances: &scene.instances,
+        lights: &lights,
+        environment: Environment::moonlit_night(),
+        snowfall: false,
+    };
+    scene.renderer.render(&scene.world, &frame).expect("render")
+}
+
+fn save_png(path: &Path, out: &RenderOutput) {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).expect("create folder");
+    }
+    image::save_buffer(
+        path,
+        &out.rgba8,
+        out.width,
+        out.height,
+        image::ColorType::Rgba8,
+    )
+    .expect("write png");
+}
+
+fn rgb(rgba: &[u8]) -> Vec<u8> {
+    rgba.chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
+/// Compare with the golden of `name` (or bless it).
+fn check(name: &str, out: &RenderOutput) {
+    let golden = golden_dir().join(format!("{name}.png"));
+    if std::env::var("SNOWPRINT_BLESS").is_ok_and(|v| v == "1") {
+        save_png(&golden, out);
+        eprintln!("blessed {}", golden.display());
+        return;
+    }
+    let reference = image::open(&golden)
+        .unwrap_or_else(|e| {
+            panic!(
+                "no golden {} ({e}); run SNOWPRINT_BLESS=1 cargo test --release --test render_golden",
+                golden.display()
+            )
+        })
+        .to_rgb8();
+    assert_eq!(
+        reference.dimensions(),
+        (out.width, out.height),
+        "golden {} has another size",
+        golden.display()
+    );
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(out.width, out.height, reference.as_raw()),
+        nv_flip::FlipImageRgb8::with_data(out.width, out.height, &rgb(&out.rgba8)),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let pool = nv_flip::FlipPool::from_image(&error);
+    let (mean, p99) = (pool.mean() as f64, pool.get_weighted_percentile(0.99));
+    let tol = tolerance(name);
+    eprintln!(
+        "{name}: FLIP mean {mean:.4} (max {}), p99 {p99:.4} (max {})",
+        tol.mean, tol.p99
+    );
+    if mean > tol.mean || p99 > tol.p99 {
+        let dir = diff_dir();
+        std::fs::create_dir_all(&dir).expect("create diff folder");
+        let map = error.apply_color_lut(&nv_flip::magma_lut());
+        let diff = dir.join(format!("{name}-flip.png"));
+        image::save_buffer(
+            &diff,
+            &map.to_vec(),
+            out.width,
+            out.height,
+            image::ColorType::Rgb8,
+        )
+        .expect("write diff");
+        save_png(&dir.join(format!("{name}-actual.png")), out);
+        panic!(
+            "{name}: FLIP mean {mean:.4} (allowed {}), 99th percentile {p99:.4} (allowed {}); error map {}, image {}; re-bless with SNOWPRINT_BLESS=1 if the change is intended",
+            tol.mean,
+            tol.p99,
+            diff.display(),
+            dir.join(format!("{name}-actual.png")).display()
+        );
+    }
+}
+
+#[test]
+fn both_tiers_match_their_goldens() {
+    let mut scene = scene();
+    for (tier, name) in [(Tier::Relief, "relief"), (Tier::Pom, "pom")] {
+        let out = render(&mut scene, tier);
+        // The untouched roof is drawn with the basic material, the others with the deformable one.
+        assert_eq!(out.basic_material_surfaces, vec![scene.fresh], "{name}");
+        assert_eq!(out.surfaces.len(), 3);
+        check(name, &out);
+    }
+}
