@@ -79,14 +79,14 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Frames to render (default: 240 on a GPU, 36 on a software adapter). One frame shows the end
+    /// Frames to render (default: 240 on a GPU, 48 on a software adapter). One frame shows the end
     /// of the camera's clip.
     #[arg(long)]
     pub frames: Option<u32>,
-    /// Frame size, WIDTHxHEIGHT (default: 1280x720 on a GPU, 480x270 on a software adapter).
+    /// Frame size, WIDTHxHEIGHT (default: 1280x720 on a GPU, 640x360 on a software adapter).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Camera: flythrough, closeup, overview, street or angel.
+    /// Camera: flythrough, closeup, overview, street, angel, fall or slide.
     #[arg(long, default_value = "flythrough")]
     pub camera: String,
     /// Snow tracing: relief (the talk's relief mapping) or pom (parallax occlusion mapping).
@@ -205,7 +205,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
     let (default_frames, default_size, default_ss) = if software {
-        (36, (480, 270), 1)
+        (48, (640, 360), 1)
     } else {
         (240, (1280, 720), 2)
     };
@@ -238,6 +238,8 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     config.debug_view = args.debug_view;
     if software {
         config.snowflakes = 3000;
+    } else {
+        config.shadow_map_size = 4096;
     }
     let mut renderer = Renderer::new(&ctx, config).map_err(|e| e.to_string())?;
     let scene = build_scene(&mut world, &mut renderer)?;

@@ -449,6 +449,15 @@ struct Person {
     act: Act,
     coat: [f32; 3],
     trousers: [f32; 3],
+    /// Leaves the scene at this time (the stand-in has no getting-up animation: the fallen person
+    /// vanishes so that the imprint of the body can be seen).
+    leaves: Option<f32>,
+}
+
+impl Person {
+    fn present(&self, t: f32) -> bool {
+        self.leaves.is_none_or(|l| t < l)
+    }
 }
 
 /// The stand-in world.
@@ -715,6 +724,7 @@ impl StandIn {
                 }),
                 coat: coat(0.08, 0.09, 0.12),
                 trousers: coat(0.06, 0.06, 0.07),
+                leaves: None,
             },
             // Runs down the street.
             Person {
@@ -730,6 +740,7 @@ impl StandIn {
                 }),
                 coat: coat(0.35, 0.05, 0.04),
                 trousers: coat(0.07, 0.07, 0.1),
+                leaves: None,
             },
             // Slides feet-first across roof B.
             Person {
@@ -741,16 +752,18 @@ impl StandIn {
                 },
                 coat: coat(0.12, 0.2, 0.1),
                 trousers: coat(0.1, 0.08, 0.06),
+                leaves: None,
             },
             // Falls onto its back on roof A.
             Person {
                 act: Act::Fall {
-                    at: Vec3::new(-1.3, ROOF_A + 0.02, -2.6),
+                    at: Vec3::new(-1.3, ROOF_A + 0.02, -0.5),
                     dir: Vec3::new(0.0, 0.0, 1.0),
                     t_fall: 4.5,
                 },
                 coat: coat(0.3, 0.26, 0.2),
                 trousers: coat(0.08, 0.08, 0.09),
+                leaves: Some(6.5),
             },
             // Makes a snow angel on roof A.
             Person {
@@ -762,6 +775,7 @@ impl StandIn {
                 },
                 coat: coat(0.1, 0.18, 0.35),
                 trousers: coat(0.06, 0.06, 0.08),
+                leaves: None,
             },
         ];
         Ok(Self {
@@ -791,7 +805,15 @@ fn catmull_rom(points: &[Vec3], u: f32) -> Vec3 {
 }
 
 /// Cameras of the stand-in world.
-const CAMERAS: &[&str] = &["flythrough", "closeup", "overview", "street", "angel"];
+const CAMERAS: &[&str] = &[
+    "flythrough",
+    "closeup",
+    "overview",
+    "street",
+    "angel",
+    "fall",
+    "slide",
+];
 
 impl DemoScene for StandIn {
     fn name(&self) -> &str {
@@ -812,7 +834,7 @@ impl DemoScene for StandIn {
 
     fn deformers(&self, t0: f32, t1: f32) -> Vec<Deformer> {
         let mut out = Vec::new();
-        for p in &self.people {
+        for p in self.people.iter().filter(|p| p.present(t1)) {
             let a = p.act.skeleton(t0).shapes();
             let b = p.act.skeleton(t1).shapes();
             for ((shape, prev), (_, pose)) in a.into_iter().zip(b) {
@@ -824,7 +846,7 @@ impl DemoScene for StandIn {
 
     fn instances(&self, t: f32) -> Vec<Instance> {
         let mut v = self.statics.clone();
-        for p in &self.people {
+        for p in self.people.iter().filter(|p| p.present(t)) {
             v.extend(p.act.skeleton(t).instances(&self.body, p.coat, p.trousers));
         }
         v
@@ -837,7 +859,7 @@ impl DemoScene for StandIn {
     fn span(&self, camera: &str) -> (f32, f32) {
         match camera {
             "closeup" => (3.5, 8.5),
-            "angel" => (4.0, 7.0),
+            "angel" | "fall" | "slide" => (4.0, 8.0),
             _ => (2.0, 10.0),
         }
     }
@@ -852,21 +874,23 @@ impl DemoScene for StandIn {
         };
         Some(match name {
             "flythrough" => {
+                // Over the street, down to the slide on roof B, across to the snow angel, the fall
+                // and the walker's prints on roof A.
                 let eyes = [
-                    Vec3::new(-20.0, 22.0, 26.0),
-                    Vec3::new(-6.0, 19.0, 17.0),
-                    Vec3::new(6.0, 17.0, 11.0),
-                    Vec3::new(9.5, 15.2, 5.5),
-                    Vec3::new(3.0, 14.2, 5.2),
-                    Vec3::new(-2.5, 13.9, 4.2),
+                    Vec3::new(-13.0, 17.0, 12.0),
+                    Vec3::new(-2.0, 16.5, 11.0),
+                    Vec3::new(8.0, 14.5, 8.0),
+                    Vec3::new(6.5, 14.6, 3.6),
+                    Vec3::new(1.5, 14.3, 2.6),
+                    Vec3::new(-2.6, 14.0, 3.8),
                 ];
                 let targets = [
-                    Vec3::new(0.0, 8.0, 0.0),
-                    Vec3::new(2.0, 9.0, 1.0),
-                    Vec3::new(7.0, 9.5, 1.0),
-                    Vec3::new(4.0, 11.0, 0.0),
-                    Vec3::new(0.5, 12.0, 0.0),
-                    Vec3::new(-0.5, 12.1, -0.6),
+                    Vec3::new(2.0, 9.0, 0.0),
+                    Vec3::new(8.0, 9.5, 1.0),
+                    Vec3::new(11.0, 9.0, 0.8),
+                    Vec3::new(2.8, 12.0, -1.4),
+                    Vec3::new(-1.4, 12.0, -2.6),
+                    Vec3::new(0.4, 12.1, 1.0),
                 ];
                 let s = u * u * (3.0 - 2.0 * u);
                 cam(catmull_rom(&eyes, s), catmull_rom(&targets, s), 50.0)
@@ -883,6 +907,16 @@ impl DemoScene for StandIn {
             "angel" => cam(
                 Vec3::new(0.6, ROOF_A + 2.6, 0.4),
                 Vec3::new(2.7, ROOF_A, -2.0),
+                50.0,
+            ),
+            "fall" => cam(
+                Vec3::new(0.4, ROOF_A + 2.3, 1.2),
+                Vec3::new(-1.4, ROOF_A, -1.4),
+                50.0,
+            ),
+            "slide" => cam(
+                Vec3::new(6.6, ROOF_B + 2.6, 3.6),
+                Vec3::new(11.0, ROOF_B, 0.6),
                 50.0,
             ),
             "overview" => cam(Vec3::new(0.0, 34.0, 16.0), Vec3::new(2.0, 8.0, 1.0), 50.0),

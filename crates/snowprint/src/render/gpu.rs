@@ -42,13 +42,15 @@ pub struct FrameUniform {
     pub view_proj: [[f32; 4]; 4],
     /// Clip to world.
     pub inv_view_proj: [[f32; 4]; 4],
-    /// World to the moon's shadow-map clip space.
-    pub shadow_view_proj: [[f32; 4]; 4],
+    /// World to the moon's near shadow cascade.
+    pub shadow_near: [[f32; 4]; 4],
+    /// World to the moon's far shadow cascade.
+    pub shadow_far: [[f32; 4]; 4],
     /// Eye position; w: time.
     pub eye: [f32; 4],
     /// Towards the moon; w: cosine of the moon's angular radius.
     pub moon_dir: [f32; 4],
-    /// Moonlight; w: shadow-map texel in metres.
+    /// Moonlight; w unused.
     pub moon_color: [f32; 4],
     /// Sky overhead; w: exposure.
     pub sky_zenith: [f32; 4],
@@ -64,6 +66,8 @@ pub struct FrameUniform {
     pub viewport: [f32; 4],
     /// Debug view, point lights, tier, snowflakes.
     pub options: [u32; 4],
+    /// Shadow texels in metres: near cascade, far cascade.
+    pub shadow_texels: [f32; 4],
     /// Point lights.
     pub lights: [PointLightRaw; MAX_POINT_LIGHTS],
 }
@@ -224,8 +228,13 @@ mod tests {
                 std::mem::offset_of!(FrameUniform, inv_view_proj),
             ),
             (
-                "shadow_view_proj",
-                std::mem::offset_of!(FrameUniform, shadow_view_proj),
+                "shadow_near",
+                std::mem::offset_of!(FrameUniform, shadow_near),
+            ),
+            ("shadow_far", std::mem::offset_of!(FrameUniform, shadow_far)),
+            (
+                "shadow_texels",
+                std::mem::offset_of!(FrameUniform, shadow_texels),
             ),
             ("eye", std::mem::offset_of!(FrameUniform, eye)),
             ("moon_dir", std::mem::offset_of!(FrameUniform, moon_dir)),

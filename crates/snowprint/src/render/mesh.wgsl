@@ -1,7 +1,8 @@
 // mesh.wgsl: opaque meshes (rooftops, walls, props, people) and the moon's shadow map.
 // Prepended: frame.wgsl, snow.wgsl (for its noise and the snow colours; the heightfield contract is
 // stubbed below because meshes never trace snow).
-// Shadow pass reads: frame uniforms (shadow_view_proj), meshes, instances; writes: shadow map.
+// Shadow pass reads: frame uniforms (shadow_near, shadow_far), meshes, instances; writes: the
+// shadow cascades.
 // Opaque pass reads: frame uniforms, shadow map, meshes, instances; writes: scene colour, depth.
 
 fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {
@@ -67,9 +68,16 @@ fn vs_mesh(v: MeshVertex, inst: MeshInstance) -> MeshVarying {
     return out;
 }
 
+// Which shadow cascade a shadow pipeline renders (0 near, 1 far).
+override SHADOW_CASCADE: u32 = 0u;
+
 @vertex
 fn vs_shadow(v: MeshVertex, inst: MeshInstance) -> @builtin(position) vec4<f32> {
-    return frame.shadow_view_proj * (model_matrix(inst) * vec4<f32>(v.position, 1.0));
+    var m = frame.shadow_far;
+    if SHADOW_CASCADE == 0u {
+        m = frame.shadow_near;
+    }
+    return m * (model_matrix(inst) * vec4<f32>(v.position, 1.0));
 }
 
 // Coordinates on a wall: horizontal along the wall, vertical up.

@@ -87,6 +87,16 @@ const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const NEAR: f32 = 0.05;
+/// Side of the near shadow cascade, metres.
+const NEAR_CASCADE: f32 = 12.0;
+
+/// The moon's two shadow projections and their texels in metres.
+struct ShadowCascades {
+    near: Mat4,
+    far: Mat4,
+    near_texel: f32,
+    far_texel: f32,
+}
 const FAR: f32 = 600.0;
 
 /// What the renderer can report instead of panicking.
@@ -759,7 +769,8 @@ pub struct Renderer {
     heightfield_layout: wgpu::BindGroupLayout,
     classify_pipeline: wgpu::ComputePipeline,
     heightfield_pipeline: wgpu::ComputePipeline,
-    shadow_pipeline: wgpu::RenderPipeline,
+    /// One pipeline per cascade (the cascade is an override constant of `vs_shadow`).
+    shadow_pipelines: [wgpu::RenderPipeline; 2],
     mesh_pipeline: wgpu::RenderPipeline,
     basic_pipeline: wgpu::RenderPipeline,
     deformable_pipeline: wgpu::RenderPipeline,
@@ -776,7 +787,10 @@ pub struct Renderer {
     state_buffer: Growable,
     heightfield_params: Growable,
     instance_buffer: Growable,
+    /// Both cascades, for sampling.
     shadow_view: wgpu::TextureView,
+    /// Each cascade, for rendering into.
+    cascade_views: [wgpu::TextureView; 2],
     shadow_size: u32,
     targets: Targets,
     heightfields: HashMap<SurfaceId, HeightfieldTexture>,
@@ -941,7 +955,16 @@ impl Renderer {
             label: Some("frame"),
             entries: &[
                 uniform_entry(0, vf),
-                texture_entry(1, wgpu::TextureSampleType::Depth),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -1065,31 +1088,37 @@ impl Renderer {
         let mesh_buffers: Vec<Option<wgpu::VertexBufferLayout>> =
             mesh_buffers.into_iter().map(Some).collect();
 
-        let shadow_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("shadow"),
-            layout: Some(&layout("shadow", &[&shadow_layout])),
-            vertex: wgpu::VertexState {
-                module: &mesh_module,
-                entry_point: Some("vs_shadow"),
-                compilation_options: Default::default(),
-                buffers: &mesh_buffers,
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
+        let shadow_pipelines = [0.0, 1.0].map(|cascade| {
+            let constants = [("SHADOW_CASCADE", cascade)];
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("shadow"),
+                layout: Some(&layout("shadow", &[&shadow_layout])),
+                vertex: wgpu::VertexState {
+                    module: &mesh_module,
+                    entry_point: Some("vs_shadow"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    buffers: &mesh_buffers,
                 },
-            }),
-            multisample: wgpu::MultisampleState::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: wgpu::StencilState::default(),
+                    bias: wgpu::DepthBiasState {
+                        constant: 2,
+                        slope_scale: 2.0,
+                        clamp: 0.0,
+                    },
+                }),
+                multisample: wgpu::MultisampleState::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
         });
         let render = |label: &str,
                       module: &wgpu::ShaderModule,
@@ -1220,23 +1249,32 @@ impl Renderer {
             mapped_at_creation: false,
         });
         let shadow_size = config.shadow_map_size;
-        let shadow_view = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("moon shadow map"),
-                size: wgpu::Extent3d {
-                    width: shadow_size,
-                    height: shadow_size,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: DEPTH_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
+        let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("moon shadow cascades"),
+            size: wgpu::Extent3d {
+                width: shadow_size,
+                height: shadow_size,
+                depth_or_array_layers: 2,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let shadow_view = shadow_texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let cascade_views = [0, 1].map(|layer| {
+            shadow_texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
             })
-            .create_view(&Default::default());
+        });
         let timestamps = gpu.caps.timestamps.then(|| {
             let count = 2 * PASSES.len() as u32;
             Timestamps {
@@ -1308,7 +1346,7 @@ impl Renderer {
             heightfield_layout,
             classify_pipeline,
             heightfield_pipeline,
-            shadow_pipeline,
+            shadow_pipelines,
             mesh_pipeline,
             basic_pipeline,
             deformable_pipeline,
@@ -1321,6 +1359,7 @@ impl Renderer {
             linear_sampler,
             frame_buffer,
             shadow_view,
+            cascade_views,
             shadow_size,
             targets,
             heightfields: HashMap::new(),
@@ -1731,12 +1770,13 @@ impl Renderer {
         Ok(())
     }
 
-    /// The moon's shadow projection fitted around everything drawn, and its texel in metres.
-    fn shadow_projection(
+    /// The moon's two shadow cascades: the near one around what the camera looks at, the far one
+    /// around everything drawn.
+    fn shadow_cascades(
         &self,
         world: &SnowWorld,
         frame: &RenderFrame<'_>,
-    ) -> RenderResult<(Mat4, f32)> {
+    ) -> RenderResult<ShadowCascades> {
         let mut lo = Vec3::splat(f32::MAX);
         let mut hi = Vec3::splat(f32::MIN);
         for (id, _) in frame.surfaces {
@@ -1786,16 +1826,37 @@ impl Renderer {
             vlo = vlo.min(v);
             vhi = vhi.max(v);
         }
+        let (near_z, far_z) = (-vhi.z - 1.0, -vlo.z + 1.0);
         let proj = glam::camera::rh::proj::directx::orthographic(
-            vlo.x,
-            vhi.x,
-            vlo.y,
-            vhi.y,
-            -vhi.z - 1.0,
-            -vlo.z + 1.0,
+            vlo.x, vhi.x, vlo.y, vhi.y, near_z, far_z,
         );
-        let texel = (vhi.x - vlo.x).max(vhi.y - vlo.y) / self.shadow_size as f32;
-        Ok((proj * view, texel))
+        let far_texel = (vhi.x - vlo.x).max(vhi.y - vlo.y) / self.shadow_size as f32;
+
+        // The near cascade: a square of NEAR_CASCADE metres around the point 40% of the way into
+        // it along the view, with the far cascade's depth range (every caster still casts). Its
+        // centre is snapped to whole texels in the moon's view so that a moving camera does not
+        // make its shadow edges crawl.
+        let cam = &frame.camera;
+        let forward = (cam.target - cam.eye).normalize_or(Vec3::NEG_Z);
+        let focus = view.transform_point3(cam.eye + forward * (NEAR_CASCADE * 0.4));
+        let near_texel = NEAR_CASCADE / self.shadow_size as f32;
+        let snap = |v: f32| (v / near_texel).round() * near_texel;
+        let (cx, cy) = (snap(focus.x), snap(focus.y));
+        let half = NEAR_CASCADE * 0.5;
+        let near_proj = glam::camera::rh::proj::directx::orthographic(
+            cx - half,
+            cx + half,
+            cy - half,
+            cy + half,
+            near_z,
+            far_z,
+        );
+        Ok(ShadowCascades {
+            near: near_proj * view,
+            far: proj * view,
+            near_texel,
+            far_texel,
+        })
     }
 
     fn tonemap_pipeline(&mut self, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
@@ -1874,7 +1935,7 @@ impl Renderer {
         &self.heightfields[&id]
     }
 
-    fn frame_uniform(&self, frame: &RenderFrame<'_>, shadow: (Mat4, f32)) -> FrameUniform {
+    fn frame_uniform(&self, frame: &RenderFrame<'_>, shadow: &ShadowCascades) -> FrameUniform {
         let cfg = &self.config;
         let (w, h) = (cfg.width * cfg.supersample, cfg.height * cfg.supersample);
         let aspect = w as f32 / h as f32;
@@ -1903,13 +1964,15 @@ impl Renderer {
         FrameUniform {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-            shadow_view_proj: shadow.0.to_cols_array_2d(),
+            shadow_near: shadow.near.to_cols_array_2d(),
+            shadow_far: shadow.far.to_cols_array_2d(),
+            shadow_texels: [shadow.near_texel, shadow.far_texel, 0.0, 0.0],
             eye: v4(frame.camera.eye, frame.time),
             moon_dir: v4(
                 e.moon_direction.normalize(),
                 e.moon_radius_degrees.to_radians().cos(),
             ),
-            moon_color: v4(e.moon_color, shadow.1),
+            moon_color: v4(e.moon_color, 0.0),
             sky_zenith: v4(e.sky_zenith, e.exposure),
             sky_horizon: v4(e.sky_horizon, e.fog_density),
             ground_bounce: v4(e.ground_bounce, e.city_glow),
@@ -1935,8 +1998,8 @@ impl Renderer {
         format: wgpu::TextureFormat,
     ) -> RenderResult<Encoded> {
         self.check_frame(frame)?;
-        let shadow = self.shadow_projection(world, frame)?;
-        let uniform = self.frame_uniform(frame, shadow);
+        let shadow = self.shadow_cascades(world, frame)?;
+        let uniform = self.frame_uniform(frame, &shadow);
         self.queue
             .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
 
@@ -2256,24 +2319,34 @@ impl Renderer {
             p.set_vertex_buffer(0, mesh.vertices.slice(..));
             p.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
         };
-        {
+        // The shadow pass: both cascades, the near one first; the pass's timestamps span both.
+        for cascade in 0..2 {
+            let writes = ts.map(|t| wgpu::RenderPassTimestampWrites {
+                query_set: &t.set,
+                beginning_of_pass_write_index: (cascade == 0).then_some(2 * pass::SHADOW as u32),
+                end_of_pass_write_index: (cascade == 1).then_some(2 * pass::SHADOW as u32 + 1),
+            });
             let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(PASSES[pass::SHADOW].name),
+                label: Some(if cascade == 0 {
+                    "shadow (near cascade)"
+                } else {
+                    "shadow (far cascade)"
+                }),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.shadow_view,
+                    view: &self.cascade_views[cascade],
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Store,
                     }),
                     stencil_ops: None,
                 }),
-                timestamp_writes: render_ts(pass::SHADOW),
+                timestamp_writes: writes,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
             if !shadow_draws.is_empty() {
-                p.set_pipeline(&self.shadow_pipeline);
+                p.set_pipeline(&self.shadow_pipelines[cascade]);
                 p.set_bind_group(0, &shadow_bg, &[]);
                 p.set_vertex_buffer(1, self.instance_buffer.buffer.slice(..));
                 for (mesh, range) in &shadow_draws {

@@ -388,7 +388,7 @@ fn snow_roof_tiles(p: vec2<f32>, pixel: f32) -> SnowLayer {
     let edge_z = mix(smoothstep(0.0, 0.06, fz), 0.8, blur);
     let edge_x = mix(smoothstep(0.0, 0.05, fx) * smoothstep(0.0, 0.05, 1.0 - fx), 0.85, blur);
     let gap = edge_z * edge_x;
-    let clay = mix(vec3<f32>(0.30, 0.085, 0.05), vec3<f32>(0.42, 0.16, 0.08), v);
+    let clay = mix(vec3<f32>(0.36, 0.11, 0.06), vec3<f32>(0.50, 0.20, 0.10), v);
     let weathered = mix(clay, vec3<f32>(0.16, 0.12, 0.10), 0.35 * snow_noise(p * 1.3).x);
     var layer: SnowLayer;
     layer.albedo = weathered * (0.25 + 0.75 * gap) * (0.85 + 0.3 * grain.x);
@@ -406,7 +406,7 @@ fn snow_concrete(p: vec2<f32>, pixel: f32) -> SnowLayer {
     let f = abs(cell - round(cell)) * 2.0;            // 0 on a joint
     let joint = mix(smoothstep(0.0, 0.012, min(f.x, f.y)), 0.97, smoothstep(0.005, 0.02, pixel));
     var layer: SnowLayer;
-    let base = vec3<f32>(0.30, 0.30, 0.29) * (0.75 + 0.5 * blotch.x) * (0.9 + 0.2 * grain.x);
+    let base = vec3<f32>(0.38, 0.38, 0.37) * (0.75 + 0.5 * blotch.x) * (0.9 + 0.2 * grain.x);
     layer.albedo = base * (0.35 + 0.65 * joint);
     layer.roughness = 0.85 - 0.2 * blotch.x;
     // The joint grooves tilt the normal towards their middle.
@@ -509,7 +509,7 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     // Diffuse and specular: a simple lerp between the stages, as in the talk. The ground is wet
     // where the snow was pressed onto it.
     let snow_albedo = mix(SNOW_FRESH, SNOW_PACKED, smoothstep(0.05, 0.8, dep));
-    let wet_ground = ground_layer.albedo * 0.6;
+    let wet_ground = ground_layer.albedo * 0.8;
     var m: SnowSample;
     m.albedo = snow_sss_tint(mix(snow_albedo, wet_ground, ground), transition, sky);
     m.roughness = mix(mix(0.62, 0.5, dep), ground_layer.roughness * 0.55, ground);
