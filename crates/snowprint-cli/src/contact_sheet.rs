@@ -96,7 +96,7 @@ pub fn compose(frames: &[(usize, f32, RgbaImage)]) -> RgbaImage {
     sheet
 }
 
-/// A GIF written frame by frame (frames wider than 640 pixels are scaled down).
+/// A GIF written frame by frame (frames wider than 480 pixels are scaled down).
 pub struct GifWriter {
     encoder: image::codecs::gif::GifEncoder<std::io::BufWriter<std::fs::File>>,
     size: (u32, u32),
@@ -113,7 +113,7 @@ impl GifWriter {
         encoder
             .set_repeat(image::codecs::gif::Repeat::Infinite)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        let w = width.min(640);
+        let w = width.min(480);
         let h = (height as u64 * w as u64 / width as u64).max(1) as u32;
         Ok(Self {
             encoder,

@@ -281,7 +281,10 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     } else {
         1000
     };
-    let mut gif = contact_sheet::GifWriter::create(&gif_path, width, height, delay_ms)?;
+    // The GIF keeps at most 120 frames (every k-th), so that it stays a few megabytes.
+    let gif_every = frames.div_ceil(120) as usize;
+    let mut gif =
+        contact_sheet::GifWriter::create(&gif_path, width, height, delay_ms * gif_every as u32)?;
 
     let bar = ProgressBar::new(frames as u64);
     bar.set_style(
@@ -345,7 +348,9 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             image
                 .save(&path)
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-            gif.add(&image)?;
+            if k % gif_every == 0 {
+                gif.add(&image)?;
+            }
             if sheet_frames.contains(&k) {
                 sheet_images.push((k, t, image));
             }

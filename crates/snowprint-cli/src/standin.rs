@@ -745,8 +745,8 @@ impl StandIn {
             // Slides feet-first across roof B.
             Person {
                 act: Act::Slide {
-                    from: Vec3::new(7.6, ROOF_B, 1.2),
-                    to: Vec3::new(13.8, ROOF_B, 0.4),
+                    from: Vec3::new(9.6, ROOF_B, 1.6),
+                    to: Vec3::new(14.4, ROOF_B, 1.2),
                     t0: 1.5,
                     t1: 4.0,
                 },
@@ -915,8 +915,8 @@ impl DemoScene for StandIn {
                 50.0,
             ),
             "slide" => cam(
-                Vec3::new(6.6, ROOF_B + 2.6, 3.6),
-                Vec3::new(11.0, ROOF_B, 0.6),
+                Vec3::new(9.0, ROOF_B + 2.3, 3.9),
+                Vec3::new(12.6, ROOF_B, 1.2),
                 50.0,
             ),
             "overview" => cam(Vec3::new(0.0, 34.0, 16.0), Vec3::new(2.0, 8.0, 1.0), 50.0),

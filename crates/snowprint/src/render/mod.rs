@@ -436,7 +436,7 @@ impl Environment {
     /// A clear, cold night with a low moon.
     pub fn moonlit_night() -> Self {
         Self {
-            moon_direction: Vec3::new(-0.85, 0.42, 0.3).normalize(),
+            moon_direction: Vec3::new(0.8, 0.42, 0.42).normalize(),
             moon_color: Vec3::new(0.55, 0.68, 1.0),
             moon_radius_degrees: 1.6,
             sky_zenith: Vec3::new(0.010, 0.018, 0.045),
