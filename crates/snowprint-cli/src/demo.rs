@@ -79,11 +79,11 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Frames to render (default: 240 on a GPU, 48 on a software adapter). One frame shows the end
+    /// Frames to render (default: 240 on a GPU, 60 on a software adapter). One frame shows the end
     /// of the camera's clip.
     #[arg(long)]
     pub frames: Option<u32>,
-    /// Frame size, WIDTHxHEIGHT (default: 1280x720 on a GPU, 640x360 on a software adapter).
+    /// Frame size, WIDTHxHEIGHT (default: 1280x720 on a GPU, 800x450 on a software adapter).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Camera: flythrough, closeup, overview, street, angel, fall or slide.
@@ -205,7 +205,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
     let (default_frames, default_size, default_ss) = if software {
-        (48, (640, 360), 1)
+        (60, (800, 450), 1)
     } else {
         (240, (1280, 720), 2)
     };
@@ -477,4 +477,102 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         args.out.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(out: &Path) -> Args {
+        Args {
+            out: out.to_owned(),
+            frames: Some(3),
+            size: Some((64, 36)),
+            camera: "closeup".into(),
+            tier: Tier::Pom,
+            supersample: Some(1),
+            debug_view: DebugView::Shaded,
+            no_snowfall: false,
+            from: Some(1.0),
+            to: Some(1.2),
+            sim_hz: Some(10),
+        }
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("snowprint-demo-test-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    #[test]
+    fn a_run_writes_every_output_and_replaces_an_earlier_run() {
+        let out = scratch("outputs");
+        std::fs::create_dir_all(&out).unwrap();
+        // Left by an earlier, longer run: must not survive next to the new frames.
+        std::fs::write(out.join("frame_0009.png"), b"stale").unwrap();
+        std::fs::write(out.join("notes.txt"), b"the user's").unwrap();
+        run(&GpuOptions::default(), &args(&out)).unwrap();
+        let mut names: Vec<String> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names.retain(|n| n != "demo.mp4");
+        assert_eq!(
+            names,
+            [
+                "contact_sheet.png",
+                "demo.gif",
+                "frame_0000.png",
+                "frame_0001.png",
+                "frame_0002.png",
+                "notes.txt",
+                "report.json"
+            ]
+        );
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        assert_eq!(report["frames"], 3);
+        assert_eq!(report["resolution"], serde_json::json!([64, 36]));
+        assert_eq!(report["tier"], "pom");
+        assert_eq!(report["camera"], "closeup");
+        assert!(report["adapter"]["name"].is_string());
+        // roof_c is never walked on: the basic material.
+        assert_eq!(
+            report["basic_material_surfaces_last_frame"],
+            serde_json::json!([2])
+        );
+        assert!(report["gpu_pass_times_ms"].is_array());
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn a_failed_run_leaves_nothing_that_looks_complete() {
+        let out = scratch("failed");
+        let mut a = args(&out);
+        a.camera = "nowhere".into();
+        let e = run(&GpuOptions::default(), &a).unwrap_err();
+        assert!(e.contains("nowhere") && e.contains("closeup"), "{e}");
+        assert!(!out.join("report.json").exists());
+        let mut a = args(&out);
+        a.from = Some(2.0);
+        a.to = Some(1.0);
+        assert!(
+            run(&GpuOptions::default(), &a)
+                .unwrap_err()
+                .contains("--from")
+        );
+        assert!(!out.join("report.json").exists());
+        let _ = std::fs::remove_dir_all(&out);
+    }
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
+        assert!(parse_size("1280").unwrap_err().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("0x10").unwrap_err().contains("16 to 8192"));
+    }
 }
