@@ -153,6 +153,16 @@ fn mistakes_are_refused_with_the_value() {
     )];
     let e = r.render(&world, &frame(&[], &nan)).unwrap_err().to_string();
     assert!(e.contains("instance 0 transform"), "{e}");
+    let flat = [Instance::new(
+        m,
+        Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0)),
+        [1.0; 3],
+    )];
+    let e = r
+        .render(&world, &frame(&[], &flat))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("invertible"), "{e}");
 
     let broken = Mesh {
         positions: vec![Vec3::ZERO],

@@ -144,6 +144,10 @@ pub enum RenderError {
     /// The GPU did not finish or a readback failed.
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// The GPU refused a pipeline or a frame (a driver that cannot compile a shader, a limit
+    /// exceeded); wgpu's message is kept.
+    #[error("the GPU refused the renderer's work: {0}")]
+    Gpu(String),
 }
 
 /// Result of the renderer.
@@ -948,6 +952,9 @@ impl Renderer {
     pub fn new(gpu: &GpuContext, config: RenderConfig) -> RenderResult<Self> {
         let device = gpu.device.clone();
         config.validate(&device)?;
+        // Pipelines are checked by naga in the tests; a driver that still refuses one is reported
+        // as an error rather than wgpu's default panic.
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let filterable = gpu.caps.filterable_rgba16f;
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
 
@@ -1304,6 +1311,9 @@ impl Renderer {
             timestamps: false,
         };
         let targets = create_targets(&device, config.width, config.height, config.supersample);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Gpu(e.to_string()));
+        }
         Ok(Self {
             surface_buffer: Growable::new(
                 &device,
@@ -1461,6 +1471,7 @@ impl Renderer {
         // reused.
         self.finish_stats(true)?;
         let output_view = self.targets.output_view.clone();
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let Encoded {
             mut encoder,
             surfaces,
@@ -1489,6 +1500,9 @@ impl Renderer {
         );
         self.copy_stats(&mut encoder, surfaces);
         self.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Gpu(e.to_string()));
+        }
         self.start_stats_map();
 
         let slice = self.targets.readback.slice(..);
@@ -1545,6 +1559,7 @@ impl Renderer {
             });
         }
         self.finish_stats(false)?;
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let Encoded {
             mut encoder,
             surfaces,
@@ -1554,6 +1569,9 @@ impl Renderer {
             self.copy_stats(&mut encoder, surfaces);
         }
         self.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Gpu(e.to_string()));
+        }
         if copied {
             self.start_stats_map();
         }
@@ -1649,7 +1667,15 @@ impl Renderer {
                 .slice(..)
                 .get_mapped_range()
                 .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
-            let words: &[u32] = bytemuck::cast_slice(&data);
+            // Read by value: a mapped range promises no alignment.
+            let word = |i: usize| {
+                u32::from_le_bytes([
+                    data[4 * i],
+                    data[4 * i + 1],
+                    data[4 * i + 2],
+                    data[4 * i + 3],
+                ])
+            };
             let surfaces = self
                 .stats
                 .surfaces
@@ -1659,21 +1685,26 @@ impl Renderer {
                     let base = s * STATE_WORDS as usize;
                     SurfaceShading {
                         surface: id,
-                        material: if words[base + STATE_TOUCHED as usize] == 0 {
+                        material: if word(base + STATE_TOUCHED as usize) == 0 {
                             SnowMaterialKind::Basic
                         } else {
                             SnowMaterialKind::Deformable
                         },
-                        deepest: words[base + STATE_DEEPEST as usize] as f32 / 65535.0,
+                        deepest: word(base + STATE_DEEPEST as usize) as f32 / 65535.0,
                     }
                 })
                 .collect();
             let mut pass_times = Vec::new();
             if let (true, Some(ts)) = (self.stats.timestamps, &self.timestamps) {
                 let start = n * STATE_WORDS as usize * 4;
-                let ticks: &[u64] = bytemuck::cast_slice(&data[start..start + PASSES.len() * 16]);
+                let tick = |i: usize| {
+                    let o = start + 8 * i;
+                    let mut b = [0u8; 8];
+                    b.copy_from_slice(&data[o..o + 8]);
+                    u64::from_le_bytes(b)
+                };
                 for (i, p) in PASSES.iter().enumerate() {
-                    let dt = ticks[2 * i + 1].saturating_sub(ticks[2 * i]);
+                    let dt = tick(2 * i + 1).saturating_sub(tick(2 * i));
                     pass_times.push(PassTime {
                         name: p.name,
                         gpu_ms: dt as f64 * ts.period_ns as f64 * 1e-6,
@@ -1725,11 +1756,11 @@ impl Renderer {
             if inst.mesh.0 as usize >= self.meshes.len() {
                 return Err(RenderError::StaleMesh { index: inst.mesh.0 });
             }
-            if !finite_mat(&inst.transform) {
+            if !finite_mat(&inst.transform) || inst.transform.determinant().abs() < 1e-12 {
                 return bad(
                     format!("instance {i} transform"),
                     format!("{:?}", inst.transform),
-                    "finite",
+                    "finite and invertible (no zero scale)",
                 );
             }
         }
