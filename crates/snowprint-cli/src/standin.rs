@@ -832,7 +832,7 @@ impl DemoScene for StandIn {
         Environment::moonlit_night()
     }
 
-    fn deformers(&self, t0: f32, t1: f32) -> Vec<Deformer> {
+    fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {
         let mut out = Vec::new();
         for p in self.people.iter().filter(|p| p.present(t1)) {
             let a = p.act.skeleton(t0).shapes();
@@ -841,7 +841,10 @@ impl DemoScene for StandIn {
                 out.push(Deformer::moving(shape, prev, pose));
             }
         }
-        out
+        world
+            .step(t1 - t0, &out)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
     }
 
     fn instances(&self, t: f32) -> Vec<Instance> {

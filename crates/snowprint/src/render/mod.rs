@@ -1802,7 +1802,7 @@ impl Renderer {
     }
 
     /// The moon's two shadow cascades: the near one around what the camera looks at, the far one
-    /// around everything drawn.
+    /// around the snow surfaces and every shadow caster.
     fn shadow_cascades(
         &self,
         world: &SnowWorld,
@@ -1825,7 +1825,9 @@ impl Renderer {
                 hi = hi.max(p);
             }
         }
-        for inst in frame.instances {
+        // Receivers beyond the surfaces and the casters (a backdrop, a ground to the horizon) are
+        // left out: they would spread the far cascade's texels over what casts no shadow.
+        for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
             let r = self.meshes[inst.mesh.0 as usize].radius;
             let (scale, _, t) = inst.transform.to_scale_rotation_translation();
             let r = r * scale.abs().max_element();
