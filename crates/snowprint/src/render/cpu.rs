@@ -177,6 +177,20 @@ pub fn pom_search(
     None
 }
 
+/// The depression at a texel smoothed by a 3x3 binomial filter (`[1 2 1] x [1 2 1] / 16`), as the
+/// heightfield pass stores it: the capture's binary coverage leaves texel staircases on the rims of
+/// pits pressed to the ground, which this keeps out of the picture. Must match
+/// `smoothed_depression` in `heightfield.wgsl`.
+pub fn smoothed_depression(depression: impl Fn(i32, i32) -> f32, col: i32, row: i32) -> f32 {
+    let mut sum = 0.0;
+    for dy in -1..=1i32 {
+        for dx in -1..=1i32 {
+            sum += ((2 - dx.abs()) * (2 - dy.abs())) as f32 * depression(col + dx, row + dy);
+        }
+    }
+    sum / 16.0
+}
+
 /// Normal of the snow top from the depressions around a texel, by a 3x3 Sobel filter (smoother
 /// than central differences, which matters at 4 cm texels). `depression(col, row)` is the fraction
 /// of the snow depth pressed down (clamped at the edges by the caller). Returns a unit local normal.
@@ -507,6 +521,17 @@ mod tests {
             19
         );
         assert_eq!(linear_taps(grazing, 10.0, 0.04, 0.5, 4.0, 16.0), 16);
+    }
+
+    #[test]
+    fn smoothing_keeps_flat_snow_and_ramps_and_rounds_a_step() {
+        assert!((smoothed_depression(|_, _| 0.4, 3, 3) - 0.4).abs() < 1e-6);
+        let ramp = |c: i32, _r: i32| 0.1 * c as f32;
+        assert!((smoothed_depression(ramp, 5, 2) - 0.5).abs() < 1e-6);
+        // A staircase corner: a quarter of the plane pressed to the ground.
+        let corner = |c: i32, r: i32| if c >= 0 && r >= 0 { 1.0 } else { 0.0 };
+        assert_eq!(smoothed_depression(corner, 0, 0), 9.0 / 16.0);
+        assert_eq!(smoothed_depression(corner, -1, -1), 1.0 / 16.0);
     }
 
     #[test]

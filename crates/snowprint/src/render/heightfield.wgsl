@@ -1,7 +1,8 @@
 // heightfield.wgsl: turns one surface's heightmap in the pool into the texture the snow material
 // samples with filtering: (depression, normal.x, normal.z, ambient occlusion) per texel. Normals
 // by a 3x3 Sobel filter, occlusion from the horizon of the snow around each texel (the talk's
-// "derive parametric AO from the heightmap"), and a second texture with the moon's visibility
+// "derive parametric AO from the heightmap"; the depression itself is stored smoothed by a 3x3
+// binomial filter), and a second texture with the moon's visibility
 // over the snow of each texel (a soft shadow of the prints' walls on their floors, computed once
 // per texel instead of per pixel). Dispatched indirectly: zero workgroups for a surface on the
 // basic material.
@@ -87,6 +88,21 @@ fn light_visibility(c: i32, r: i32) -> f32 {
     return visible;
 }
 
+// The depression smoothed by a 3x3 binomial filter: the capture rasterizes deformers with binary
+// coverage on the texel grid, so the rim of a pit pressed to the ground is a staircase of texels;
+// this (and the renderer's cubic B-spline on top) keeps that staircase out of the picture.
+// Must match `smoothed_depression` in cpu.rs.
+fn smoothed_depression(c: i32, r: i32) -> f32 {
+    var sum = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let w = f32((2 - abs(dx)) * (2 - abs(dy)));
+            sum += w * depression(c + dx, r + dy);
+        }
+    }
+    return sum / 16.0;
+}
+
 // Must match `sobel_normal` in cpu.rs.
 fn sobel_normal(c: i32, r: i32) -> vec3<f32> {
     let d = params.snow_depth;
@@ -131,6 +147,6 @@ fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = i32(gid.y);
     let n = sobel_normal(c, r);
     let ao = horizon_ao(c, r);
-    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(depression(c, r), n.x, n.z, ao));
+    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(smoothed_depression(c, r), n.x, n.z, ao));
     textureStore(out_light, vec2<i32>(c, r), vec4<f32>(light_visibility(c, r), 0.0, 0.0, 1.0));
 }

@@ -94,15 +94,11 @@ fn sample_bilinear(uv: vec2<f32>) -> vec4<f32> {
     return textureSampleLevel(heightfield, linear_sampler, uv, 0.0);
 }
 
-// The heightfield contract of snow.wgsl, for the search: one bilinear tap with its weights
-// remapped by a smoothstep, so that the heightfield has no creases at texel boundaries (creases
-// show as stair-steps on grazing rims).
+// The heightfield contract of snow.wgsl, for the search: one bilinear tap of the smoothed
+// depression. (A smoothstep remap of the weights would remove the creases at texel boundaries,
+// but its flat spots at texel centres pull the rims of deep pits onto the texel grid.)
 fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {
-    let p = uv * s.grid + 0.5;
-    let i = floor(p);
-    let f = p - i;
-    let w = f * f * (3.0 - 2.0 * f);
-    return sample_bilinear((i + w - 0.5) / s.grid).x;
+    return sample_bilinear(uv).x;
 }
 
 // ... and for shading: a cubic B-spline from four bilinear taps (smooth normals and occlusion,
