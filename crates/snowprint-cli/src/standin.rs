@@ -1,7 +1,8 @@
-//! A stand-in demo world built in code, used until the library's own demo world (`snowprint::demo`)
-//! lands: three flat roofs at different heights (concrete, roof tiles, and one nobody walks on, so
+//! The stand-in demo world (`snowprint demo --scene standin`), built in code before the library's
+//! own demo world (`snowprint::demo`) existed and kept as a small, self-contained second world:
+//! three flat roofs at different heights (concrete, roof tiles, and one nobody walks on, so
 //! it keeps the basic material), a street with lamps, facades with lit windows, a water tower, and
-//! capsule people: one walks (heel, ball and toe shapes per foot), one runs down the street, one
+//! capsule people: one walks (heel, ball, arch and toe blocks per boot), one runs down the street, one
 //! slides feet-first, one falls onto its back from standing, one makes a snow angel. Each body part
 //! is both drawn and pressed into the snow, as in the talk.
 
@@ -817,7 +818,7 @@ const CAMERAS: &[&str] = &[
 
 impl DemoScene for StandIn {
     fn name(&self) -> &str {
-        "stand-in (crate::demo not yet available)"
+        "stand-in (crates/snowprint-cli/src/standin.rs)"
     }
 
     fn surfaces(&self) -> &[(SurfaceId, GroundMaterial)] {
