@@ -57,6 +57,10 @@ pub struct Row {
     pub ratio_to_copy: f64,
     /// Pool bytes of the surfaces.
     pub pool_bytes: u64,
+    /// Bytes per surface in the pool (heightmap history pair and normals, slot alignment included).
+    pub bytes_per_surface: u64,
+    /// Every GPU allocation of the world: pool, scratch, capture buffers, viewport target, tables.
+    pub memory: snowprint::MemoryReport,
 }
 
 /// Per-stage medians, microseconds.
@@ -323,6 +327,8 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         copy_us,
         ratio_to_copy: update_us / copy_us,
         pool_bytes: world.memory().pool_used,
+        bytes_per_surface: slot,
+        memory: world.memory(),
     })
 }
 
