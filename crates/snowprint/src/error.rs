@@ -18,6 +18,16 @@ pub enum SnowError {
         /// Names of the adapters that exist, comma separated.
         available: String,
     },
+    /// The adapter lacks a capability the passes need.
+    #[error(
+        "GPU adapter {adapter} lacks {missing}, which snowprint's capture and compute passes need; pick another adapter with --adapter, or install a Vulkan driver (on Debian or Ubuntu: `apt-get install mesa-vulkan-drivers`)"
+    )]
+    AdapterUnsupported {
+        /// The adapter, described.
+        adapter: String,
+        /// The missing capabilities.
+        missing: String,
+    },
     /// The device could not be created.
     #[error("the GPU device could not be created on {adapter}: {source}")]
     RequestDevice {

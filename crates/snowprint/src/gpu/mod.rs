@@ -52,6 +52,16 @@ impl std::fmt::Debug for GpuContext {
     }
 }
 
+/// What the passes need beyond WebGPU's baseline: compute shaders, and fragment shaders that write
+/// storage buffers (the capture keeps the lowest point per texel with an atomic in a buffer).
+pub const REQUIRED_DOWNLEVEL: wgpu::DownlevelFlags =
+    wgpu::DownlevelFlags::COMPUTE_SHADERS.union(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE);
+
+/// The required capabilities an adapter lacks (empty when it has them all).
+pub fn missing_capabilities(adapter: &wgpu::Adapter) -> wgpu::DownlevelFlags {
+    REQUIRED_DOWNLEVEL.difference(adapter.get_downlevel_capabilities().flags)
+}
+
 /// Rank of an adapter: lower is better.
 fn adapter_rank(info: &wgpu::AdapterInfo) -> (u8, u8) {
     let kind = match info.device_type {
@@ -95,7 +105,13 @@ impl GpuContext {
         if adapters.is_empty() {
             return Err(SnowError::NoAdapter);
         }
-        adapters.sort_by_key(|a| adapter_rank(&a.get_info()));
+        // Adapters that lack what the passes need go last, then by type and backend.
+        adapters.sort_by_key(|a| {
+            (
+                !missing_capabilities(a).is_empty(),
+                adapter_rank(&a.get_info()),
+            )
+        });
         let adapter = match &requested {
             Some(name) => {
                 let needle = name.to_lowercase();
@@ -125,6 +141,13 @@ impl GpuContext {
     /// Create a device on a given adapter, checking capabilities.
     pub async fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
+        let missing = missing_capabilities(&adapter);
+        if !missing.is_empty() {
+            return Err(SnowError::AdapterUnsupported {
+                adapter: describe(&info),
+                missing: format!("{missing:?}"),
+            });
+        }
         let features = adapter.features();
         let limits = adapter.limits();
         let mut warnings = Vec::new();
