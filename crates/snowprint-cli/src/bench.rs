@@ -450,7 +450,20 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
     }
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    // The talk's memory: how many 512^2 surfaces fit its 2 MiB pool at the storage this build uses.
+    let talk_pool: u64 = 2 << 20;
+    let slot_512 = snowprint::pool::slot_bytes(512 * 512);
+    let fit = talk_pool / slot_512;
+    println!(
+        "\nmemory: a 512^2 surface takes {slot_512} bytes (two 32-bit history halves of 16-bit depression + 16-bit displaced snow, and 32-bit normals): {fit} fit the talk's 2 MiB pool"
+    );
     let report = serde_json::json!({
+        "memory_talk_pool": {
+            "pool_bytes": talk_pool,
+            "bytes_per_512_surface": slot_512,
+            "surfaces_512_that_fit": fit,
+            "precision": "depression and displaced snow 16-bit fixed point (1/65535 of the snow depth) each; history kept per surface as a ping-pong pair; normals 2 x 16-bit snorm",
+        },
         "adapter": snowprint::gpu::describe(&gpu.info),
         "timestamps": timestamps,
         "frames": args.frames,
