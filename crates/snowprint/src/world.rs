@@ -16,6 +16,7 @@ use crate::capture::{
 };
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
+use crate::gpu::resources::{Growable, bind_group};
 use crate::gpu::{Capabilities, GpuContext};
 use crate::heightmap::Heightmap;
 use crate::mesh::{Mesh, MeshId};
@@ -189,63 +190,7 @@ struct MeshGpu {
     radius: f32,
 }
 
-/// A growable GPU buffer.
-struct Growable {
-    buffer: wgpu::Buffer,
-    usage: wgpu::BufferUsages,
-    label: &'static str,
-}
-
-impl Growable {
-    fn new(
-        device: &wgpu::Device,
-        label: &'static str,
-        usage: wgpu::BufferUsages,
-        size: u64,
-    ) -> Self {
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage,
-            mapped_at_creation: false,
-        });
-        Self {
-            buffer,
-            usage,
-            label,
-        }
-    }
-
-    fn ensure(&mut self, device: &wgpu::Device, size: u64) {
-        if self.buffer.size() < size {
-            *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
-        }
-    }
-}
-
 const UNIFORM_STRIDE: u64 = 256;
-
-/// A bind group of whole buffers at bindings 0, 1, 2, ...
-fn buffers_bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    buffers: &[&wgpu::Buffer],
-) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: b.as_entire_binding(),
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout,
-        entries: &entries,
-    })
-}
 
 /// One surface's work in a frame.
 struct Job {
@@ -910,29 +855,43 @@ impl SnowWorld {
             &self.scratch.buffer,
             &self.pool,
         );
-        let blur_bg = buffers_bind_group(
+        let blur_bg = bind_group(
             &self.device,
             "blur",
             &self.acc.blur_layout,
-            &[records, capture, winding, scratch],
+            &[
+                records.as_entire_binding(),
+                capture.as_entire_binding(),
+                winding.as_entire_binding(),
+                scratch.as_entire_binding(),
+            ],
         );
-        let merge_bg = buffers_bind_group(
+        let merge_bg = bind_group(
             &self.device,
             "merge",
             &self.acc.merge_layout,
-            &[records, scratch, pool],
+            &[
+                records.as_entire_binding(),
+                scratch.as_entire_binding(),
+                pool.as_entire_binding(),
+            ],
         );
-        let normals_bg = buffers_bind_group(
+        let normals_bg = bind_group(
             &self.device,
             "normals",
             &self.acc.normals_layout,
-            &[records, pool],
+            &[records.as_entire_binding(), pool.as_entire_binding()],
         );
-        let fused_bg = buffers_bind_group(
+        let fused_bg = bind_group(
             &self.device,
             "fused",
             &self.acc.fused_layout,
-            &[records, capture, winding, pool],
+            &[
+                records.as_entire_binding(),
+                capture.as_entire_binding(),
+                winding.as_entire_binding(),
+                pool.as_entire_binding(),
+            ],
         );
         let ts = if self.profiling {
             self.timestamps.as_ref()

@@ -12,6 +12,8 @@
 
 pub mod cpu;
 
+use crate::gpu::resources::compute_storage;
+
 /// Record layout shared by every pass.
 pub const SHARED: &str = include_str!("../shared.wgsl");
 /// Stage 1 (without the shared prelude).
@@ -62,47 +64,38 @@ pub struct AccumulatePipelines {
     pub fused_layout: wgpu::BindGroupLayout,
 }
 
-fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl AccumulatePipelines {
     /// Compile the three passes.
     pub fn new(device: &wgpu::Device) -> Self {
         let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blur"),
             entries: &[
-                storage(0, true),
-                storage(1, true),
-                storage(2, true),
-                storage(3, false),
+                compute_storage(0, true),
+                compute_storage(1, true),
+                compute_storage(2, true),
+                compute_storage(3, false),
             ],
         });
         let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("merge"),
-            entries: &[storage(0, true), storage(1, true), storage(2, false)],
+            entries: &[
+                compute_storage(0, true),
+                compute_storage(1, true),
+                compute_storage(2, false),
+            ],
         });
         let fused_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("fused"),
             entries: &[
-                storage(0, true),
-                storage(1, true),
-                storage(2, true),
-                storage(3, false),
+                compute_storage(0, true),
+                compute_storage(1, true),
+                compute_storage(2, true),
+                compute_storage(3, false),
             ],
         });
         let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("normals"),
-            entries: &[storage(0, true), storage(1, false)],
+            entries: &[compute_storage(0, true), compute_storage(1, false)],
         });
         let make = |name: &str, src: &str, layout: &wgpu::BindGroupLayout| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -5,6 +5,8 @@
 //! `SNOWPRINT_ADAPTER` environment variable. Optional features (timestamp queries) are requested only
 //! where the adapter has them; where one is missing the library falls back and says so with a warning.
 
+pub(crate) mod resources;
+
 use crate::error::{Result, SnowError};
 
 /// How to choose the GPU.

@@ -57,6 +57,7 @@ pub mod gpu;
 pub mod graph;
 pub mod shaders;
 
+use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform};
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -681,40 +682,6 @@ struct GpuMesh {
     radius: f32,
 }
 
-/// A GPU buffer that grows (to the next power of two) when asked for more.
-struct Growable {
-    buffer: wgpu::Buffer,
-    usage: wgpu::BufferUsages,
-    label: &'static str,
-}
-
-impl Growable {
-    fn new(
-        device: &wgpu::Device,
-        label: &'static str,
-        usage: wgpu::BufferUsages,
-        size: u64,
-    ) -> Self {
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: size.max(16),
-            usage,
-            mapped_at_creation: false,
-        });
-        Self {
-            buffer,
-            usage,
-            label,
-        }
-    }
-
-    fn ensure(&mut self, device: &wgpu::Device, size: u64) {
-        if self.buffer.size() < size {
-            *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
-        }
-    }
-}
-
 /// A deformed surface's shading textures, written by the heightfield pass.
 struct HeightfieldTexture {
     size: (u32, u32),
@@ -811,32 +778,6 @@ impl std::fmt::Debug for Renderer {
             .field("meshes", &self.meshes.len())
             .field("timestamps", &self.timestamps.is_some())
             .finish()
-    }
-}
-
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
     }
 }
 
@@ -961,7 +902,7 @@ impl Renderer {
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &[
-                uniform_entry(0, vf),
+                uniform(0, vf),
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -992,12 +933,12 @@ impl Renderer {
         });
         let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow frame"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
         });
         let surface_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("snow surface"),
             entries: &[
-                uniform_entry(0, vf),
+                uniform(0, vf),
                 texture_entry(1, wgpu::TextureSampleType::Float { filterable }),
                 texture_entry(2, wgpu::TextureSampleType::Float { filterable }),
             ],
@@ -1012,17 +953,17 @@ impl Renderer {
         let classify_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("classify"),
             entries: &[
-                storage_entry(0, true),
-                storage_entry(1, true),
-                storage_entry(2, false),
+                compute_storage(0, true),
+                compute_storage(1, true),
+                compute_storage(2, false),
             ],
         });
         let heightfield_layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("heightfield"),
                 entries: &[
-                    storage_entry(0, true),
-                    uniform_entry(1, wgpu::ShaderStages::COMPUTE),
+                    compute_storage(0, true),
+                    uniform(1, wgpu::ShaderStages::COMPUTE),
                     storage_texture_entry(2),
                     storage_texture_entry(3),
                 ],
@@ -2205,33 +2146,23 @@ impl Renderer {
                 },
             ],
         });
-        let shadow_bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow frame"),
-            layout: &self.shadow_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: self.frame_buffer.as_entire_binding(),
-            }],
-        });
+        let shadow_bg = bind_group(
+            dev,
+            "shadow frame",
+            &self.shadow_layout,
+            &[self.frame_buffer.as_entire_binding()],
+        );
         let classify_bg = (n > 0).then(|| {
-            dev.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("classify"),
-                layout: &self.classify_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: world.pool_buffer().as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: self.classify_buffer.buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: self.state_buffer.buffer.as_entire_binding(),
-                    },
+            bind_group(
+                dev,
+                "classify",
+                &self.classify_layout,
+                &[
+                    world.pool_buffer().as_entire_binding(),
+                    self.classify_buffer.buffer.as_entire_binding(),
+                    self.state_buffer.buffer.as_entire_binding(),
                 ],
-            })
+            )
         });
         let mut hf_bgs = Vec::with_capacity(n);
         let mut surface_bgs = Vec::with_capacity(n);

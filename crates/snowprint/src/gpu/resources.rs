@@ -1,0 +1,89 @@
+//! Small GPU resource helpers shared by the world's passes and the renderer's.
+
+/// A GPU buffer that grows (to the next power of two) when asked for more; the old contents are
+/// not kept, so it suits per-frame tables rewritten before each use.
+pub(crate) struct Growable {
+    /// The current buffer.
+    pub buffer: wgpu::Buffer,
+    usage: wgpu::BufferUsages,
+    label: &'static str,
+}
+
+impl Growable {
+    /// A buffer of at least `size` bytes (16 at least, so that it can always be bound).
+    pub fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        usage: wgpu::BufferUsages,
+        size: u64,
+    ) -> Self {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage,
+            mapped_at_creation: false,
+        });
+        Self {
+            buffer,
+            usage,
+            label,
+        }
+    }
+
+    /// Make sure the buffer holds at least `size` bytes.
+    pub fn ensure(&mut self, device: &wgpu::Device, size: u64) {
+        if self.buffer.size() < size {
+            *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
+        }
+    }
+}
+
+/// A storage buffer binding seen by compute shaders.
+pub(crate) fn compute_storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A uniform buffer binding (no dynamic offset).
+pub(crate) fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A bind group of `resources` at bindings 0, 1, 2, ... in order.
+pub(crate) fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: r.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
