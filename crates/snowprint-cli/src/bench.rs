@@ -9,8 +9,8 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use snowprint::{
-    Deformer, GpuContext, GpuOptions, PassMode, Pose, Shape, SnowWorld, StageTimes, SurfaceDesc,
-    SurfaceUpdate, WorldConfig,
+    Deformer, GpuContext, GpuOptions, PassMode, PoolFormat, Pose, Precision, Shape, SnowWorld,
+    StageTimes, SurfaceDesc, SurfaceUpdate, WorldConfig,
 };
 
 /// Arguments of `snowprint bench`.
@@ -41,15 +41,17 @@ pub struct Row {
     pub resolution: u32,
     /// Deformers over each surface.
     pub deformers_per_surface: u32,
-    /// Blur, merge and normals fused in one pass (else three passes).
+    /// Blur and merge fused in one pass (else separate passes).
     pub fused: bool,
+    /// Bits a channel of the pool.
+    pub precision_bits: u32,
     /// Median GPU time of the whole update, microseconds (or whole frames timed on the CPU).
     pub update_us: f64,
     /// Median GPU time per stage, microseconds.
     pub stages_us: Option<StageTimesUs>,
     /// Median CPU time to build and encode the frame, microseconds.
     pub cpu_encode_us: f64,
-    /// Bytes of heightmap history the update rewrites (texels x 4).
+    /// Bytes of heightmap the update rewrites (the heights regions of the surfaces).
     pub heightmap_bytes: u64,
     /// Median GPU time of a plain buffer copy of `heightmap_bytes`, microseconds.
     pub copy_us: f64,
@@ -57,7 +59,7 @@ pub struct Row {
     pub ratio_to_copy: f64,
     /// Pool bytes of the surfaces.
     pub pool_bytes: u64,
-    /// Bytes per surface in the pool (heightmap history pair and normals, slot alignment included).
+    /// Bytes per surface in the pool (both channels, slot alignment included).
     pub bytes_per_surface: u64,
     /// Every GPU allocation of the world: pool, scratch, capture buffers, viewport target, tables.
     pub memory: snowprint::MemoryReport,
@@ -74,7 +76,7 @@ pub struct StageTimesUs {
     pub merge: f64,
     /// Normals.
     pub normals: f64,
-    /// Fused blur + merge + normals.
+    /// Fused blur + merge.
     pub fused: f64,
 }
 
@@ -214,18 +216,21 @@ struct Config {
     resolution: u32,
     deformers: u32,
     passes: PassMode,
+    precision: Precision,
 }
 
 fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     // Square surfaces at 4 cm texels have exactly `resolution` texels a side.
     let side = c.resolution as f32 * 0.04;
-    let slot = snowprint::pool::slot_bytes(c.resolution as u64 * c.resolution as u64);
+    let format = PoolFormat::new(c.precision);
+    let slot = format.slot_bytes(c.resolution, c.resolution);
     let mut world = SnowWorld::new(
         gpu,
         WorldConfig {
             pool_bytes: slot * c.surfaces as u64,
             max_resolution: c.resolution,
             passes: c.passes,
+            format,
             atlas_side: 8192.min(gpu.caps.max_texture_side),
             ..Default::default()
         },
@@ -297,7 +302,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             None => total.push(wall),
         }
     }
-    let bytes = c.surfaces as u64 * c.resolution as u64 * c.resolution as u64 * 4;
+    let bytes = c.surfaces as u64 * format.heights_bytes(c.resolution, c.resolution);
     let copy = CopyTimer::new(gpu, bytes);
     let mut copies = Vec::new();
     for i in 0..args.warmup + args.frames {
@@ -314,6 +319,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         resolution: c.resolution,
         deformers_per_surface: c.deformers,
         fused: world.config().passes == PassMode::Fused,
+        precision_bits: c.precision.bits(),
         update_us,
         stages_us: timestamps.then(|| StageTimesUs {
             capture: median(&mut cap),
@@ -356,12 +362,17 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         resolution,
         deformers,
         passes,
+        precision: Precision::Bits16,
     };
-    // The talk's frame, fused and as three separate passes; the sweeps use the device's default.
+    let at = |precision, c: Config| Config { precision, ..c };
+    // The talk's frame, fused and as separate passes, at each precision; the sweeps use the
+    // device's default passes and 16 bits.
     let (auto, fused, separate) = (PassMode::Auto, PassMode::Fused, PassMode::Separate);
     let mut configs = vec![
         cfg("talk_budget", 2, 512, 10, fused),
         cfg("talk_budget", 2, 512, 10, separate),
+        at(Precision::Bits8, cfg("talk_budget", 2, 512, 10, fused)),
+        at(Precision::Bits32, cfg("talk_budget", 2, 512, 10, fused)),
     ];
     let (counts, resolutions, deformers): (&[u32], &[u32], &[u32]) = if quick {
         (&[1, 4, 16], &[64, 128, 256], &[1, 10, 100])
@@ -380,9 +391,10 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
     );
     configs.extend(deformers.iter().map(|&d| cfg("deformers", 2, 512, d, auto)));
     if !quick {
-        // The most 512^2 surfaces one storage binding of 2 GiB holds at 12 bytes a texel.
-        configs.push(cfg("many_512", 512, 512, 1, fused));
-        configs.push(cfg("many_512", 512, 512, 1, separate));
+        // The 1024 surfaces of 512^2: 1 GiB of heights at 16 bits, 512 MiB at 8.
+        configs.push(cfg("many_512", 1024, 512, 1, fused));
+        configs.push(cfg("many_512", 1024, 512, 1, separate));
+        configs.push(at(Precision::Bits8, cfg("many_512", 1024, 512, 1, fused)));
     }
     let bar = ProgressBar::new(configs.len() as u64);
     bar.set_style(
@@ -411,9 +423,10 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         }
     );
     println!(
-        "{:<12} {:>5} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}",
+        "{:<12} {:>5} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}",
         "sweep",
         "mode",
+        "bits",
         "surfaces",
         "res",
         "defs",
@@ -431,9 +444,10 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<12} {:>5} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2}",
+            "{:<12} {:>5} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2}",
             r.sweep,
-            if r.fused { "fused" } else { "3pass" },
+            if r.fused { "fused" } else { "split" },
+            r.precision_bits,
             r.surfaces,
             r.resolution,
             r.deformers_per_surface,
@@ -450,20 +464,42 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
     }
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-    // The talk's memory: how many 512^2 surfaces fit its 2 MiB pool at the storage this build uses.
-    let talk_pool: u64 = 2 << 20;
-    let slot_512 = snowprint::pool::slot_bytes(512 * 512);
-    let fit = talk_pool / slot_512;
+    // The talk's memory: how many 512^2 surfaces a real 2 MiB pool holds at each precision, and
+    // what each precision costs in accuracy against 32 bits on the talk's frame.
+    let fits = Precision::ALL
+        .into_iter()
+        .map(|p| talk_pool_fit(&gpu, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    println!("\nmemory: 512^2 surfaces (both channels, no history, no normals) in the talk's 2 MiB pool");
+    for f in &fits {
+        println!(
+            "  {:>2}-bit: {:>7} bytes a surface, {} fit and update",
+            f.precision_bits, f.bytes_per_surface, f.surfaces
+        );
+    }
+    let errors = precision_errors(&gpu, if quick { 30 } else { 120 })?;
     println!(
-        "\nmemory: a 512^2 surface takes {slot_512} bytes (two 32-bit history halves of 16-bit depression + 16-bit displaced snow, and 32-bit normals): {fit} fit the talk's 2 MiB pool"
+        "\nprecision: {} frames of the talk's frame (2 x 512^2, 10 moving spheres each, snow refilling), against 32 bits",
+        errors[0].frames
     );
+    for e in &errors {
+        println!(
+            "  {:>2}-bit: depression max {:.2e} (mean {:.2e}) of the snow depth = {:.2} mm of 30 cm; displaced max {:.2e} (mean {:.2e})",
+            e.precision_bits,
+            e.depression_max,
+            e.depression_mean,
+            e.depression_max * 300.0,
+            e.displaced_max,
+            e.displaced_mean
+        );
+    }
     let report = serde_json::json!({
         "memory_talk_pool": {
-            "pool_bytes": talk_pool,
-            "bytes_per_512_surface": slot_512,
-            "surfaces_512_that_fit": fit,
-            "precision": "depression and displaced snow 16-bit fixed point (1/65535 of the snow depth) each; history kept per surface as a ping-pong pair; normals 2 x 16-bit snorm",
+            "pool_bytes": 2u64 << 20,
+            "layout": "depression and displaced snow per texel at the pool's precision, updated in place (no history per surface: the capture buffers of a frame are shared by every surface in it); normals not kept (the renderer derives them)",
+            "fits": fits,
         },
+        "precision_error_vs_32_bit": errors,
         "adapter": snowprint::gpu::describe(&gpu.info),
         "timestamps": timestamps,
         "frames": args.frames,
@@ -497,6 +533,178 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
     }
     eprintln!("snowprint: wrote {}", args.out.display());
     Ok(())
+}
+
+/// How many 512^2 surfaces fit a real 2 MiB pool at one precision.
+#[derive(Serialize, Debug, Clone)]
+pub struct PoolFit {
+    /// Bits a channel.
+    pub precision_bits: u32,
+    /// Pool bytes of one 512^2 surface.
+    pub bytes_per_surface: u64,
+    /// Surfaces added before the pool refused one, all of which were then updated and read back
+    /// pressed.
+    pub surfaces: u32,
+    /// Pool bytes in use with them.
+    pub pool_used: u64,
+    /// Bytes outside the pool the frame that updated them all used (scratch, capture and winding
+    /// buffers, tables), shared by every surface updated in a frame.
+    pub frame_bytes: u64,
+}
+
+/// Add 512^2 surfaces to a world with the talk's 2 MiB pool until it refuses one, then press each
+/// with a sphere in one update and check every one was pressed.
+fn talk_pool_fit(gpu: &GpuContext, precision: Precision) -> Result<PoolFit, String> {
+    let format = PoolFormat::new(precision);
+    let mut world = SnowWorld::new(
+        gpu,
+        WorldConfig {
+            pool_bytes: 2 << 20,
+            format,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let side = 512.0 * 0.04;
+    let mut ids = Vec::new();
+    loop {
+        let x = ids.len() as f32 * (side + 1.0);
+        match world.add_surface(SurfaceDesc::new("talk", [x, 0.0, 0.0], [side, side], 0.3)) {
+            Ok(id) => ids.push((id, x)),
+            Err(snowprint::SnowError::PoolExhausted { .. }) => break,
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    let spheres: Vec<Vec<Deformer>> = ids
+        .iter()
+        .map(|&(_, x)| {
+            vec![Deformer::new(
+                Shape::Sphere { radius: 0.3 },
+                Pose::at([x, 0.1, 0.0]),
+            )]
+        })
+        .collect();
+    let updates: Vec<SurfaceUpdate<'_>> = ids
+        .iter()
+        .zip(&spheres)
+        .map(|(&(surface, _), d)| SurfaceUpdate {
+            surface,
+            elapsed: 0.0,
+            deformers: d,
+        })
+        .collect();
+    world.update(&updates).map_err(|e| e.to_string())?;
+    for &(id, _) in &ids {
+        let (depression, _) = world.read_channels(id).map_err(|e| e.to_string())?;
+        if !depression.iter().any(|&v| v > 0) {
+            return Err(format!(
+                "a 512^2 surface at {precision} was not pressed: the pool is broken"
+            ));
+        }
+    }
+    let memory = world.memory();
+    Ok(PoolFit {
+        precision_bits: precision.bits(),
+        bytes_per_surface: format.slot_bytes(512, 512),
+        surfaces: ids.len() as u32,
+        pool_used: memory.pool_used,
+        frame_bytes: memory.scratch + memory.frame_tables + memory.capture_atlas,
+    })
+}
+
+/// The error of one precision against 32 bits.
+#[derive(Serialize, Debug, Clone)]
+pub struct PrecisionError {
+    /// Bits a channel.
+    pub precision_bits: u32,
+    /// Frames run.
+    pub frames: u32,
+    /// Largest difference in depression, fraction of the snow depth.
+    pub depression_max: f64,
+    /// Mean difference in depression over all texels.
+    pub depression_mean: f64,
+    /// Largest difference in displaced snow, fraction of the snow depth.
+    pub displaced_max: f64,
+    /// Mean difference in displaced snow.
+    pub displaced_mean: f64,
+}
+
+/// Run the talk's frame (2 surfaces of 512^2, 10 moving spheres each, snow refilling at 2% of the
+/// depth a second) for `frames` frames at 8, 16 and 32 bits, and compare the heightmaps with the
+/// 32-bit ones.
+fn precision_errors(gpu: &GpuContext, frames: u32) -> Result<Vec<PrecisionError>, String> {
+    let side = 512.0 * 0.04;
+    let run = |precision: Precision| -> Result<Vec<(Vec<f64>, Vec<f64>)>, String> {
+        let format = PoolFormat::new(precision);
+        let mut world = SnowWorld::new(
+            gpu,
+            WorldConfig {
+                pool_bytes: 2 * format.slot_bytes(512, 512),
+                format,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| e.to_string())?;
+        let centers = [Vec3::ZERO, Vec3::new(side + 1.0, 0.0, 0.0)];
+        let mut ids = Vec::new();
+        for c in centers {
+            let mut desc = SurfaceDesc::new("talk", c.into(), [side, side], 0.3);
+            desc.replenish_rate = 0.02;
+            ids.push(world.add_surface(desc).map_err(|e| e.to_string())?);
+        }
+        for f in 0..frames {
+            let deformers: Vec<Vec<Deformer>> = centers
+                .iter()
+                .map(|&c| deformers_over(c, side, 10, f))
+                .collect();
+            let updates: Vec<SurfaceUpdate<'_>> = ids
+                .iter()
+                .zip(&deformers)
+                .map(|(&surface, d)| SurfaceUpdate {
+                    surface,
+                    elapsed: 1.0 / 60.0,
+                    deformers: d,
+                })
+                .collect();
+            world.update(&updates).map_err(|e| e.to_string())?;
+        }
+        let max = precision.channel_max() as f64;
+        ids.iter()
+            .map(|&id| {
+                let (d, p) = world.read_channels(id).map_err(|e| e.to_string())?;
+                Ok((
+                    d.iter().map(|&v| v as f64 / max).collect(),
+                    p.iter().map(|&v| v as f64 / max).collect(),
+                ))
+            })
+            .collect()
+    };
+    let reference = run(Precision::Bits32)?;
+    let mut out = Vec::new();
+    for precision in [Precision::Bits8, Precision::Bits16] {
+        let got = run(precision)?;
+        let (mut dm, mut ds, mut pm, mut ps, mut n) = (0.0f64, 0.0, 0.0f64, 0.0, 0.0);
+        for (g, r) in got.iter().zip(&reference) {
+            for i in 0..g.0.len() {
+                let dd = (g.0[i] - r.0[i]).abs();
+                let dp = (g.1[i] - r.1[i]).abs();
+                dm = dm.max(dd);
+                pm = pm.max(dp);
+                ds += dd;
+                ps += dp;
+                n += 1.0;
+            }
+        }
+        out.push(PrecisionError {
+            precision_bits: precision.bits(),
+            frames,
+            depression_max: dm,
+            depression_mean: ds / n,
+            displaced_max: pm,
+            displaced_mean: ps / n,
+        });
+    }
+    Ok(out)
 }
 
 fn write(path: &Path, text: &str) -> Result<(), String> {

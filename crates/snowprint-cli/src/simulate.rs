@@ -105,7 +105,10 @@ pub fn simulate(
     let pool: u64 = scene
         .surfaces
         .iter()
-        .map(|s| snowprint::pool::slot_bytes(s.layout().texels()))
+        .map(|s| {
+            let l = s.layout();
+            snowprint::PoolFormat::default().slot_bytes(l.width, l.height)
+        })
         .sum();
     let mut world = SnowWorld::new(
         &ctx,

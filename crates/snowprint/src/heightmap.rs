@@ -29,6 +29,24 @@ impl Heightmap {
         }
     }
 
+    /// Convert channels at `precision` (see [`crate::pool`]) to 16-bit units, rounding to nearest.
+    pub fn from_channels(
+        width: u32,
+        height: u32,
+        precision: crate::pool::Precision,
+        depression: &[u32],
+        displaced: &[u32],
+    ) -> Self {
+        let max = precision.channel_max() as u64;
+        let to16 = |v: &u32| ((*v as u64 * 65535 + max / 2) / max) as u16;
+        Self {
+            width,
+            height,
+            depression: depression.iter().map(to16).collect(),
+            displaced: displaced.iter().map(to16).collect(),
+        }
+    }
+
     /// Depression at a texel as a fraction of the snow depth.
     pub fn fraction(&self, column: u32, row: u32) -> f32 {
         self.depression[(row * self.width + column) as usize] as f32 / 65535.0

@@ -45,6 +45,7 @@ pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
 };
 pub use mesh::{Mesh, MeshId};
+pub use pool::{PoolFormat, Precision};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{

@@ -2,26 +2,29 @@
 // Must match `SurfaceRecord` in src/pool/mod.rs (checked by a test that parses this file with naga).
 
 struct SurfaceRecord {
-    // Element (u32) offsets into the pool buffer.
-    heights_read: u32,    // half of the ping-pong pair holding the previous heightmap
-    heights_write: u32,   // half that receives the new heightmap
-    normals: u32,         // normals region (pack2x16snorm of local x and z)
-    scratch: u32,         // element offset into the scratch buffer (blurred capture, f32)
+    // Word (u32) offsets into the pool buffer.
+    heights: u32,         // the heights region (see pool/texel.wgsl), updated in place
+    normals: u32,         // normals region (pack2x16snorm of local x and z), or NO_NORMALS
+    scratch: u32,         // word offset into the per-frame capture buffers and the scratch
     width: u32,
     height: u32,
     atlas_x: u32,         // where the surface's capture lies in the capture atlas
     atlas_y: u32,
     mode: u32,            // 0 = depth capture, 1 = mask capture
-    replenish_units: u32, // depression units (1/65535 of the snow depth) refilled this update
+    replenish_units: u32, // channel units (1/channel_max(PRECISION) of the snow depth) refilled
     batch: u32,           // capture batch; NO_CAPTURE when nothing touched the surface
     mask_fraction: f32,   // mask capture: fraction of the snow depth a covered texel is pressed
     snow_depth: f32,      // metres
     frustum_height: f32,  // metres: snow depth + ankle height
     texel_x: f32,         // metres
     texel_z: f32,         // metres
+    pad: u32,
 }
 
 const NO_CAPTURE: u32 = 0xffffffffu;
 const MODE_DEPTH: u32 = 0u;
 const MODE_MASK: u32 = 1u;
-const UNITS: f32 = 65535.0;
+const NO_NORMALS: u32 = 0xffffffffu;
+
+// Bits a channel of the pool's heightmaps (8, 16 or 32): set when the world compiles its passes.
+override PRECISION: u32 = 16u;

@@ -20,7 +20,7 @@ use crate::gpu::resources::{Growable, bind_group};
 use crate::gpu::{Capabilities, GpuContext};
 use crate::heightmap::Heightmap;
 use crate::mesh::{Mesh, MeshId};
-use crate::pool::{NO_CAPTURE, Slot, SlotAllocator, SurfaceRecord};
+use crate::pool::{NO_CAPTURE, NO_NORMALS, PoolFormat, Slot, SlotAllocator, SurfaceRecord};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 
 /// Which of the talk's two capture paths to use.
@@ -68,6 +68,8 @@ pub struct WorldConfig {
     pub max_resolution: u32,
     /// How blur, merge and normals are dispatched.
     pub passes: PassMode,
+    /// How heightmaps are stored: bits a channel, and whether normals are kept.
+    pub format: PoolFormat,
 }
 
 /// How the accumulation chain is dispatched.
@@ -76,11 +78,11 @@ pub enum PassMode {
     /// Fused on GPUs, separate on software adapters (the default).
     #[default]
     Auto,
-    /// Blur, merge and normals in one pass: one dispatch instead of three and no scratch round
-    /// trip, at the price of recomputing the neighbours' values (45 capture loads a texel instead of
-    /// 9), which suits GPUs, where a pass costs more than its memory traffic.
+    /// Blur and merge in one pass: one dispatch instead of two and no scratch round trip, at the
+    /// price of staging each tile's capture apron in workgroup memory, which suits GPUs, where a
+    /// pass costs more than its memory traffic. (Normals, when kept, follow in their own pass.)
     Fused,
-    /// Three passes; [`SnowWorld::read_last_blurred`] can then show stage 1's output. Cheaper on
+    /// Separate passes; [`SnowWorld::read_last_blurred`] can then show stage 1's output. Cheaper on
     /// software adapters, where every load counts and a pass costs little.
     Separate,
 }
@@ -93,6 +95,7 @@ impl Default for WorldConfig {
             atlas_side: 2048,
             max_resolution: crate::surface::MAX_RESOLUTION,
             passes: PassMode::Auto,
+            format: PoolFormat::default(),
         }
     }
 }
@@ -108,7 +111,7 @@ pub struct StageTimes {
     pub merge_ms: f64,
     /// The normals dispatch.
     pub normals_ms: f64,
-    /// The fused blur + merge + normals dispatch (when [`PassMode::Fused`]).
+    /// The fused blur + merge dispatch (when [`PassMode::Fused`]).
     pub fused_ms: f64,
 }
 
@@ -147,12 +150,14 @@ pub struct MemoryReport {
     pub pool_used: u64,
     /// Most pool bytes ever in slots.
     pub pool_high_water: u64,
-    /// Scratch buffer (blurred captures of one frame).
+    /// Scratch buffer (blurred captures of one frame, shared by every surface updated in it).
     pub scratch: u64,
     /// Capture atlas textures.
     pub capture_atlas: u64,
-    /// Per-frame tables (records, views, primitives, mesh draws).
+    /// Per-frame tables (records, views, primitives, mesh draws, capture and winding buffers).
     pub frame_tables: u64,
+    /// How the pool stores heightmaps.
+    pub format: PoolFormat,
 }
 
 /// One surface's share of a [`SnowWorld::update`].
@@ -170,8 +175,6 @@ struct SurfaceState {
     desc: SurfaceDesc,
     layout: SurfaceLayout,
     slot: Slot,
-    /// Which half of the ping-pong pair holds the current heightmap.
-    parity: u32,
     /// Replenishment not yet applied, units (fraction kept between frames).
     carry: f64,
 }
@@ -337,7 +340,7 @@ impl SnowWorld {
         });
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
-            acc: AccumulatePipelines::new(&device),
+            acc: AccumulatePipelines::new(&device, config.format.precision),
             records: Growable::new(
                 &device,
                 "surface records",
@@ -411,12 +414,13 @@ impl SnowWorld {
     pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
         desc.validate()?;
         let layout = SurfaceLayout::for_size_capped(desc.size, self.config.max_resolution);
+        let needed = self.config.format.slot_bytes(layout.width, layout.height);
         let slot = self
             .alloc
-            .alloc(layout.texels())
+            .alloc(needed)
             .ok_or_else(|| SnowError::PoolExhausted {
                 name: desc.name.clone(),
-                needed: crate::pool::slot_bytes(layout.texels()),
+                needed,
                 free: self.alloc.largest_free(),
                 budget: self.alloc.budget(),
             })?;
@@ -427,7 +431,6 @@ impl SnowWorld {
             desc,
             layout,
             slot,
-            parity: 0,
             carry: 0.0,
         };
         let index = match self.surfaces.iter().position(Option::is_none) {
@@ -561,6 +564,7 @@ impl SnowWorld {
                 + self.draws.buffer.size()
                 + self.capture.buffer.size()
                 + self.winding.buffer.size(),
+            format: self.config.format,
         }
     }
 
@@ -653,7 +657,7 @@ impl SnowWorld {
                 continue;
             };
             state.carry +=
-                state.desc.replenish_rate as f64 * dt as f64 * accumulate::cpu::UNITS as f64;
+                state.desc.replenish_rate as f64 * dt as f64 * self.config.format.precision.channel_max() as f64;
             let units = state.carry.floor().min(u32::MAX as f64);
             state.carry -= units;
             let units = units as u32;
@@ -697,13 +701,14 @@ impl SnowWorld {
                 continue;
             }
             let texel = state.texel();
-            let (read, write) = (state.parity as u64, 1 - state.parity as u64);
             jobs.push(Job {
                 surface: index,
                 record: SurfaceRecord {
-                    heights_read: state.slot.region(read),
-                    heights_write: state.slot.region(write),
-                    normals: state.slot.region(2),
+                    heights: state.slot.heights_word(),
+                    normals: state
+                        .slot
+                        .normals_word(&self.config.format, state.layout.width, state.layout.height)
+                        .unwrap_or(NO_NORMALS),
                     scratch: 0,
                     width: state.layout.width,
                     height: state.layout.height,
@@ -720,6 +725,7 @@ impl SnowWorld {
                     frustum_height,
                     texel_x: texel.x,
                     texel_z: texel.y,
+                    pad: 0,
                 },
                 captured,
                 prims: p0..prims.len() as u32,
@@ -889,8 +895,8 @@ impl SnowWorld {
             &[
                 records.as_entire_binding(),
                 capture.as_entire_binding(),
-                winding.as_entire_binding(),
                 pool.as_entire_binding(),
+                winding.as_entire_binding(),
             ],
         );
         let ts = if self.profiling {
@@ -978,18 +984,23 @@ impl SnowWorld {
                 }
             }
         }
-        let separate = [
-            (Stage::Blur, &self.acc.blur, &blur_bg),
-            (Stage::Merge, &self.acc.merge, &merge_bg),
-            (Stage::Normals, &self.acc.normals, &normals_bg),
-        ];
-        let fused = [(Stage::Fused, &self.acc.fused, &fused_bg)];
-        let passes: &[_] = if self.config.passes == PassMode::Fused {
-            &fused
+        let mut passes = if self.config.passes == PassMode::Fused {
+            vec![(Stage::Fused, &self.acc.fused, &fused_bg)]
         } else {
-            &separate
+            vec![
+                (Stage::Blur, &self.acc.blur, &blur_bg),
+                (Stage::Merge, &self.acc.merge, &merge_bg),
+            ]
         };
-        for &(stage, pipeline, bg) in passes {
+        if self.config.format.normals {
+            passes.push((Stage::Normals, &self.acc.normals, &normals_bg));
+        }
+        // The merge writes a unit (two texels at 8 bits) per invocation.
+        let unit = match self.config.format.precision {
+            crate::pool::Precision::Bits8 => 2,
+            _ => 1,
+        };
+        for &(stage, pipeline, bg) in &passes {
             let q = next_query(stage, &mut stages);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(match stage {
@@ -1011,8 +1022,13 @@ impl SnowWorld {
             } else {
                 WORKGROUP
             };
+            let units_w = if matches!(stage, Stage::Merge) {
+                max_w.div_ceil(unit)
+            } else {
+                max_w
+            };
             pass.dispatch_workgroups(
-                max_w.div_ceil(side),
+                units_w.div_ceil(side),
                 max_h.div_ceil(side),
                 jobs.len() as u32,
             );
@@ -1025,12 +1041,6 @@ impl SnowWorld {
         self.queue.submit([enc.finish()]);
         stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
 
-        // The new heightmap is now the other half of each pair.
-        for job in &jobs {
-            if let Some(state) = self.surfaces[job.surface].as_mut() {
-                state.parity ^= 1;
-            }
-        }
         self.last = LastFrame {
             captured: captured
                 .iter()
@@ -1094,32 +1104,58 @@ impl SnowWorld {
         self.read_buffer(&staging, 0, size)
     }
 
-    /// The packed texels of a surface's current heightmap (depression low 16 bits, displaced high).
+    /// The words of a surface's heights region as stored (layout per precision: see
+    /// [`crate::pool`]; at 16 bits, depression in the low 16 bits and displaced in the high 16).
     pub fn read_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
         let s = self.state(id)?;
         let bytes = self.download(
             &self.pool,
-            s.slot.region_bytes(s.parity as u64),
-            s.layout.texels() * 4,
+            s.slot.offset,
+            self.config
+                .format
+                .heights_bytes(s.layout.width, s.layout.height),
         )?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
-    /// Read a surface's current heightmap back to the CPU (waits for the GPU).
+    /// A surface's `(depression, displaced)` channels in units of `1 / channel_max` of the snow
+    /// depth at the pool's precision, row-major.
+    pub fn read_channels(&self, id: SurfaceId) -> Result<(Vec<u32>, Vec<u32>)> {
+        let s = self.state(id)?;
+        let words = self.read_packed(id)?;
+        Ok(self
+            .config
+            .format
+            .decode(s.layout.width, s.layout.height, &words))
+    }
+
+    /// Read a surface's current heightmap back to the CPU (waits for the GPU), in 16-bit units
+    /// whatever the pool's precision (exact at 8 and 16 bits, rounded to nearest at 32).
     pub fn read_heightmap(&self, id: SurfaceId) -> Result<Heightmap> {
         let s = self.state(id)?;
-        let packed = self.read_packed(id)?;
-        Ok(Heightmap::from_packed(
+        let (depression, displaced) = self.read_channels(id)?;
+        Ok(Heightmap::from_channels(
             s.layout.width,
             s.layout.height,
-            &packed,
+            self.config.format.precision,
+            &depression,
+            &displaced,
         ))
     }
 
-    /// Read a surface's packed normals (see [`crate::accumulate::cpu::unpack_normal`]).
+    /// Read a surface's packed normals (see [`crate::accumulate::cpu::unpack_normal`]). Fails
+    /// when the pool keeps no normals ([`PoolFormat::normals`]).
     pub fn read_normals_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
         let s = self.state(id)?;
-        let bytes = self.download(&self.pool, s.slot.region_bytes(2), s.layout.texels() * 4)?;
+        let Some(word) =
+            s.slot
+                .normals_word(&self.config.format, s.layout.width, s.layout.height)
+        else {
+            return Err(SnowError::Readback(
+                "this world keeps no normals; set WorldConfig.format.normals to keep them".into(),
+            ));
+        };
+        let bytes = self.download(&self.pool, word as u64 * 4, s.layout.texels() * 4)?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
@@ -1179,10 +1215,21 @@ impl SnowWorld {
     }
 
     /// Pool placement of a surface's slot, for renderers that read the heightmap on the GPU:
-    /// `(current heights element offset, normals element offset)`. Valid until the next step.
-    pub fn gpu_offsets(&self, id: SurfaceId) -> Result<(u32, u32)> {
+    /// `(heights word offset, normals word offset when kept)`. Valid while the surface lives;
+    /// read the heights with `pool/texel.wgsl` ([`crate::pool::TEXEL_WGSL`]) at
+    /// [`SnowWorld::pool_format`]'s precision.
+    pub fn gpu_offsets(&self, id: SurfaceId) -> Result<(u32, Option<u32>)> {
         let s = self.state(id)?;
-        Ok((s.slot.region(s.parity as u64), s.slot.region(2)))
+        Ok((
+            s.slot.heights_word(),
+            s.slot
+                .normals_word(&self.config.format, s.layout.width, s.layout.height),
+        ))
+    }
+
+    /// How the pool stores heightmaps.
+    pub fn pool_format(&self) -> PoolFormat {
+        self.config.format
     }
 
     /// The pool buffer (`array<u32>` in WGSL), for renderers that sample heightmaps on the GPU.

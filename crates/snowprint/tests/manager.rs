@@ -14,7 +14,12 @@ use snowprint::manager::{
     CameraView, Lookup, ManagedDeformer, ManagedId, ManagerConfig, Planner, SnowManager, UNLIMITED,
     ZoneId,
 };
-use snowprint::pool::slot_bytes;
+use snowprint::pool::PoolFormat;
+
+/// Pool bytes of a surface's slot in the managers' default format.
+fn slot_bytes(layout: snowprint::SurfaceLayout) -> u64 {
+    PoolFormat::default().slot_bytes(layout.width, layout.height)
+}
 use snowprint::{Camera, Deformer, Heightmap, Pose, Shape, SnowError, SurfaceDesc};
 
 // ---------------------------------------------------------------------------------------------
@@ -244,7 +249,7 @@ proptest! {
                     "waited {} frames, bound {} (n = {})", u.wait_frames, p.wait_bound(n), n);
             }
             let resident: Vec<ManagedId> = p.resident().collect();
-            let bytes: u64 = resident.iter().map(|&id| slot_bytes(p.surface(id).unwrap().layout().texels())).sum();
+            let bytes: u64 = resident.iter().map(|&id| slot_bytes(p.surface(id).unwrap().layout())).sum();
             prop_assert_eq!(bytes, p.pool_used());
             prop_assert_eq!(plan.stats.pool_bytes_used, bytes);
             prop_assert!(bytes <= p.pool_budget());
@@ -466,7 +471,7 @@ fn unloading_a_zone_frees_its_slots_and_loading_brings_surfaces_back() {
     assert!(!p.is_resident(a));
     assert_eq!(
         p.pool_used(),
-        used - slot_bytes(p.surface(a).unwrap().layout().texels())
+        used - slot_bytes(p.surface(a).unwrap().layout())
     );
     let plan = p
         .tick(
@@ -490,7 +495,7 @@ fn unloading_a_zone_frees_its_slots_and_loading_brings_surfaces_back() {
 #[test]
 fn a_full_pool_evicts_the_least_useful_and_never_goes_over() {
     // Room for exactly two 4 m x 4 m surfaces.
-    let one = slot_bytes(100 * 100);
+    let one = PoolFormat::default().slot_bytes(100, 100);
     let config = ManagerConfig {
         pool_bytes: 2 * one + 1000,
         retain_inactive: true,

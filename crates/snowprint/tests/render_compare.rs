@@ -81,7 +81,7 @@ fn heightfield_pass_matches_its_cpu_reference() {
         heights: offset,
         width: w,
         height: h,
-        _pad: 0,
+        bits: 16,
         snow_depth: depth,
         texel_x: texel.x,
         texel_z: texel.y,
@@ -112,7 +112,7 @@ fn heightfield_pass_matches_its_cpu_reference() {
     let (shape, lit) = (texture(), texture());
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("heightfield.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(shaders::HEIGHTFIELD.into()),
+        source: wgpu::ShaderSource::Wgsl(shaders::heightfield().into()),
     });
     let pipeline = dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: None,

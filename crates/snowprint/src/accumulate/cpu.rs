@@ -2,13 +2,11 @@
 
 use glam::Vec3;
 
+use crate::pool::Precision;
 use crate::world::CaptureMode;
 
 /// Tap offsets of the blur, texels. Must match `TAPS` in `blur.wgsl`.
 pub const TAPS: [[f32; 2]; 4] = [[-0.25, -0.75], [0.75, -0.25], [0.25, 0.75], [-0.75, 0.25]];
-/// Depression units: 65535 = pressed to the ground.
-pub const UNITS: f32 = 65535.0;
-
 /// Settings the blur needs from a surface.
 #[derive(Clone, Copy, Debug)]
 pub struct BlurInput {
@@ -76,26 +74,51 @@ pub fn depression_of(inp: &BlurInput, capture: &[f32]) -> Vec<f32> {
         .collect()
 }
 
-/// Quantize a depression fraction to units the way `merge.wgsl` does.
-pub fn to_units(d: f32) -> u32 {
-    (d.clamp(0.0, 1.0) * UNITS + 0.5).floor() as u32
+/// Quantize a depression fraction to channel units the way `maths.wgsl` does (`to_units`).
+pub fn to_units(d: f32, precision: Precision) -> u32 {
+    let c = d.clamp(0.0, 1.0);
+    if c >= 1.0 {
+        return precision.channel_max();
+    }
+    (c * precision.channel_max() as f32 + 0.5).floor() as u32
 }
 
-/// Stage 2: replenish `old` by `replenish_units`, then deepen it by the blurred capture (when there
-/// is one). Texels pack the depression in the low 16 bits and displaced snow in the high 16.
-pub fn merge(old: &[u32], blurred: Option<&[f32]>, replenish_units: u32) -> Vec<u32> {
-    old.iter()
-        .enumerate()
-        .map(|(i, &o)| {
-            let depressed = (o & 0xffff).max(replenish_units) - replenish_units;
-            let displaced = (o >> 16).max(replenish_units) - replenish_units;
-            let captured = blurred.map_or(0, |b| to_units(b[i]));
-            let new_depressed = depressed.max(captured);
-            let pushed = new_depressed - depressed;
-            let new_displaced = (displaced + pushed).min(0xffff);
-            new_depressed | (new_displaced << 16)
+/// Stage 2 on one texel: replenish `old` (depression, displaced) by `replenish_units`, then deepen
+/// it by the blurred capture (when there is one); what a capture deepens is added to the displaced
+/// channel, which saturates at a whole snow depth.
+pub fn merge_channels(
+    old: (u32, u32),
+    blurred: Option<f32>,
+    replenish_units: u32,
+    precision: Precision,
+) -> (u32, u32) {
+    let depressed = old.0.max(replenish_units) - replenish_units;
+    let displaced = old.1.max(replenish_units) - replenish_units;
+    let captured = blurred.map_or(0, |b| to_units(b, precision));
+    let new_depressed = depressed.max(captured);
+    let pushed = new_depressed - depressed;
+    let new_displaced = displaced.saturating_add(pushed).min(precision.channel_max());
+    (new_depressed, new_displaced)
+}
+
+/// Stage 2 over a heightmap of channels (row-major depression and displaced).
+pub fn merge(
+    depression: &[u32],
+    displaced: &[u32],
+    blurred: Option<&[f32]>,
+    replenish_units: u32,
+    precision: Precision,
+) -> (Vec<u32>, Vec<u32>) {
+    (0..depression.len())
+        .map(|i| {
+            merge_channels(
+                (depression[i], displaced[i]),
+                blurred.map(|b| b[i]),
+                replenish_units,
+                precision,
+            )
         })
-        .collect()
+        .unzip()
 }
 
 /// WGSL's `pack2x16snorm`.
@@ -116,9 +139,11 @@ pub fn unpack_normal(v: u32) -> Vec3 {
     Vec3::new(x, (1.0 - x * x - z * z).max(0.0).sqrt(), z)
 }
 
-/// Normals of the snow top of packed heights, packed as `normals.wgsl` packs them.
+/// Normals of the snow top of a depression channel at `precision`, packed as `normals.wgsl`
+/// packs them.
 pub fn normals(
-    heights: &[u32],
+    depression: &[u32],
+    precision: Precision,
     width: u32,
     height: u32,
     snow_depth: f32,
@@ -128,9 +153,9 @@ pub fn normals(
     let h = |x: i32, y: i32| {
         let cx = x.clamp(0, width as i32 - 1) as usize;
         let cy = y.clamp(0, height as i32 - 1) as usize;
-        -((heights[cy * width as usize + cx] & 0xffff) as f32) / UNITS * snow_depth
+        -(depression[cy * width as usize + cx] as f32) / precision.channel_max() as f32 * snow_depth
     };
-    let mut out = Vec::with_capacity(heights.len());
+    let mut out = Vec::with_capacity(depression.len());
     for y in 0..height as i32 {
         for x in 0..width as i32 {
             let dhdx = (h(x + 1, y) - h(x - 1, y)) / (2.0 * texel_x);
@@ -195,15 +220,30 @@ mod tests {
 
     #[test]
     fn merge_never_shallower_and_replenishes() {
-        let old = [1000u32, 500, 0];
-        let blurred = [0.0, 0.5, 0.01];
-        let m = merge(&old, Some(&blurred), 100);
-        assert_eq!(m[0] & 0xffff, 900);
-        assert_eq!(m[1] & 0xffff, to_units(0.5));
-        assert_eq!(m[1] >> 16, to_units(0.5) - 400);
-        assert_eq!(m[2] & 0xffff, to_units(0.01));
+        let p = Precision::Bits16;
+        let (dep, disp) = merge(&[1000, 500, 0], &[0; 3], Some(&[0.0, 0.5, 0.01]), 100, p);
+        assert_eq!(dep[0], 900);
+        assert_eq!(dep[1], to_units(0.5, p));
+        assert_eq!(disp[1], to_units(0.5, p) - 400);
+        assert_eq!(dep[2], to_units(0.01, p));
         // Replenishment saturates at untouched snow.
-        assert_eq!(merge(&[50], None, 100), vec![0]);
+        assert_eq!(merge(&[50], &[50], None, 100, p), (vec![0], vec![0]));
+    }
+
+    /// Quantization by hand at each precision: 0.5 rounds to half the range, 1 is the maximum
+    /// exactly, and the displaced channel saturates instead of wrapping (at 32 bits too).
+    #[test]
+    fn units_and_saturation_at_each_precision() {
+        assert_eq!(to_units(0.5, Precision::Bits8), 128); // 127.5 + 0.5
+        assert_eq!(to_units(0.5, Precision::Bits16), 32768);
+        assert_eq!(to_units(0.5, Precision::Bits32), 1 << 31);
+        for p in Precision::ALL {
+            assert_eq!(to_units(1.0, p), p.channel_max());
+            assert_eq!(to_units(2.0, p), p.channel_max());
+            let max = p.channel_max();
+            let out = merge_channels((0, max - 1), Some(1.0), 0, p);
+            assert_eq!(out, (max, max), "{p}");
+        }
     }
 
     #[test]

@@ -45,26 +45,36 @@ fn blur_taps(
     return (t0 + t1 + t2 + t3) * 0.25;
 }
 
-// Replenish an old packed texel by `rep` units, then deepen it by a blurred capture (when there is
-// one). A capture never makes a depression shallower; what it deepens is added to the displaced
-// channel (high 16 bits).
-fn merge_texel(old: u32, blurred: f32, has_capture: bool, rep: u32) -> u32 {
+// A depression fraction in channel units, rounded to nearest (1 = channel_max exactly).
+fn to_units(d: f32) -> u32 {
+    let c = clamp(d, 0.0, 1.0);
+    if c >= 1.0 {
+        return channel_max(PRECISION);
+    }
+    return u32(floor(c * f32(channel_max(PRECISION)) + 0.5));
+}
+
+// Replenish an old texel (depression, displaced) by `rep` units, then deepen it by a blurred
+// capture (when there is one). A capture never makes a depression shallower; what it deepens is
+// added to the displaced channel, which saturates at a whole snow depth.
+fn merge_channels(old: vec2<u32>, blurred: f32, has_capture: bool, rep: u32) -> vec2<u32> {
     // Saturating subtraction: snow refills up to the untouched top and no further.
-    let depressed = max(old & 0xffffu, rep) - rep;
-    let displaced = max(old >> 16u, rep) - rep;
+    let depressed = max(old.x, rep) - rep;
+    let displaced = max(old.y, rep) - rep;
     var captured = 0u;
     if has_capture {
-        captured = u32(floor(clamp(blurred, 0.0, 1.0) * UNITS + 0.5));
+        captured = to_units(blurred);
     }
     let new_depressed = max(depressed, captured);
     let pushed = new_depressed - depressed;
-    let new_displaced = min(displaced + pushed, 0xffffu);
-    return new_depressed | (new_displaced << 16u);
+    let cmax = channel_max(PRECISION);
+    let new_displaced = select(displaced + pushed, cmax, displaced > cmax - pushed);
+    return vec2<u32>(new_depressed, new_displaced);
 }
 
-// Height of the snow top (metres, 0 = untouched) of a depression in units.
+// Height of the snow top (metres, 0 = untouched) of a depression in channel units.
 fn snow_height(rec: SurfaceRecord, units: u32) -> f32 {
-    return -f32(units) / UNITS * rec.snow_depth;
+    return -f32(units) / f32(channel_max(PRECISION)) * rec.snow_depth;
 }
 
 // Packed normal (pack2x16snorm of local x and z) from the heights left, right, below (-z) and

@@ -3,16 +3,20 @@
 //!
 //! 1. [`blur.wgsl`](BLUR_SHADER): capture to depression, 4-tap bilinear Poisson blur
 //!    (reads the capture buffer, writes the scratch buffer);
-//! 2. [`merge.wgsl`](MERGE_SHADER): replenish the history, then deepen it by the blurred capture
-//!    (reads one half of each slot's ping-pong pair and the scratch, writes the other half);
-//! 3. [`normals.wgsl`](NORMALS_SHADER): normals of the new snow top (reads the new half, writes
-//!    the normals region).
+//! 2. [`merge.wgsl`](MERGE_SHADER): replenish each heightmap, then deepen it by the blurred
+//!    capture, in place (reads the scratch and each slot's heights, writes the heights);
+//! 3. [`normals.wgsl`](NORMALS_SHADER), only when the pool keeps normals: normals of the new snow
+//!    top (reads the heights, writes the normals region).
+//!
+//! On GPUs, [`fused.wgsl`](FUSED_SHADER) does stages 1 and 2 in one pass. Every pass reads and
+//! writes heights through `pool/texel.wgsl`, at the pool's [`Precision`] (an override constant).
 //!
 //! CPU reference: [`cpu`].
 
 pub mod cpu;
 
 use crate::gpu::resources::compute_storage;
+use crate::pool::Precision;
 
 /// Record layout shared by every pass.
 pub const SHARED: &str = include_str!("../shared.wgsl");
@@ -28,6 +32,10 @@ pub const FUSED_SHADER: &str = include_str!("fused.wgsl");
 pub const MATHS: &str = include_str!("maths.wgsl");
 /// Reading the capture buffer (for the passes that bind it).
 pub const CAPTURE_READ: &str = include_str!("capture_read.wgsl");
+/// Reading heights from the pool at any precision.
+pub const TEXEL_READ: &str = include_str!("../pool/texel.wgsl");
+/// Writing heights to the pool at any precision.
+pub const TEXEL_WRITE: &str = include_str!("../pool/texel_write.wgsl");
 
 /// Workgroup side of the separate accumulation passes.
 pub const WORKGROUP: u32 = 8;
@@ -41,7 +49,13 @@ pub fn with_prelude(stage: &str) -> String {
     } else {
         ""
     };
-    format!("{SHARED}\n{MATHS}\n{capture}\n{stage}")
+    let pool = if stage.contains("var<storage, read_write> pool") {
+        format!("{TEXEL_READ}\n{TEXEL_WRITE}")
+    } else {
+        String::new()
+    };
+    let channels = crate::pool::CHANNELS_WGSL;
+    format!("{SHARED}\n{channels}\n{MATHS}\n{capture}\n{pool}\n{stage}")
 }
 
 /// The three compute pipelines and their layouts.
@@ -52,7 +66,7 @@ pub struct AccumulatePipelines {
     pub merge: wgpu::ComputePipeline,
     /// Normals.
     pub normals: wgpu::ComputePipeline,
-    /// Blur, merge and normals fused.
+    /// Blur and merge fused.
     pub fused: wgpu::ComputePipeline,
     /// Layout of the blur's group 0.
     pub blur_layout: wgpu::BindGroupLayout,
@@ -60,13 +74,13 @@ pub struct AccumulatePipelines {
     pub merge_layout: wgpu::BindGroupLayout,
     /// Layout of the normals' group 0.
     pub normals_layout: wgpu::BindGroupLayout,
-    /// Layout of the fused pass's group 0: records, capture, winding, pool.
+    /// Layout of the fused pass's group 0: records, capture, pool, winding.
     pub fused_layout: wgpu::BindGroupLayout,
 }
 
 impl AccumulatePipelines {
-    /// Compile the three passes.
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// Compile the passes for heightmaps of `precision`.
+    pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
         let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blur"),
             entries: &[
@@ -89,14 +103,15 @@ impl AccumulatePipelines {
             entries: &[
                 compute_storage(0, true),
                 compute_storage(1, true),
-                compute_storage(2, true),
-                compute_storage(3, false),
+                compute_storage(2, false),
+                compute_storage(3, true),
             ],
         });
         let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("normals"),
             entries: &[compute_storage(0, true), compute_storage(1, false)],
         });
+        let constants = [("PRECISION", precision.bits() as f64)];
         let make = |name: &str, src: &str, layout: &wgpu::BindGroupLayout| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(name),
@@ -112,7 +127,11 @@ impl AccumulatePipelines {
                 layout: Some(&pl),
                 module: &module,
                 entry_point: Some(name),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    // Every pass writes its workgroup arrays before reading them.
+                    zero_initialize_workgroup_memory: false,
+                },
                 cache: None,
             })
         };
@@ -178,8 +197,7 @@ mod tests {
             .map(|m| (m.name.clone().unwrap(), m.offset))
             .collect();
         let expect = [
-            "heights_read",
-            "heights_write",
+            "heights",
             "normals",
             "scratch",
             "width",
@@ -194,6 +212,7 @@ mod tests {
             "frustum_height",
             "texel_x",
             "texel_z",
+            "pad",
         ];
         for (i, (name, offset)) in names.iter().enumerate() {
             assert_eq!(name, expect[i]);

@@ -1,5 +1,6 @@
-// Normals of the snow top derived from the new heightmap, for shading.
-// Reads: `records`, the `heights_write` half of each slot in `pool` (written by the merge).
+// Normals of the snow top derived from the new heightmap, for renderers that want them
+// precomputed (only dispatched when the pool keeps normals).
+// Reads: `records`, each record's heights region in `pool` (written by the merge).
 // Writes: the `normals` region: pack2x16snorm of the normal's local x and z (y is positive and
 // follows from unit length).
 // CPU reference: accumulate::cpu::normals. Maths: maths.wgsl.
@@ -10,13 +11,13 @@
 fn height_at(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     let cx = u32(clamp(x, 0, i32(rec.width) - 1));
     let cy = u32(clamp(y, 0, i32(rec.height) - 1));
-    return snow_height(rec, pool[rec.heights_write + cy * rec.width + cx] & 0xffffu);
+    return snow_height(rec, pool_texel(PRECISION, rec.heights, rec.width, rec.height, cx, cy).x);
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn normals(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = records[gid.z];
-    if gid.x >= rec.width || gid.y >= rec.height {
+    if rec.normals == NO_NORMALS || gid.x >= rec.width || gid.y >= rec.height {
         return;
     }
     let x = i32(gid.x);

@@ -147,6 +147,8 @@ pub struct ManagerConfig {
     pub capture: CaptureConfig,
     /// Largest side of the world's capture atlas, texels.
     pub atlas_side: u32,
+    /// How the world's pool stores heightmaps (bits a channel, normals or not).
+    pub format: crate::pool::PoolFormat,
 }
 
 impl Default for ManagerConfig {
@@ -162,6 +164,7 @@ impl Default for ManagerConfig {
             replenish_interval: 0.25,
             capture: CaptureConfig::default(),
             atlas_side: 2048,
+            format: crate::pool::PoolFormat::default(),
         }
     }
 }
@@ -394,6 +397,7 @@ impl SnowManager {
                 atlas_side: config.atlas_side,
                 // The planner sizes slots by the talk's rule (`SurfaceDesc::layout`, 512 a side).
                 max_resolution: crate::surface::MAX_RESOLUTION,
+                format: config.format,
                 ..WorldConfig::default()
             },
         )?;

@@ -29,7 +29,7 @@ use super::{CameraView, ManagedDeformer, ManagedId, ManagerConfig, TickStats, Zo
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::mesh::MeshId;
-use crate::pool::{Slot, SlotAllocator, slot_bytes};
+use crate::pool::{Slot, SlotAllocator};
 use crate::surface::SurfaceDesc;
 
 /// Margin, metres, added to every touch test so that the planner's answer is a superset of the
@@ -166,7 +166,7 @@ struct Status {
     touched: u64,
     player: u64,
     active: u64,
-    /// Pool bytes of its slot (at most 3 MiB for 512 x 512 texels).
+    /// Pool bytes of its slot (at most 4 MiB: 512 x 512 texels at 32 bits with normals).
     bytes: u32,
     zone: u32,
     queue_len: u32,
@@ -191,7 +191,6 @@ impl Status {
 #[derive(Clone, Debug)]
 struct Managed {
     desc: SurfaceDesc,
-    texels: u64,
     slot: Option<Slot>,
     /// Position in [`Planner::resident`] while resident.
     resident_pos: usize,
@@ -369,8 +368,8 @@ impl Planner {
     /// could never hold a heightmap).
     pub fn add_surface(&mut self, desc: &SurfaceDesc, zone: ZoneId) -> Result<ManagedId> {
         desc.validate()?;
-        let texels = desc.layout().texels();
-        let needed = slot_bytes(texels);
+        let layout = desc.layout();
+        let needed = self.config.format.slot_bytes(layout.width, layout.height);
         if needed > self.alloc.budget() {
             return Err(SnowError::PoolExhausted {
                 name: desc.name.clone(),
@@ -401,7 +400,7 @@ impl Planner {
             touched: 0,
             player: 0,
             active: 0,
-            // A slot is at most 512 x 512 texels x 12 bytes.
+            // A slot is at most 512 x 512 texels x 16 bytes: 4 MiB.
             bytes: u32::try_from(needed).unwrap_or(u32::MAX),
             zone: zone as u32,
             queue_len: 0,
@@ -417,7 +416,6 @@ impl Planner {
         ));
         self.surfaces.push(Managed {
             desc: desc.clone(),
-            texels,
             slot: None,
             resident_pos: 0,
             queue: VecDeque::new(),
@@ -955,9 +953,8 @@ impl Planner {
                 break;
             }
             let bytes = self.status[cand.index as usize].bytes as u64;
-            let texels = self.surfaces[cand.index as usize].texels;
             if bytes <= free
-                && let Some(slot) = self.alloc.alloc(texels)
+                && let Some(slot) = self.alloc.alloc(bytes)
             {
                 self.give_slot(cand.index, slot);
                 continue;
@@ -996,7 +993,7 @@ impl Planner {
                 evicted[v] = true;
                 self.release(victims[v].index, false);
             }
-            if let Some(slot) = self.alloc.alloc(texels) {
+            if let Some(slot) = self.alloc.alloc(bytes) {
                 self.give_slot(cand.index, slot);
             }
         }

@@ -1,33 +1,193 @@
 //! The pooled heightmap storage: one GPU buffer holding the heightmaps of every resident surface,
 //! so that all surfaces updated in a frame are processed by one dispatch per stage.
 //!
-//! Each surface owns a *slot* of three regions of `width * height` 32-bit texels:
-//! the two halves of its ping-pong pair (depression in the low 16 bits, displaced snow in the high
-//! 16) and its normals. Slots are placed first-fit at 256-byte alignment and accounted in exact
-//! bytes (alignment padding included). Running out of room is a normal state: [`SlotAllocator::alloc`]
-//! returns `None` and the caller decides whom to evict.
+//! Each surface owns a *slot*: its heightmap, two channels per texel (the depression and the
+//! displaced snow, both in units of `1 / channel_max` of the snow depth) at the pool's
+//! [`Precision`], and, only when [`PoolFormat::normals`] is on, a region of packed normals. No
+//! history is kept per surface: the update replenishes and deepens each texel in place (it reads
+//! only that texel's old value), and the per-frame capture buffers are shared by every surface
+//! updated in the frame. Slots are placed first-fit at 256-byte alignment and accounted in exact
+//! bytes (alignment padding included). Running out of room is a normal state:
+//! [`SlotAllocator::alloc`] returns `None` and the caller decides whom to evict.
+//!
+//! Storage of the heights region, in 32-bit words (`texel.wgsl` reads and writes it the same way):
+//!
+//! | precision | bytes a texel | layout |
+//! |---|---|---|
+//! | 8 bits | 2 | rows padded to an even width; a word holds two neighbours along x, each as 16 bits: depression in the low byte, displaced in the high byte |
+//! | 16 bits | 4 | a word per texel: depression in the low 16 bits, displaced in the high 16 |
+//! | 32 bits | 8 | two planes: every texel's depression, then every texel's displaced snow |
 
 use bytemuck::{Pod, Zeroable};
 
+/// WGSL that reads a surface's heights from a `pool: array<u32>` binding at any precision
+/// (`pool_texel`, `pool_fractions`, `channel_max`), for renderers that sample the pool.
+pub const TEXEL_WGSL: &str = concat!(include_str!("channels.wgsl"), include_str!("texel.wgsl"));
+/// WGSL of `channel_max(bits)` alone (part of [`TEXEL_WGSL`]).
+pub const CHANNELS_WGSL: &str = include_str!("channels.wgsl");
+
 /// Alignment of slots in the pool, bytes.
 pub const SLOT_ALIGN: u64 = 256;
-/// Bytes per texel per region (one `u32`).
-pub const TEXEL_BYTES: u64 = 4;
-/// Regions per slot: ping-pong pair of heights, and normals.
-pub const REGIONS: u64 = 3;
+
+/// Bits per channel of the heightmaps in a pool.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub enum Precision {
+    /// 8 bits a channel (1/255 of the snow depth: 1.2 mm of 30 cm snow), 2 bytes a texel.
+    Bits8,
+    /// 16 bits a channel, 4 bytes a texel (the default).
+    #[default]
+    Bits16,
+    /// 32 bits a channel, 8 bytes a texel: no quantization coarser than the f32 capture.
+    Bits32,
+}
+
+impl Precision {
+    /// All precisions, coarsest first.
+    pub const ALL: [Precision; 3] = [Precision::Bits8, Precision::Bits16, Precision::Bits32];
+
+    /// Bits a channel.
+    pub fn bits(self) -> u32 {
+        match self {
+            Precision::Bits8 => 8,
+            Precision::Bits16 => 16,
+            Precision::Bits32 => 32,
+        }
+    }
+
+    /// The precision of `bits` bits a channel (8, 16 or 32).
+    pub fn from_bits(bits: u32) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.bits() == bits)
+    }
+
+    /// The value of a channel pressed to the ground (a whole snow depth).
+    pub fn channel_max(self) -> u32 {
+        match self {
+            Precision::Bits8 => 0xff,
+            Precision::Bits16 => 0xffff,
+            Precision::Bits32 => u32::MAX,
+        }
+    }
+
+    /// Bytes a texel (both channels).
+    pub fn texel_bytes(self) -> u64 {
+        2 * self.bits() as u64 / 8
+    }
+}
+
+impl std::fmt::Display for Precision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}-bit", self.bits())
+    }
+}
+
+/// How heightmaps are stored in a pool.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct PoolFormat {
+    /// Bits a channel.
+    pub precision: Precision,
+    /// Keep a region of packed normals per surface (4 bytes a texel), written by the update for
+    /// renderers that want them precomputed. Off by default: the renderer derives normals from
+    /// the heights as it shades.
+    pub normals: bool,
+}
+
+impl PoolFormat {
+    /// The format with `precision` and no normals.
+    pub fn new(precision: Precision) -> Self {
+        Self {
+            precision,
+            normals: false,
+        }
+    }
+
+    /// 32-bit words of one row of the heights region.
+    pub fn row_words(&self, width: u32) -> u32 {
+        match self.precision {
+            Precision::Bits8 => width.div_ceil(2),
+            Precision::Bits16 | Precision::Bits32 => width,
+        }
+    }
+
+    /// Bytes of the heights region of a `width x height` heightmap.
+    pub fn heights_bytes(&self, width: u32, height: u32) -> u64 {
+        let words = self.row_words(width) as u64 * height as u64;
+        match self.precision {
+            Precision::Bits32 => 8 * words,
+            _ => 4 * words,
+        }
+    }
+
+    /// Bytes a `width x height` surface takes in the pool, alignment included.
+    pub fn slot_bytes(&self, width: u32, height: u32) -> u64 {
+        let normals = if self.normals {
+            4 * width as u64 * height as u64
+        } else {
+            0
+        };
+        (self.heights_bytes(width, height) + normals).div_ceil(SLOT_ALIGN) * SLOT_ALIGN
+    }
+
+    /// Encode channels (row-major, `width x height`) into the words of a heights region.
+    pub fn encode(&self, width: u32, height: u32, depression: &[u32], displaced: &[u32]) -> Vec<u32> {
+        let (w, h) = (width as usize, height as usize);
+        match self.precision {
+            Precision::Bits8 => {
+                let rw = self.row_words(width) as usize;
+                let mut out = vec![0u32; rw * h];
+                for y in 0..h {
+                    for x in 0..w {
+                        let i = y * w + x;
+                        let v = (depression[i] & 0xff) | ((displaced[i] & 0xff) << 8);
+                        out[y * rw + x / 2] |= v << (16 * (x % 2));
+                    }
+                }
+                out
+            }
+            Precision::Bits16 => depression
+                .iter()
+                .zip(displaced)
+                .map(|(&d, &p)| (d & 0xffff) | (p << 16))
+                .collect(),
+            Precision::Bits32 => depression.iter().chain(displaced).copied().collect(),
+        }
+    }
+
+    /// Decode the words of a heights region into `(depression, displaced)` channels, row-major.
+    pub fn decode(&self, width: u32, height: u32, words: &[u32]) -> (Vec<u32>, Vec<u32>) {
+        let (w, h) = (width as usize, height as usize);
+        match self.precision {
+            Precision::Bits8 => {
+                let rw = self.row_words(width) as usize;
+                let half = |x: usize, y: usize| (words[y * rw + x / 2] >> (16 * (x % 2))) & 0xffff;
+                let all = |shift: u32| {
+                    (0..h)
+                        .flat_map(|y| (0..w).map(move |x| (x, y)))
+                        .map(|(x, y)| (half(x, y) >> shift) & 0xff)
+                        .collect()
+                };
+                (all(0), all(8))
+            }
+            Precision::Bits16 => (
+                words.iter().map(|&v| v & 0xffff).collect(),
+                words.iter().map(|&v| v >> 16).collect(),
+            ),
+            Precision::Bits32 => (words[..w * h].to_vec(), words[w * h..2 * w * h].to_vec()),
+        }
+    }
+}
 
 /// Per-surface record read by every compute pass of the update.
 /// Must match `SurfaceRecord` in `shared.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SurfaceRecord {
-    /// Element offset of the half holding the previous heightmap.
-    pub heights_read: u32,
-    /// Element offset of the half receiving the new heightmap.
-    pub heights_write: u32,
-    /// Element offset of the normals region.
+    /// Word offset of the heights region in the pool (updated in place).
+    pub heights: u32,
+    /// Word offset of the normals region, or [`NO_NORMALS`].
     pub normals: u32,
-    /// Element offset into the scratch buffer.
+    /// Word offset into the per-frame capture buffers.
     pub scratch: u32,
     /// Texels along x.
     pub width: u32,
@@ -53,10 +213,14 @@ pub struct SurfaceRecord {
     pub texel_x: f32,
     /// Texel side along z, metres.
     pub texel_z: f32,
+    /// Unused (keeps the record at 64 bytes).
+    pub pad: u32,
 }
 
 /// `batch` of a record whose surface had nothing to capture this update.
 pub const NO_CAPTURE: u32 = u32::MAX;
+/// `normals` of a record in a pool that keeps no normals.
+pub const NO_NORMALS: u32 = u32::MAX;
 
 /// A slot in the pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,25 +229,20 @@ pub struct Slot {
     pub offset: u64,
     /// Bytes reserved, alignment included.
     pub bytes: u64,
-    /// Texels per region.
-    pub texels: u64,
 }
 
 impl Slot {
-    /// Element (u32) offset of region `r` (0, 1: ping-pong halves; 2: normals).
-    pub fn region(&self, r: u64) -> u32 {
-        ((self.offset + r * self.texels * TEXEL_BYTES) / TEXEL_BYTES) as u32
+    /// Word (u32) offset of the heights region.
+    pub fn heights_word(&self) -> u32 {
+        (self.offset / 4) as u32
     }
 
-    /// Byte offset of region `r`.
-    pub fn region_bytes(&self, r: u64) -> u64 {
-        self.offset + r * self.texels * TEXEL_BYTES
+    /// Word offset of the normals region of a `width x height` surface in `format`, when kept.
+    pub fn normals_word(&self, format: &PoolFormat, width: u32, height: u32) -> Option<u32> {
+        format
+            .normals
+            .then(|| ((self.offset + format.heights_bytes(width, height)) / 4) as u32)
     }
-}
-
-/// Bytes a surface of `texels` texels takes in the pool.
-pub fn slot_bytes(texels: u64) -> u64 {
-    (texels * TEXEL_BYTES * REGIONS).div_ceil(SLOT_ALIGN) * SLOT_ALIGN
 }
 
 /// First-fit allocator over a fixed byte budget, with exact accounting.
@@ -132,9 +291,10 @@ impl SlotAllocator {
         self.free.iter().map(|f| f.1).max().unwrap_or(0)
     }
 
-    /// Reserve a slot for `texels` texels, or `None` when no free block is large enough.
-    pub fn alloc(&mut self, texels: u64) -> Option<Slot> {
-        let bytes = slot_bytes(texels);
+    /// Reserve a slot of `bytes` bytes (rounded up to [`SLOT_ALIGN`]), or `None` when no free
+    /// block is large enough.
+    pub fn alloc(&mut self, bytes: u64) -> Option<Slot> {
+        let bytes = bytes.max(1).div_ceil(SLOT_ALIGN) * SLOT_ALIGN;
         let i = self.free.iter().position(|&(_, len)| len >= bytes)?;
         let (offset, len) = self.free[i];
         if len == bytes {
@@ -144,11 +304,7 @@ impl SlotAllocator {
         }
         self.used += bytes;
         self.high_water = self.high_water.max(self.used);
-        Some(Slot {
-            offset,
-            bytes,
-            texels,
-        })
+        Some(Slot { offset, bytes })
     }
 
     /// Return a slot to the pool, merging it with free neighbours.
@@ -181,9 +337,12 @@ mod tests {
     #[test]
     fn exact_accounting() {
         let mut a = SlotAllocator::new(1 << 20);
-        let s1 = a.alloc(200 * 150).unwrap();
-        assert_eq!(s1.bytes, slot_bytes(30_000));
-        assert_eq!(s1.bytes, 360_192); // 360000 rounded up to 256
+        let f = PoolFormat {
+            precision: Precision::Bits16,
+            normals: true,
+        };
+        let s1 = a.alloc(f.slot_bytes(201, 150)).unwrap();
+        assert_eq!(s1.bytes, 241_408); // 201 x 150 x 8 = 241200, rounded up to 256
         let s2 = a.alloc(100).unwrap();
         assert_eq!(a.used(), s1.bytes + s2.bytes);
         assert!(a.alloc(1 << 20).is_none());
@@ -193,16 +352,52 @@ mod tests {
         assert_eq!(a.largest_free(), 1 << 20);
     }
 
+    /// The talk's memory figure: four 512^2 heightmaps with both channels in its 2 MiB pool at
+    /// 8 bits, two at 16, one at 32.
+    #[test]
+    fn talk_pool_holds_four_512_surfaces_at_8_bits() {
+        for (p, fit) in [
+            (Precision::Bits8, 4),
+            (Precision::Bits16, 2),
+            (Precision::Bits32, 1),
+        ] {
+            let f = PoolFormat::new(p);
+            let mut a = SlotAllocator::new(2 << 20);
+            let n = std::iter::from_fn(|| a.alloc(f.slot_bytes(512, 512))).count();
+            assert_eq!(n, fit, "{p}");
+        }
+    }
+
+    /// Encoding and decoding are inverse at every precision, odd widths included (8-bit rows are
+    /// padded to whole words).
+    #[test]
+    fn encode_decode_round_trip() {
+        for p in Precision::ALL {
+            let f = PoolFormat::new(p);
+            let (w, h) = (7, 3);
+            let max = p.channel_max();
+            let dep: Vec<u32> = (0..21u32).map(|i| max - i * 3).collect();
+            let disp: Vec<u32> = (0..21u32).map(|i| i * 5).collect();
+            let words = f.encode(w, h, &dep, &disp);
+            assert_eq!(words.len() as u64 * 4, f.heights_bytes(w, h));
+            assert_eq!(f.decode(w, h, &words), (dep, disp), "{p}");
+        }
+        // 8 bits: texel (1, 0) sits in the high half of word 0, depression in its low byte.
+        let f = PoolFormat::new(Precision::Bits8);
+        let words = f.encode(3, 1, &[1, 2, 3], &[4, 5, 6]);
+        assert_eq!(words, vec![0x0502_0401, 0x0000_0603]);
+    }
+
     proptest! {
         #[test]
         fn never_over_budget_and_never_overlapping(ops in proptest::collection::vec((0u64..40_000, any::<bool>()), 1..200)) {
             let mut a = SlotAllocator::new(2 << 20);
             let mut live: Vec<Slot> = Vec::new();
-            for (texels, free) in ops {
+            for (bytes, free) in ops {
                 if free && !live.is_empty() {
-                    let s = live.swap_remove(texels as usize % live.len());
+                    let s = live.swap_remove(bytes as usize % live.len());
                     a.free(s);
-                } else if let Some(s) = a.alloc(texels.max(1)) {
+                } else if let Some(s) = a.alloc(bytes * 4) {
                     live.push(s);
                 }
                 let sum: u64 = live.iter().map(|s| s.bytes).sum();

@@ -7,10 +7,14 @@
 
 // Must match `ClassifyRecord` in src/render/gpu.rs.
 struct ClassifyRecord {
-    heights: u32,     // element offset of the current heightmap in the pool
+    heights: u32,     // word offset of the heightmap in the pool
     width: u32,
     height: u32,
     box_vertices: u32,
+    bits: u32,        // bits a channel (pool/texel.wgsl)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Words per surface in the state table. Must match `STATE_WORDS` in src/render/gpu.rs.
@@ -32,7 +36,8 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
     let count = rec.width * rec.height;
     var local_max = 0u;
     for (var i = li; i < count; i += 256u) {
-        local_max = max(local_max, pool[rec.heights + i] & 0xffffu);
+        let t = pool_texel(rec.bits, rec.heights, rec.width, rec.height, i % rec.width, i / rec.width);
+        local_max = max(local_max, t.x);
     }
     atomicMax(&deepest, local_max);
     workgroupBarrier();
@@ -55,6 +60,6 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
         state[base + 9u] = (rec.height + 7u) / 8u;
         state[base + 10u] = 1u;
         state[base + 11u] = touched;
-        state[base + 12u] = d;
+        state[base + 12u] = bitcast<u32>(f32(d) / f32(channel_max(rec.bits)));
     }
 }

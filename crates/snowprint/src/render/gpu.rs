@@ -15,7 +15,7 @@ pub const STATE_DEFORMABLE_DRAW: u64 = 4;
 pub const STATE_HEIGHTFIELD_DISPATCH: u64 = 8;
 /// Offset of the "deformed" flag.
 pub const STATE_TOUCHED: u64 = 11;
-/// Offset of the deepest depression (units of 1/65535 of the snow depth).
+/// Offset of the deepest depression (an f32 fraction of the snow depth, as bits).
 pub const STATE_DEEPEST: u64 = 12;
 /// Vertices of a surface's box: five faces of two triangles (no bottom).
 pub const BOX_VERTICES: u32 = 30;
@@ -112,6 +112,10 @@ pub struct ClassifyRecord {
     pub height: u32,
     /// Vertices of the box.
     pub box_vertices: u32,
+    /// Bits a channel of the pool's heightmaps.
+    pub bits: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
@@ -124,8 +128,8 @@ pub struct HeightfieldParams {
     pub width: u32,
     /// Texels along z.
     pub height: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// Bits a channel of the pool's heightmaps.
+    pub bits: u32,
     /// Snow depth, metres.
     pub snow_depth: f32,
     /// Texel side along x, metres.
@@ -303,9 +307,9 @@ mod tests {
 
     #[test]
     fn compute_tables_match_wgsl() {
-        let (size, _) = layout(shaders::CLASSIFY, "ClassifyRecord");
+        let (size, _) = layout(&shaders::classify(), "ClassifyRecord");
         assert_eq!(size as usize, std::mem::size_of::<ClassifyRecord>());
-        let (size, _) = layout(shaders::HEIGHTFIELD, "HeightfieldParams");
+        let (size, _) = layout(&shaders::heightfield(), "HeightfieldParams");
         assert_eq!(size as usize, std::mem::size_of::<HeightfieldParams>());
         assert!(shaders::CLASSIFY.contains(&format!("const STATE_WORDS: u32 = {STATE_WORDS}u;")));
     }

@@ -11,10 +11,10 @@
 
 // Must match `HeightfieldParams` in src/render/gpu.rs.
 struct HeightfieldParams {
-    heights: u32,
+    heights: u32,       // word offset of the heightmap in the pool
     width: u32,
     height: u32,
-    _pad: u32,
+    bits: u32,          // bits a channel (pool/texel.wgsl)
     snow_depth: f32,
     texel_x: f32,
     texel_z: f32,
@@ -39,7 +39,7 @@ const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
 fn depression(c: i32, r: i32) -> f32 {
     let x = u32(clamp(c, 0, i32(params.width) - 1));
     let y = u32(clamp(r, 0, i32(params.height) - 1));
-    return f32(pool[params.heights + y * params.width + x] & 0xffffu) / 65535.0;
+    return pool_fractions(params.bits, params.heights, params.width, params.height, x, y).x;
 }
 
 // Snow height (metres above the ground) at the texel nearest to a metric offset.

@@ -980,8 +980,8 @@ impl Renderer {
         let sky_module = module("sky.wgsl", shaders::sky());
         let snowfall_module = module("snowfall.wgsl", shaders::snowfall());
         let tonemap_module = module("tonemap.wgsl", shaders::tonemap());
-        let classify_module = module("classify.wgsl", shaders::CLASSIFY.to_owned());
-        let heightfield_module = module("heightfield.wgsl", shaders::HEIGHTFIELD.to_owned());
+        let classify_module = module("classify.wgsl", shaders::classify());
+        let heightfield_module = module("heightfield.wgsl", shaders::heightfield());
 
         let layout = |label: &str, groups: &[&wgpu::BindGroupLayout]| {
             let groups: Vec<Option<&wgpu::BindGroupLayout>> =
@@ -1631,7 +1631,7 @@ impl Renderer {
                         } else {
                             SnowMaterialKind::Deformable
                         },
-                        deepest: word(base + STATE_DEEPEST as usize) as f32 / 65535.0,
+                        deepest: f32::from_bits(word(base + STATE_DEEPEST as usize)),
                     }
                 })
                 .collect();
@@ -1985,6 +1985,7 @@ impl Renderer {
         let mut hf_bytes = vec![0u8; n.max(1) * UNIFORM_STRIDE as usize];
         let mut records = Vec::with_capacity(n);
         let mut sizes = Vec::with_capacity(n);
+        let bits = world.pool_format().precision.bits();
         for (s, (id, ground)) in frame.surfaces.iter().enumerate() {
             let desc = world.surface(*id)?;
             let layout = world.layout(*id)?;
@@ -2025,7 +2026,7 @@ impl Renderer {
                 heights,
                 width: layout.width,
                 height: layout.height,
-                _pad: 0,
+                bits,
                 snow_depth: desc.snow_depth,
                 texel_x,
                 texel_z,
@@ -2045,6 +2046,8 @@ impl Renderer {
                 width: layout.width,
                 height: layout.height,
                 box_vertices: BOX_VERTICES,
+                bits,
+                _pad: [0; 3],
             });
             sizes.push((layout.width, layout.height));
         }

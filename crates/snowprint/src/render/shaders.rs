@@ -22,6 +22,16 @@ pub const CLASSIFY: &str = include_str!("classify.wgsl");
 /// Heightmap to filtered shading texture (depression, normal, occlusion).
 pub const HEIGHTFIELD: &str = include_str!("heightfield.wgsl");
 
+/// Module of the classify pass (reads the pool through `pool/texel.wgsl`).
+pub fn classify() -> String {
+    join(&[crate::pool::TEXEL_WGSL, CLASSIFY])
+}
+
+/// Module of the heightfield pass (reads the pool through `pool/texel.wgsl`).
+pub fn heightfield() -> String {
+    join(&[crate::pool::TEXEL_WGSL, HEIGHTFIELD])
+}
+
 fn join(parts: &[&str]) -> String {
     parts.join("\n")
 }
@@ -59,7 +69,7 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("sky", sky()),
         ("snowfall", snowfall()),
         ("tonemap", tonemap()),
-        ("classify", CLASSIFY.to_owned()),
-        ("heightfield", HEIGHTFIELD.to_owned()),
+        ("classify", classify()),
+        ("heightfield", heightfield()),
     ]
 }

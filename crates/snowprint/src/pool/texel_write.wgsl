@@ -1,0 +1,25 @@
+// texel_write.wgsl: writing the heights region (see texel.wgsl), for the update's passes, which
+// bind `pool` read_write. A *unit* is what one invocation writes without racing its neighbours:
+// two texels along x at 8 bits (one word), one texel otherwise.
+
+// Texels a unit covers.
+fn unit_texels(bits: u32) -> u32 {
+    return select(1u, 2u, bits == 8u);
+}
+
+// Store the unit starting at texel (x, y): `a` there and, at 8 bits, `b` at (x + 1, y).
+fn pool_store_unit(bits: u32, base: u32, width: u32, height: u32, x: u32, y: u32, a: vec2<u32>, b: vec2<u32>) {
+    if bits == 8u {
+        let lo = (a.x & 0xffu) | ((a.y & 0xffu) << 8u);
+        let hi = (b.x & 0xffu) | ((b.y & 0xffu) << 8u);
+        pool[base + y * ((width + 1u) / 2u) + x / 2u] = lo | (hi << 16u);
+        return;
+    }
+    let i = base + y * width + x;
+    if bits == 16u {
+        pool[i] = (a.x & 0xffffu) | (a.y << 16u);
+        return;
+    }
+    pool[i] = a.x;
+    pool[i + width * height] = a.y;
+}
