@@ -470,7 +470,9 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         .into_iter()
         .map(|p| talk_pool_fit(&gpu, p))
         .collect::<Result<Vec<_>, _>>()?;
-    println!("\nmemory: 512^2 surfaces (both channels, no history, no normals) in the talk's 2 MiB pool");
+    println!(
+        "\nmemory: 512^2 surfaces (both channels, no history, no normals) in the talk's 2 MiB pool"
+    );
     for f in &fits {
         println!(
             "  {:>2}-bit: {:>7} bytes a surface, {} fit and update",
@@ -634,7 +636,9 @@ pub struct PrecisionError {
 /// 32-bit ones.
 fn precision_errors(gpu: &GpuContext, frames: u32) -> Result<Vec<PrecisionError>, String> {
     let side = 512.0 * 0.04;
-    let run = |precision: Precision| -> Result<Vec<(Vec<f64>, Vec<f64>)>, String> {
+    // Per surface, (depression, displaced) as fractions of the snow depth.
+    type Fractions = (Vec<f64>, Vec<f64>);
+    let run = |precision: Precision| -> Result<Vec<Fractions>, String> {
         let format = PoolFormat::new(precision);
         let mut world = SnowWorld::new(
             gpu,

@@ -28,6 +28,9 @@ pub fn manager_config(scene: &Scene) -> ManagerConfig {
         if let Some(d) = b.active_distance {
             config.active_distance = d;
         }
+        if let Some(p) = b.precision {
+            config.format.precision = p;
+        }
     }
     config
 }

@@ -656,8 +656,9 @@ impl SnowWorld {
             let Some(state) = self.surfaces[index].as_mut() else {
                 continue;
             };
-            state.carry +=
-                state.desc.replenish_rate as f64 * dt as f64 * self.config.format.precision.channel_max() as f64;
+            state.carry += state.desc.replenish_rate as f64
+                * dt as f64
+                * self.config.format.precision.channel_max() as f64;
             let units = state.carry.floor().min(u32::MAX as f64);
             state.carry -= units;
             let units = units as u32;
@@ -1147,9 +1148,9 @@ impl SnowWorld {
     /// when the pool keeps no normals ([`PoolFormat::normals`]).
     pub fn read_normals_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
         let s = self.state(id)?;
-        let Some(word) =
-            s.slot
-                .normals_word(&self.config.format, s.layout.width, s.layout.height)
+        let Some(word) = s
+            .slot
+            .normals_word(&self.config.format, s.layout.width, s.layout.height)
         else {
             return Err(SnowError::Readback(
                 "this world keeps no normals; set WorldConfig.format.normals to keep them".into(),

@@ -146,7 +146,11 @@ fn every_stage_matches_its_cpu_reference() {
         let deformers = crowd(desc.center);
         let l = desc.layout();
         if precision == Precision::Bits8 {
-            assert_eq!(l.width % 2, 1, "an odd width exercises the padded 8-bit rows");
+            assert_eq!(
+                l.width % 2,
+                1,
+                "an odd width exercises the padded 8-bit rows"
+            );
         }
         // Two frames: the second merges into a non-empty history and replenishes.
         let zero = vec![0u32; l.texels() as usize];
@@ -200,7 +204,8 @@ fn every_stage_matches_its_cpu_reference() {
             // Stage 2: 0.5/s x 0.1 s x channel_max units a frame, applied whole, the fraction
             // carried (at 16 bits: 3276.75, so 3276 then 3277).
             let rate = 0.05 * precision.channel_max() as f64;
-            let units = ((frame + 1) as f64 * rate).floor() as u32 - (frame as f64 * rate).floor() as u32;
+            let units =
+                ((frame + 1) as f64 * rate).floor() as u32 - (frame as f64 * rate).floor() as u32;
             let gpu = w.read_channels(id).unwrap();
             let cpu = acc_cpu::merge(&before.0, &before.1, Some(&gpu_blur), units, precision);
             let slack = merge_slack(precision);
@@ -875,7 +880,8 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
             let inp = blur_input(&desc, CaptureMode::Depth);
             // 0.3/s x 0.1 s x channel_max a frame, the fraction carried.
             let rate = 0.03 * precision.channel_max() as f64;
-            let units = ((frame + 1) as f64 * rate).floor() as u32 - (frame as f64 * rate).floor() as u32;
+            let units =
+                ((frame + 1) as f64 * rate).floor() as u32 - (frame as f64 * rate).floor() as u32;
             let cpu = acc_cpu::merge(
                 &before.0,
                 &before.1,

@@ -603,8 +603,9 @@ fn inactive_surfaces_hold_no_heightmap_by_default() {
 
 #[test]
 fn a_surface_larger_than_the_pool_is_refused() {
+    // A 4 m x 4 m surface needs 100 x 100 texels x 4 bytes = 40,000 bytes.
     let config = ManagerConfig {
-        pool_bytes: 100_000,
+        pool_bytes: 30_000,
         ..ManagerConfig::default()
     };
     let mut p = Planner::new(&config).unwrap();

@@ -1120,7 +1120,7 @@ mod manager_keys {
     #[test]
     fn budget_camera_player_and_zone_parse() {
         let s = parse(
-            "zone = 3\n[budget]\nupdates_per_frame = 4\npool_bytes = 1048576\nactive_distance = 25.5\n\
+            "zone = 3\n[budget]\nupdates_per_frame = 4\npool_bytes = 1048576\nactive_distance = 25.5\nprecision_bits = 8\n\
              [camera]\ntarget = [1, 2, 3]\nkeys = [{ t = 0, eye = [0, 10, 0] }, { t = 2, eye = [4, 10, 0] }]\n\
              [[deformer]]\nname = \"p\"\nshape = \"sphere\"\nradius = 0.1\nplayer = true\nkeys = [{ t = 0, position = [0, 0.1, 0] }]\n",
         )
@@ -1131,6 +1131,7 @@ mod manager_keys {
             (b.updates_per_frame, b.pool_bytes, b.active_distance),
             (Some(4), Some(1 << 20), Some(25.5))
         );
+        assert_eq!(b.precision, Some(snowprint::Precision::Bits8));
         let c = s.camera.unwrap();
         assert_eq!(c.fov_y_degrees, 50.0);
         // Halfway between the keys.
@@ -1149,6 +1150,11 @@ mod manager_keys {
                 "updates_per_frame 0",
             ),
             ("[budget]\npool_bytes = -5\n", "m.toml:8:", "pool_bytes -5"),
+            (
+                "[budget]\nprecision_bits = 12\n",
+                "m.toml:8:",
+                "precision_bits 12",
+            ),
             (
                 "[budget]\nactive_distance = nan\n",
                 "m.toml:8:",

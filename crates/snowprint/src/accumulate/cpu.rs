@@ -97,7 +97,9 @@ pub fn merge_channels(
     let captured = blurred.map_or(0, |b| to_units(b, precision));
     let new_depressed = depressed.max(captured);
     let pushed = new_depressed - depressed;
-    let new_displaced = displaced.saturating_add(pushed).min(precision.channel_max());
+    let new_displaced = displaced
+        .saturating_add(pushed)
+        .min(precision.channel_max());
     (new_depressed, new_displaced)
 }
 

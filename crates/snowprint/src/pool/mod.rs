@@ -130,7 +130,13 @@ impl PoolFormat {
     }
 
     /// Encode channels (row-major, `width x height`) into the words of a heights region.
-    pub fn encode(&self, width: u32, height: u32, depression: &[u32], displaced: &[u32]) -> Vec<u32> {
+    pub fn encode(
+        &self,
+        width: u32,
+        height: u32,
+        depression: &[u32],
+        displaced: &[u32],
+    ) -> Vec<u32> {
         let (w, h) = (width as usize, height as usize);
         match self.precision {
             Precision::Bits8 => {

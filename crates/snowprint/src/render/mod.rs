@@ -1266,7 +1266,7 @@ impl Renderer {
                 &device,
                 "classify records",
                 U::STORAGE | U::COPY_DST,
-                16 * 8,
+                std::mem::size_of::<ClassifyRecord>() as u64 * 8,
             ),
             state_buffer: Growable::new(
                 &device,
@@ -2060,7 +2060,10 @@ impl Renderer {
         self.queue
             .write_buffer(&self.heightfield_params.buffer, 0, &hf_bytes);
         if n > 0 {
-            self.classify_buffer.ensure(&self.device, (n * 16) as u64);
+            self.classify_buffer.ensure(
+                &self.device,
+                (n * std::mem::size_of::<ClassifyRecord>()) as u64,
+            );
             self.queue.write_buffer(
                 &self.classify_buffer.buffer,
                 0,

@@ -166,6 +166,23 @@ fn budget(src: &Source<'_>, b: RawBudget) -> Result<SceneBudget> {
                 )
             })
             .transpose()?,
+        precision: b
+            .precision_bits
+            .as_ref()
+            .map(|v| {
+                let bits = *v.get_ref();
+                u32::try_from(bits)
+                    .ok()
+                    .and_then(crate::pool::Precision::from_bits)
+                    .ok_or_else(|| {
+                        src.error(
+                            &v.span(),
+                            format!("[budget] has precision_bits {}", src.quote(&v.span())),
+                            "precision_bits must be 8, 16 or 32 (bits a heightmap channel)",
+                        )
+                    })
+            })
+            .transpose()?,
     })
 }
 

@@ -69,6 +69,8 @@ pub struct SceneBudget {
     pub pool_bytes: Option<u64>,
     /// Distance from the player (or camera) within which a visible surface is active, metres.
     pub active_distance: Option<f32>,
+    /// Bits a channel of the heightmaps in the pool (8, 16 or 32).
+    pub precision: Option<crate::pool::Precision>,
 }
 
 /// `[camera]` of a scene: eye positions keyed in time, looking at one target.

@@ -33,6 +33,7 @@ pub(super) struct RawBudget {
     pub updates_per_frame: Option<Spanned<i64>>,
     pub pool_bytes: Option<Spanned<i64>>,
     pub active_distance: Option<Num>,
+    pub precision_bits: Option<Spanned<i64>>,
 }
 
 /// `[camera]`: keyed eye positions looking at one target.
