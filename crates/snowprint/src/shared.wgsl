@@ -18,7 +18,7 @@ struct SurfaceRecord {
     frustum_height: f32,  // metres: snow depth + ankle height
     texel_x: f32,         // metres
     texel_z: f32,         // metres
-    pad: u32,
+    tiles: u32,           // first of the surface's 16x16 tile flags (set where the capture wrote)
 }
 
 const NO_CAPTURE: u32 = 0xffffffffu;

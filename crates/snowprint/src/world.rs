@@ -248,6 +248,8 @@ pub struct SnowWorld {
     draws: Growable,
     capture: Growable,
     winding: Growable,
+    /// One flag per 16x16 tile of each captured surface: set by the capture where it wrote.
+    tiles: Growable,
     scratch: Growable,
     last: LastFrame,
     profiling: bool,
@@ -377,6 +379,7 @@ impl SnowWorld {
                 U::STORAGE | U::COPY_DST | U::COPY_SRC,
                 4 * 4096,
             ),
+            tiles: Growable::new(&device, "capture tiles", U::STORAGE | U::COPY_DST, 4 * 256),
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
             queue: gpu.queue.clone(),
             caps: gpu.caps.clone(),
@@ -563,7 +566,8 @@ impl SnowWorld {
                 + self.prims.buffer.size()
                 + self.draws.buffer.size()
                 + self.capture.buffer.size()
-                + self.winding.buffer.size(),
+                + self.winding.buffer.size()
+                + self.tiles.buffer.size(),
             format: self.config.format,
         }
     }
@@ -726,7 +730,7 @@ impl SnowWorld {
                     frustum_height,
                     texel_x: texel.x,
                     texel_z: texel.y,
-                    pad: 0,
+                    tiles: 0,
                 },
                 captured,
                 prims: p0..prims.len() as u32,
@@ -755,6 +759,7 @@ impl SnowWorld {
         let (placements, atlas_side) = capture::pack_atlas_compact(&rects, self.config.atlas_side);
         let batches = placements.iter().map(|p| p.batch + 1).max().unwrap_or(0);
         let mut scratch_len = 0u32;
+        let mut tiles_len = 0u32;
         for (k, &j) in captured.iter().enumerate() {
             let r = &mut jobs[j].record;
             r.atlas_x = placements[k].x;
@@ -762,6 +767,8 @@ impl SnowWorld {
             r.batch = placements[k].batch;
             r.scratch = scratch_len;
             scratch_len += r.width * r.height;
+            r.tiles = tiles_len;
+            tiles_len += r.width.div_ceil(FUSED_WORKGROUP) * r.height.div_ceil(FUSED_WORKGROUP);
         }
         stats.captured = captured.len() as u32;
         stats.capture_batches = batches;
@@ -784,9 +791,13 @@ impl SnowWorld {
                 offset: r.scratch,
                 origin: [r.atlas_x as f32, r.atlas_y as f32],
                 texels: [r.width as f32, r.height as f32],
+                tiles: r.tiles,
+                tiles_x: r.width.div_ceil(FUSED_WORKGROUP),
+                pad: [0; 2],
             };
             let o = k * UNIFORM_STRIDE as usize;
-            view_bytes[o..o + 32].copy_from_slice(bytemuck::bytes_of(&v));
+            let size = std::mem::size_of::<CaptureView>();
+            view_bytes[o..o + size].copy_from_slice(bytemuck::bytes_of(&v));
         }
         self.views.ensure(&self.device, view_bytes.len() as u64);
         self.queue.write_buffer(&self.views.buffer, 0, &view_bytes);
@@ -804,12 +815,17 @@ impl SnowWorld {
             self.draws.ensure(&self.device, bytes.len() as u64);
             self.queue.write_buffer(&self.draws.buffer, 0, &bytes);
         }
-        self.scratch
-            .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        // The blurred capture goes through memory only when blur and merge are separate passes.
+        if self.config.passes == PassMode::Separate {
+            self.scratch
+                .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        }
         self.capture
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
         self.winding
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        self.tiles
+            .ensure(&self.device, (tiles_len.max(1) as u64) * 4);
 
         let atlas_index = self.atlas(atlas_side);
         let atlas_view = &self.atlases[atlas_index].2;
@@ -825,7 +841,7 @@ impl SnowWorld {
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &self.views.buffer,
                         offset: 0,
-                        size: std::num::NonZeroU64::new(32),
+                        size: std::num::NonZeroU64::new(std::mem::size_of::<CaptureView>() as u64),
                     }),
                 },
                 wgpu::BindGroupEntry {
@@ -839,6 +855,10 @@ impl SnowWorld {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: self.winding.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: self.tiles.buffer.as_entire_binding(),
                 },
             ],
         });
@@ -898,6 +918,7 @@ impl SnowWorld {
                 capture.as_entire_binding(),
                 pool.as_entire_binding(),
                 winding.as_entire_binding(),
+                self.tiles.buffer.as_entire_binding(),
             ],
         );
         let ts = if self.profiling {
@@ -924,6 +945,7 @@ impl SnowWorld {
         // Nothing captured yet: 0 is the code of "no deformer over this texel".
         enc.clear_buffer(&self.capture.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
         enc.clear_buffer(&self.winding.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
+        enc.clear_buffer(&self.tiles.buffer, 0, Some(tiles_len.max(1) as u64 * 4));
         for batch in 0..batches {
             let q = next_query(Stage::Capture, &mut stages);
             {

@@ -3,8 +3,9 @@
 // (18x18) in workgroup memory, blurs each texel from there, then merges the tile's units (two
 // texels along x at 8 bits, one otherwise; 16 is even, so a unit never straddles tiles) into the
 // heights region. A texel's new value depends only on its own old value, so updating in place is
-// safe whatever order the workgroups run in.
-// Reads: `records`, `capture`, `winding`, each record's heights region in `pool`.
+// safe whatever order the workgroups run in. A tile whose flag the capture left unset, on a
+// surface with no snow to refill, is left alone: its workgroup reads one word and leaves.
+// Reads: `records`, `tiles`, `capture`, `winding`, each record's heights region in `pool`.
 // Writes: the same heights region.
 // CPU reference: accumulate::cpu::blur then merge_channels. Maths: maths.wgsl, capture_read.wgsl.
 
@@ -12,6 +13,7 @@
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
 @group(0) @binding(2) var<storage, read_write> pool: array<u32>;
 @group(0) @binding(3) var<storage, read> winding: array<i32>;
+@group(0) @binding(4) var<storage, read> tiles: array<u32>;
 
 const SIDE: i32 = 16;
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
@@ -29,7 +31,16 @@ fn fused(
     if i32(wid.x) * SIDE >= i32(rec.width) || i32(wid.y) * SIDE >= i32(rec.height) {
         return;
     }
-    let has_capture = rec.batch != NO_CAPTURE;
+    var has_capture = rec.batch != NO_CAPTURE;
+    if has_capture {
+        let tiles_x = (rec.width + u32(SIDE) - 1u) / u32(SIDE);
+        has_capture = tiles[rec.tiles + wid.y * tiles_x + wid.x] != 0u;
+    }
+    // Nothing to deepen and nothing to refill: the tile stays as it is (uniform per workgroup,
+    // before any barrier).
+    if !has_capture && rec.replenish_units == 0u {
+        return;
+    }
     let tile = vec2<i32>(wid.xy) * SIDE;
     let dep_origin = tile - vec2<i32>(1);
     if has_capture {

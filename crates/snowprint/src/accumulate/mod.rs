@@ -74,7 +74,7 @@ pub struct AccumulatePipelines {
     pub merge_layout: wgpu::BindGroupLayout,
     /// Layout of the normals' group 0.
     pub normals_layout: wgpu::BindGroupLayout,
-    /// Layout of the fused pass's group 0: records, capture, pool, winding.
+    /// Layout of the fused pass's group 0: records, capture, pool, winding, tile flags.
     pub fused_layout: wgpu::BindGroupLayout,
 }
 
@@ -105,6 +105,7 @@ impl AccumulatePipelines {
                 compute_storage(1, true),
                 compute_storage(2, false),
                 compute_storage(3, true),
+                compute_storage(4, true),
             ],
         });
         let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -212,7 +213,7 @@ mod tests {
             "frustum_height",
             "texel_x",
             "texel_z",
-            "pad",
+            "tiles",
         ];
         for (i, (name, offset)) in names.iter().enumerate() {
             assert_eq!(name, expect[i]);

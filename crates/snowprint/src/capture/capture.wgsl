@@ -8,7 +8,8 @@
 // coordinates), mesh vertex buffers and `draw` (mesh-to-surface-local transform, dynamic offset).
 // Writes: `capture`, the surface's texels at `view.offset` (cleared to 0 = nothing before the pass),
 // and `winding` at the same texels (cleared to 0): how many mesh solids contain the ground point
-// under each texel.
+// under each texel; `tiles` at `view.tiles` (cleared to 0): 1 for every 16x16 tile of the update
+// whose blur reads a texel written here, so the fused update skips the tiles nothing touched.
 
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
@@ -16,6 +17,9 @@ struct CaptureView {
     offset: u32,            // first texel of the surface in `capture`
     origin: vec2<f32>,      // the surface's top-left texel in the atlas
     texels: vec2<f32>,      // the surface's heightmap width and height
+    tiles: u32,             // first tile flag of the surface in `tiles`
+    tiles_x: u32,           // tiles a row
+    pad: vec2<u32>,
 }
 // Must match `CaptureView` in capture/mod.rs.
 
@@ -35,6 +39,23 @@ struct Primitive {
 @group(0) @binding(1) var<storage, read> prims: array<Primitive>;
 @group(0) @binding(2) var<storage, read_write> capture: array<atomic<u32>>;
 @group(0) @binding(3) var<storage, read_write> winding: array<atomic<i32>>;
+@group(0) @binding(4) var<storage, read_write> tiles: array<atomic<u32>>;
+
+// Side of the update's tiles. Must match FUSED_WORKGROUP in accumulate/mod.rs.
+const TILE: u32 = 16u;
+
+// Flag every tile holding a texel within one of this one (the blur's reach).
+fn mark_tiles(frag: vec2<f32>) {
+    let cell = vec2<i32>(frag - view.origin);
+    let last = vec2<i32>(view.texels) - vec2<i32>(1);
+    let t0 = vec2<u32>(clamp(cell - vec2<i32>(1), vec2<i32>(0), last)) / TILE;
+    let t1 = vec2<u32>(clamp(cell + vec2<i32>(1), vec2<i32>(0), last)) / TILE;
+    for (var ty = t0.y; ty <= t1.y; ty++) {
+        for (var tx = t0.x; tx <= t1.x; tx++) {
+            atomicStore(&tiles[view.tiles + ty * view.tiles_x + tx], 1u);
+        }
+    }
+}
 
 // Depths in [0, 1] are stored as ONE_BITS - bits(depth): 0 (the cleared value) means nothing was
 // captured, and a larger value is a lower point, so atomicMax keeps the lowest. Non-negative
@@ -47,6 +68,7 @@ fn texel_index(frag: vec2<f32>) -> u32 {
 }
 
 fn keep_lowest(frag: vec2<f32>, depth: f32) {
+    mark_tiles(frag);
     atomicMax(&capture[texel_index(frag)], ONE_BITS - bitcast<u32>(clamp(depth, 0.0, 1.0)));
 }
 
@@ -228,6 +250,7 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) {
     // solid reaches. Above the ground, the lowest entering face is the lowest point of the solids
     // that start there. A solid wholly inside the frustum presses exactly to its lowest point.
     if in.height < 0.0 {
+        mark_tiles(in.clip.xy);
         atomicAdd(&winding[texel_index(in.clip.xy)], select(-1, 1, front));
     } else if front && in.height <= view.frustum_height {
         keep_lowest(in.clip.xy, in.height / view.frustum_height);

@@ -61,6 +61,12 @@ pub struct CaptureView {
     pub origin: [f32; 2],
     /// The surface's heightmap width and height, texels.
     pub texels: [f32; 2],
+    /// First tile flag of the surface in the tiles buffer.
+    pub tiles: u32,
+    /// Tiles a row (16x16 texels each).
+    pub tiles_x: u32,
+    /// Padding to the uniform's 16-byte size.
+    pub pad: [u32; 2],
 }
 
 /// An analytic deformer in surface-local coordinates. Must match `Primitive` in `capture.wgsl`.
@@ -313,6 +319,7 @@ impl CapturePipelines {
                 },
                 fragment_storage(2),
                 fragment_storage(3),
+                fragment_storage(4),
             ],
         });
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

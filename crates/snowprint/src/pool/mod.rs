@@ -219,8 +219,8 @@ pub struct SurfaceRecord {
     pub texel_x: f32,
     /// Texel side along z, metres.
     pub texel_z: f32,
-    /// Unused (keeps the record at 64 bytes).
-    pub pad: u32,
+    /// First of the surface's tile flags written by the capture (see `capture.wgsl`).
+    pub tiles: u32,
 }
 
 /// `batch` of a record whose surface had nothing to capture this update.
