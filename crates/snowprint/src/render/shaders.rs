@@ -22,6 +22,13 @@ pub const CLASSIFY: &str = include_str!("classify.wgsl");
 /// Heightmap to filtered shading texture (depression, normal, occlusion).
 pub const HEIGHTFIELD: &str = include_str!("heightfield.wgsl");
 
+/// Snow banks from the displaced channel (tessellated tier).
+pub const BANKS: &str = include_str!("tessellate/banks.wgsl");
+/// Dicing of the snow surfaces' meshes (tessellated tier).
+pub const DICE: &str = include_str!("tessellate/dice.wgsl");
+/// The tessellated tier's snow: displacement, shading, shadow.
+pub const TESS_SURFACE: &str = include_str!("tessellate/tess_surface.wgsl");
+
 fn join(parts: &[&str]) -> String {
     parts.join("\n")
 }
@@ -29,6 +36,12 @@ fn join(parts: &[&str]) -> String {
 /// Module of the snow pass.
 pub fn surface() -> String {
     join(&[FRAME, SNOW, SURFACE])
+}
+
+/// Module of the tessellated tier's snow and snow shadow passes (it reuses the snow pass's
+/// bindings and heightfield contract).
+pub fn tess_surface() -> String {
+    join(&[FRAME, SNOW, SURFACE, TESS_SURFACE])
 }
 
 /// Module of the shadow and opaque passes.
@@ -61,5 +74,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("tonemap", tonemap()),
         ("classify", CLASSIFY.to_owned()),
         ("heightfield", HEIGHTFIELD.to_owned()),
+        ("tess_surface", tess_surface()),
+        ("banks", BANKS.to_owned()),
+        ("dice", DICE.to_owned()),
     ]
 }
