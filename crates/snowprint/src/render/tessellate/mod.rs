@@ -63,11 +63,11 @@ pub struct BankSettings {
 }
 
 impl Default for BankSettings {
-    /// 35 % of the pushed volume into banks within 25 cm.
+    /// 25 % of the pushed volume into banks within 30 cm (more buries people lying in the snow).
     fn default() -> Self {
         Self {
-            fraction: 0.35,
-            width: 0.25,
+            fraction: 0.25,
+            width: 0.3,
         }
     }
 }
