@@ -543,7 +543,42 @@ mod tests {
             to: Some(1.2),
             sim_hz: Some(10),
             scene: "rooftops".into(),
+            compare_tiers: false,
         }
+    }
+
+    #[test]
+    fn the_tessellated_tier_compares_with_relief_side_by_side() {
+        let out = scratch("compare");
+        let mut a = args(&out);
+        a.tier = Tier::Tessellated;
+        a.frames = Some(1);
+        a.compare_tiers = true;
+        run(&GpuOptions::default(), &a).unwrap();
+        let sheet = image::open(out.join("compare_tiers.png")).unwrap();
+        assert_eq!((sheet.width(), sheet.height()), (2 * 64 + 8, 36));
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        assert_eq!(report["tier"], "tessellated");
+        assert_eq!(report["dice_overflow_last_frame"], 0);
+        let passes: Vec<&str> = report["passes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["name"].as_str().unwrap())
+            .collect();
+        for name in ["banks", "dice", "snow_shadow"] {
+            assert!(passes.contains(&name), "{passes:?}");
+        }
+        let diced: u64 = report["surfaces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s["diced_triangles_last_frame"].as_u64().unwrap_or(0))
+            .sum();
+        assert!(diced > 0, "no surface was diced");
+        let _ = std::fs::remove_dir_all(&out);
     }
 
     fn scratch(name: &str) -> PathBuf {

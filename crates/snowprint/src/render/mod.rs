@@ -412,7 +412,7 @@ impl RenderConfig {
         }
         self.dice.validate()?;
         let vertex_bytes = self.dice.max_triangles as u64 * tessellate::VERTEX_BYTES;
-        if vertex_bytes > device.limits().max_storage_buffer_binding_size as u64 {
+        if vertex_bytes > device.limits().max_storage_buffer_binding_size {
             return bad(
                 "dice.max_triangles",
                 self.dice.max_triangles.to_string(),

@@ -158,8 +158,7 @@ pub fn dice_triangle(triangle: u32, ids: [u32; 3], levels: [u32; 3]) -> Vec<[Dic
             out.push([inner(i + 1, j), inner(i + 1, j + 1), inner(i, j + 1)]);
         }
     }
-    for e in 0..3 {
-        let l = levels[e];
+    for (e, &l) in levels.iter().enumerate() {
         let m_count = n - 2;
         let (mut o, mut m) = (0u32, 0u32);
         while !(o == l && m + 1 == m_count) {
