@@ -35,6 +35,13 @@ fn glyph(c: char) -> [u8; 5] {
         '#' => [5, 7, 5, 7, 5],
         't' => [2, 7, 2, 2, 3],
         '=' => [0, 7, 0, 7, 0],
+        'r' => [0, 5, 6, 4, 4],
+        'e' => [7, 5, 7, 4, 7],
+        'l' => [6, 2, 2, 2, 7],
+        'i' => [2, 0, 2, 2, 2],
+        'f' => [3, 4, 7, 4, 4],
+        'a' => [0, 6, 1, 7, 7],
+        'd' => [1, 1, 7, 5, 7],
         _ => [0; 5],
     }
 }
@@ -63,6 +70,18 @@ fn draw_text(img: &mut RgbaImage, text: &str, x: u32, y: u32, scale: u32, color:
 }
 
 /// Thumbnails of the chosen frames in a grid of three columns, each labelled `#frame t=seconds`.
+/// Two images of the same size side by side, 8 pixels apart, each labelled in its top-left corner.
+pub fn side_by_side(left: &RgbaImage, right: &RgbaImage, a: &str, b: &str) -> RgbaImage {
+    let (w, h) = left.dimensions();
+    let mut out = RgbaImage::from_pixel(2 * w + 8, h, Rgba([0, 0, 0, 255]));
+    image::imageops::overlay(&mut out, left, 0, 0);
+    image::imageops::overlay(&mut out, right, (w + 8) as i64, 0);
+    let scale = (h / 180).max(1);
+    draw_text(&mut out, a, 8, 8, scale, Rgba([255, 255, 255, 255]));
+    draw_text(&mut out, b, w + 16, 8, scale, Rgba([255, 255, 255, 255]));
+    out
+}
+
 pub fn compose(frames: &[(usize, f32, RgbaImage)]) -> RgbaImage {
     let Some((_, _, first)) = frames.first() else {
         return RgbaImage::new(1, 1);

@@ -101,7 +101,8 @@ pub struct Args {
     /// Camera: flythrough, closeup, overview, street, angel, fall or slide.
     #[arg(long, default_value = "flythrough")]
     pub camera: String,
-    /// Snow tracing: relief (the talk's relief mapping) or pom (parallax occlusion mapping).
+    /// Snow tier: relief (the talk's relief mapping), pom (parallax occlusion mapping) or
+    /// tessellated (real displaced geometry diced on the GPU, banks, the snow in the shadow map).
     #[arg(long, default_value = "relief")]
     pub tier: Tier,
     /// Samples per pixel along each axis, 1 to 4 (default: 2 on a GPU, 1 on a software adapter).
@@ -128,6 +129,10 @@ pub struct Args {
     /// manager's budget: heightmaps, a report, a pool plot and a map; not rendered).
     #[arg(long, default_value = "rooftops")]
     pub scene: String,
+    /// Also render the last frame in the relief and the tessellated tiers and write them side by
+    /// side (relief left, tessellated right) to `compare_tiers.png`.
+    #[arg(long)]
+    pub compare_tiers: bool,
 }
 
 /// Statistics of one pass over the frames.
@@ -322,6 +327,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let mut pass_ms: Vec<(&'static str, Vec<f64>)> = Vec::new();
     let mut first_surfaces = None;
     let mut last_surfaces = Vec::new();
+    let mut last_overflow = 0;
     let instances_count;
     {
         let mut last_instances = 0;
@@ -360,8 +366,27 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
                 first_surfaces = Some(out.surfaces.clone());
             }
             last_surfaces = out.surfaces.clone();
+            last_overflow = out.dice_overflow;
             let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
                 .ok_or("the renderer returned a frame of the wrong size")?;
+            if args.compare_tiers && k + 1 == times.len() {
+                let mut pair = Vec::new();
+                for tier in [Tier::Relief, Tier::Tessellated] {
+                    renderer.set_tier(tier);
+                    let o = renderer.render(&world, &frame).map_err(|e| e.to_string())?;
+                    pair.push(
+                        image::RgbaImage::from_raw(o.width, o.height, o.rgba8)
+                            .ok_or("the renderer returned a frame of the wrong size")?,
+                    );
+                }
+                renderer.set_tier(args.tier);
+                let sheet =
+                    contact_sheet::side_by_side(&pair[0], &pair[1], "relief", "tessellated");
+                let path = staging.path("compare_tiers.png");
+                sheet
+                    .save(&path)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            }
             let name = format!("frame_{k:04}.png");
             let path = staging.path(&name);
             image
@@ -419,6 +444,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
                 "material_first_frame": first,
                 "material_last_frame": last.map(|s| s.material),
                 "deepest_print_last_frame": last.map(|s| s.deepest),
+                "diced_triangles_last_frame": last.map(|s| s.triangles),
             })
         })
         .collect();
@@ -467,6 +493,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         "search": renderer.config().search_settings(),
         "passes": renderer.passes(),
         "gpu_pass_times_ms": gpu_times,
+        "dice_overflow_last_frame": last_overflow,
         "gpu_pass_times_note": timestamps_note,
         "cpu_ms": {
             "simulation_total": sim_ms,
@@ -516,7 +543,42 @@ mod tests {
             to: Some(1.2),
             sim_hz: Some(10),
             scene: "rooftops".into(),
+            compare_tiers: false,
         }
+    }
+
+    #[test]
+    fn the_tessellated_tier_compares_with_relief_side_by_side() {
+        let out = scratch("compare");
+        let mut a = args(&out);
+        a.tier = Tier::Tessellated;
+        a.frames = Some(1);
+        a.compare_tiers = true;
+        run(&GpuOptions::default(), &a).unwrap();
+        let sheet = image::open(out.join("compare_tiers.png")).unwrap();
+        assert_eq!((sheet.width(), sheet.height()), (2 * 64 + 8, 36));
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        assert_eq!(report["tier"], "tessellated");
+        assert_eq!(report["dice_overflow_last_frame"], 0);
+        let passes: Vec<&str> = report["passes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["name"].as_str().unwrap())
+            .collect();
+        for name in ["banks", "dice", "snow_shadow"] {
+            assert!(passes.contains(&name), "{passes:?}");
+        }
+        let diced: u64 = report["surfaces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s["diced_triangles_last_frame"].as_u64().unwrap_or(0))
+            .sum();
+        assert!(diced > 0, "no surface was diced");
+        let _ = std::fs::remove_dir_all(&out);
     }
 
     fn scratch(name: &str) -> PathBuf {

@@ -66,7 +66,16 @@ fn heightfield_pass_matches_its_cpu_reference() {
     let depth = 0.2;
     let texel = Vec2::new(0.04, 0.05);
     let dep = synthetic(w, h);
-    let units: Vec<u32> = dep.iter().map(|&v| (v * 65535.0).round() as u32).collect();
+    // Depression in the low 16 bits; a displaced-snow pattern in the high 16 (the pass copies it
+    // into the light texture's .g for the banks).
+    let units: Vec<u32> = dep
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let displaced = ((i as u32).wrapping_mul(2654435761) >> 16) & 0xffff;
+            (v * 65535.0).round() as u32 | displaced << 16
+        })
+        .collect();
     // The heightmap sits at an offset in the pool, as a world's slot does.
     let offset = 100u32;
     let mut pool = vec![0u32; offset as usize];
@@ -197,9 +206,9 @@ fn heightfield_pass_matches_its_cpu_reference() {
     // edges; nearest texel for the AO's offsets, bilinear for the light march.
     let d = |c: i32, r: i32| {
         let (c, r) = (c.clamp(0, w as i32 - 1), r.clamp(0, h as i32 - 1));
-        units[(r as u32 * w + c as u32) as usize] as f32 / 65535.0
+        (units[(r as u32 * w + c as u32) as usize] & 0xffff) as f32 / 65535.0
     };
-    let mut worst = [0.0f32; 4];
+    let mut worst = [0.0f32; 5];
     for r in 0..h as i32 {
         for c in 0..w as i32 {
             let gpu_texel = texel_at(&shape_bytes, c as u32, r as u32);
@@ -224,14 +233,21 @@ fn heightfield_pass_matches_its_cpu_reference() {
                 depth,
                 texel.x.max(texel.y),
             );
-            let gpu_vis = texel_at(&lit_bytes, c as u32, r as u32)[0];
+            let gpu_light = texel_at(&lit_bytes, c as u32, r as u32);
+            let gpu_vis = gpu_light[0];
+            let displaced = cpu::displaced_fraction(
+                units[(r as u32 * w + c as u32) as usize] >> 16,
+                snowprint::Precision::Bits16,
+            );
             let errors = [
                 (gpu_texel[0] - cpu::smoothed_depression(d, c, r)).abs(),
                 (gpu_texel[1] - n.x).abs().max((gpu_texel[2] - n.z).abs()),
                 (gpu_texel[3] - ao).abs(),
                 (gpu_vis - vis).abs(),
+                // Half floats: relative error 2^-11 of values up to 1.
+                (gpu_light[1] - displaced).abs(),
             ];
-            for k in 0..4 {
+            for k in 0..5 {
                 worst[k] = worst[k].max(errors[k]);
             }
         }
@@ -239,7 +255,7 @@ fn heightfield_pass_matches_its_cpu_reference() {
     // Half-float storage keeps about three decimal digits: 1e-3 relative, within 2e-3 here.
     assert!(
         worst.iter().all(|&e| e < 2e-3),
-        "worst |GPU - CPU| (depression, normal, AO, light): {worst:?}"
+        "worst |GPU - CPU| (depression, normal, AO, light, displaced): {worst:?}"
     );
 }
 

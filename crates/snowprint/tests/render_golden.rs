@@ -60,6 +60,8 @@ struct Scene {
     surfaces: Vec<(SurfaceId, GroundMaterial)>,
     fresh: SurfaceId,
     instances: Vec<Instance>,
+    /// A person standing beside the trench (capsule and head), for the grazing view.
+    person: Vec<Instance>,
 }
 
 /// The fixed scene: deformed over 8 steps of 1/30 s.
@@ -162,9 +164,28 @@ fn scene() -> Scene {
             [0.12, 0.2, 0.4],
         ),
     ];
+    // A person standing on the snow beside the trench, in the moon's way: their shadow falls
+    // across the trench and its bank.
+    let person = vec![
+        Instance::new(
+            body,
+            Mat4::from_translation(Vec3::new(0.2, 2.15 + 0.7, -0.1)),
+            [0.25, 0.1, 0.08],
+        ),
+        Instance::new(
+            ball,
+            Mat4::from_scale_rotation_translation(
+                Vec3::splat(0.45),
+                Quat::IDENTITY,
+                Vec3::new(0.2, 2.15 + 1.5, -0.1),
+            ),
+            [0.6, 0.45, 0.35],
+        ),
+    ];
     Scene {
         world,
         renderer,
+        person,
         surfaces: vec![
             (roof, GroundMaterial::Concrete),
             (tiles, GroundMaterial::RoofTiles),
@@ -176,6 +197,21 @@ fn scene() -> Scene {
 }
 
 fn render(scene: &mut Scene, tier: Tier) -> RenderOutput {
+    let camera = Camera {
+        eye: Vec3::new(0.6, 4.6, 4.4),
+        target: Vec3::new(0.6, 1.8, -0.1),
+        fov_y_degrees: 52.0,
+    };
+    let instances = scene.instances.clone();
+    render_view(scene, tier, camera, &instances)
+}
+
+fn render_view(
+    scene: &mut Scene,
+    tier: Tier,
+    camera: Camera,
+    instances: &[Instance],
+) -> RenderOutput {
     scene.renderer.set_tier(tier);
     let lights = [PointLight {
         position: Vec3::new(-1.5, 3.2, 1.5),
@@ -183,14 +219,10 @@ fn render(scene: &mut Scene, tier: Tier) -> RenderOutput {
         radius: 6.0,
     }];
     let frame = RenderFrame {
-        camera: Camera {
-            eye: Vec3::new(0.6, 4.6, 4.4),
-            target: Vec3::new(0.6, 1.8, -0.1),
-            fov_y_degrees: 52.0,
-        },
+        camera,
         time: 1.0,
         surfaces: &scene.surfaces,
-        instances: &scene.instances,
+        instances,
         lights: &lights,
         environment: Environment::moonlit_night(),
         snowfall: false,
@@ -286,4 +318,34 @@ fn both_tiers_match_their_goldens() {
         assert_eq!(out.surfaces.len(), 3);
         check(name, &out);
     }
+}
+
+#[test]
+fn the_tessellated_tier_matches_its_goldens() {
+    let mut scene = scene();
+    let out = render(&mut scene, Tier::Tessellated);
+    assert_eq!(out.basic_material_surfaces, vec![scene.fresh]);
+    assert_eq!(out.dice_overflow, 0);
+    // Every surface in view was diced, the untouched one too.
+    assert!(
+        out.surfaces.iter().all(|s| s.triangles > 0),
+        "{:?}",
+        out.surfaces
+    );
+    check("tessellated", &out);
+
+    // Close and grazing, across the trench: the banks beside it, a standing person behind it whose
+    // shadow comes across the trench and bends into it.
+    // (Without the body that slid, so the trench is empty.)
+    let mut instances = scene.instances[..2].to_vec();
+    instances.extend(scene.person.iter().copied());
+    let camera = Camera {
+        eye: Vec3::new(-1.5, 2.75, -1.4),
+        target: Vec3::new(-0.6, 2.1, -0.45),
+        fov_y_degrees: 50.0,
+    };
+    let out = render_view(&mut scene, Tier::Tessellated, camera, &instances);
+    check("tessellated_grazing", &out);
+    let relief = render_view(&mut scene, Tier::Relief, camera, &instances);
+    check("relief_grazing", &relief);
 }

@@ -191,6 +191,14 @@ pub fn smoothed_depression(depression: impl Fn(i32, i32) -> f32, col: i32, row: 
     sum / 16.0
 }
 
+/// The displaced-snow channel of a pool texel (what the captures pushed deeper, accumulated; in
+/// units of `1 / channel_max` at the pool's precision) as a fraction of the snow depth, as the
+/// heightfield pass writes it into the light texture's `.g`. Must match `displaced` in
+/// `heightfield.wgsl`.
+pub fn displaced_fraction(units: u32, precision: crate::pool::Precision) -> f32 {
+    units as f32 / precision.channel_max() as f32
+}
+
 /// Normal of the snow top from the depressions around a texel, by a 3x3 Sobel filter (smoother
 /// than central differences, which matters at 4 cm texels). `depression(col, row)` is the fraction
 /// of the snow depth pressed down (clamped at the edges by the caller). Returns a unit local normal.

@@ -19,6 +19,10 @@ pub enum Resource {
     SurfaceState,
     /// Per deformed surface: the filtered texture of (depression, normal, occlusion).
     Heightfields,
+    /// Per deformed surface: bank heights (tessellated tier).
+    Banks,
+    /// Diced vertices, indices and indirect draws of the snow surfaces (tessellated tier).
+    DicedMesh,
     /// The moon's shadow map.
     ShadowMap,
     /// The scene's HDR colour (supersampled).
@@ -73,22 +77,29 @@ pub mod pass {
     pub const CLASSIFY: usize = 0;
     /// Heightmaps to filtered shading textures.
     pub const HEIGHTFIELD: usize = 1;
-    /// The moon's shadow map.
-    pub const SHADOW: usize = 2;
+    /// Snow banks from the displaced channel (tessellated tier; empty otherwise).
+    pub const BANKS: usize = 2;
+    /// Dicing of the snow surfaces' meshes (tessellated tier; empty otherwise).
+    pub const DICE: usize = 3;
+    /// The moon's shadow map: meshes.
+    pub const SHADOW: usize = 4;
+    /// The moon's shadow map: the displaced snow (tessellated tier; empty otherwise).
+    pub const SNOW_SHADOW: usize = 5;
     /// Opaque meshes.
-    pub const OPAQUE: usize = 3;
+    pub const OPAQUE: usize = 6;
     /// Snow surfaces.
-    pub const SNOW: usize = 4;
+    pub const SNOW: usize = 7;
     /// Sky.
-    pub const SKY: usize = 5;
+    pub const SKY: usize = 8;
     /// Falling snow.
-    pub const SNOWFALL: usize = 6;
+    pub const SNOWFALL: usize = 9;
     /// Resolve and tonemap.
-    pub const TONEMAP: usize = 7;
+    pub const TONEMAP: usize = 10;
 }
 
-/// The passes of a frame, in the order they run.
-pub const PASSES: [PassInfo; 8] = [
+/// The passes of a frame, in the order they run. The tessellated tier's passes (`banks`, `dice`,
+/// `snow_shadow`) are encoded empty in the other tiers, so every tier reports the same list.
+pub const PASSES: [PassInfo; 11] = [
     PassInfo {
         name: "classify",
         kind: PassKind::Compute,
@@ -102,9 +113,41 @@ pub const PASSES: [PassInfo; 8] = [
         writes: &[R::Heightfields],
     },
     PassInfo {
+        name: "banks",
+        kind: PassKind::Compute,
+        reads: &[R::SurfaceTable, R::SurfaceState, R::Heightfields],
+        writes: &[R::Banks],
+    },
+    PassInfo {
+        name: "dice",
+        kind: PassKind::Compute,
+        reads: &[
+            R::SurfaceTable,
+            R::SurfaceState,
+            R::Heightfields,
+            R::Banks,
+            R::FrameUniforms,
+        ],
+        writes: &[R::DicedMesh],
+    },
+    PassInfo {
         name: "shadow",
         kind: PassKind::Render,
         reads: &[R::Instances, R::FrameUniforms],
+        writes: &[R::ShadowMap],
+    },
+    PassInfo {
+        name: "snow_shadow",
+        kind: PassKind::Render,
+        reads: &[
+            R::SurfaceTable,
+            R::SurfaceState,
+            R::Heightfields,
+            R::Banks,
+            R::DicedMesh,
+            R::FrameUniforms,
+            R::ShadowMap,
+        ],
         writes: &[R::ShadowMap],
     },
     PassInfo {
@@ -120,6 +163,8 @@ pub const PASSES: [PassInfo; 8] = [
             R::SurfaceTable,
             R::SurfaceState,
             R::Heightfields,
+            R::Banks,
+            R::DicedMesh,
             R::FrameUniforms,
             R::ShadowMap,
             R::SceneDepth,
@@ -183,7 +228,10 @@ mod tests {
         validate(&PASSES).unwrap();
         assert_eq!(PASSES[pass::CLASSIFY].name, "classify");
         assert_eq!(PASSES[pass::HEIGHTFIELD].name, "heightfield");
+        assert_eq!(PASSES[pass::BANKS].name, "banks");
+        assert_eq!(PASSES[pass::DICE].name, "dice");
         assert_eq!(PASSES[pass::SHADOW].name, "shadow");
+        assert_eq!(PASSES[pass::SNOW_SHADOW].name, "snow_shadow");
         assert_eq!(PASSES[pass::OPAQUE].name, "opaque");
         assert_eq!(PASSES[pass::SNOW].name, "snow");
         assert_eq!(PASSES[pass::SKY].name, "sky");
@@ -196,5 +244,8 @@ mod tests {
         let mut p = PASSES;
         p.swap(pass::SHADOW, pass::OPAQUE);
         assert!(validate(&p).unwrap_err().contains("opaque reads ShadowMap"));
+        let mut p = PASSES;
+        p.swap(pass::BANKS, pass::DICE);
+        assert!(validate(&p).unwrap_err().contains("dice reads Banks"));
     }
 }

@@ -4,10 +4,12 @@
 // "derive parametric AO from the heightmap"; the depression itself is stored smoothed by a 3x3
 // binomial filter), and a second texture with the moon's visibility
 // over the snow of each texel (a soft shadow of the prints' walls on their floors, computed once
-// per texel instead of per pixel). Dispatched indirectly: zero workgroups for a surface on the
+// per texel instead of per pixel) in .r and the displaced snow (the pool's high 16 bits, raw) in
+// .g, which the tessellated tier's banks read. Dispatched indirectly: zero workgroups for a surface on the
 // basic material.
 // Reads: the heightmap pool. Writes: the surface's heightfield and light textures.
-// CPU reference: render::cpu::{sobel_normal, horizon_ao, light_visibility}.
+// CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
+// displaced_fraction}.
 
 // Must match `HeightfieldParams` in src/render/gpu.rs.
 struct HeightfieldParams {
@@ -40,6 +42,14 @@ fn depression(c: i32, r: i32) -> f32 {
     let x = u32(clamp(c, 0, i32(params.width) - 1));
     let y = u32(clamp(r, 0, i32(params.height) - 1));
     return pool_fractions(params.bits, params.heights, params.width, params.height, x, y).x;
+}
+
+// The displaced snow at a texel (the talk's projected-displacement channel: what the captures
+// pushed deeper, accumulated), as a fraction of the snow depth. Same shape as `depression`.
+fn displaced(c: i32, r: i32) -> f32 {
+    let x = u32(clamp(c, 0, i32(params.width) - 1));
+    let y = u32(clamp(r, 0, i32(params.height) - 1));
+    return pool_fractions(params.bits, params.heights, params.width, params.height, x, y).y;
 }
 
 // Snow height (metres above the ground) at the texel nearest to a metric offset.
@@ -148,5 +158,5 @@ fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = sobel_normal(c, r);
     let ao = horizon_ao(c, r);
     textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(smoothed_depression(c, r), n.x, n.z, ao));
-    textureStore(out_light, vec2<i32>(c, r), vec4<f32>(light_visibility(c, r), 0.0, 0.0, 1.0));
+    textureStore(out_light, vec2<i32>(c, r), vec4<f32>(light_visibility(c, r), displaced(c, r), 0.0, 1.0));
 }

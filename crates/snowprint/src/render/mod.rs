@@ -56,6 +56,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod graph;
 pub mod shaders;
+pub mod tessellate;
 
 use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform};
 use std::collections::HashMap;
@@ -78,6 +79,10 @@ use gpu::{
 };
 use graph::pass;
 pub use graph::{PASSES, PassInfo, PassKind, Resource};
+pub use tessellate::{
+    BankSettings, DiceSettings, DicedKind, DicedMesh, DicedVertex, SurfaceFields, SurfaceGeometry,
+    SurfaceMesh,
+};
 
 /// The snow material as a WGSL module (no bindings, no entry points), for renderers of your own.
 pub const SNOW_WGSL: &str = shaders::SNOW;
@@ -154,8 +159,9 @@ pub enum RenderError {
 /// Result of the renderer.
 pub type RenderResult<T> = Result<T, RenderError>;
 
-/// How snow surfaces are traced: the talk's relief mapping, or parallax occlusion mapping (the
-/// talk's "replace with POM?"), which takes more taps, interpolates the hit and self-shadows.
+/// How snow surfaces are drawn: traced by the talk's relief mapping, or by parallax occlusion
+/// mapping (the talk's "replace with POM?"), which takes more taps, interpolates the hit and
+/// self-shadows; or as real displaced geometry diced on the GPU (the talk's tessellation path).
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
 )]
@@ -166,6 +172,9 @@ pub enum Tier {
     Relief,
     /// Parallax occlusion mapping: more taps, secant refinement, self-shadowing.
     Pom,
+    /// Real geometry: each surface's mesh diced on the GPU by screen size and relief, displaced by
+    /// the heightmap, banks and macro waves, drawn into the shadow map ([`tessellate`]).
+    Tessellated,
 }
 
 impl Tier {
@@ -174,6 +183,7 @@ impl Tier {
         match self {
             Tier::Relief => "relief",
             Tier::Pom => "pom",
+            Tier::Tessellated => "tessellated",
         }
     }
 }
@@ -184,7 +194,10 @@ impl std::str::FromStr for Tier {
         match s.to_ascii_lowercase().as_str() {
             "relief" => Ok(Tier::Relief),
             "pom" => Ok(Tier::Pom),
-            _ => Err(format!("unknown tier {s:?}; use relief or pom")),
+            "tessellated" | "tess" => Ok(Tier::Tessellated),
+            _ => Err(format!(
+                "unknown tier {s:?}; use relief, pom or tessellated"
+            )),
         }
     }
 }
@@ -268,7 +281,8 @@ impl SearchSettings {
     /// steps; POM a tap per texel (8 to 40), 3 false-position steps and 10 self-shadow taps.
     pub fn for_tier(tier: Tier) -> Self {
         match tier {
-            Tier::Relief => Self {
+            // Surfaces not tessellated in the tessellated tier are relief mapped.
+            Tier::Relief | Tier::Tessellated => Self {
                 taps_per_texel: 0.5,
                 min_taps: 4,
                 max_taps: 12,
@@ -329,6 +343,8 @@ pub struct RenderConfig {
     pub search: Option<SearchSettings>,
     /// How snow and ground meet.
     pub look: SnowLook,
+    /// The tessellated tier's dicing.
+    pub dice: DiceSettings,
 }
 
 impl RenderConfig {
@@ -344,6 +360,7 @@ impl RenderConfig {
             debug_view: DebugView::Shaded,
             search: None,
             look: SnowLook::default(),
+            dice: DiceSettings::default(),
         }
     }
 
@@ -391,6 +408,15 @@ impl RenderConfig {
                 "search",
                 format!("{s:?}"),
                 "taps_per_texel above 0 and 1 <= min_taps <= max_taps <= 256",
+            );
+        }
+        self.dice.validate()?;
+        let vertex_bytes = self.dice.max_triangles as u64 * tessellate::VERTEX_BYTES;
+        if vertex_bytes > device.limits().max_storage_buffer_binding_size {
+            return bad(
+                "dice.max_triangles",
+                self.dice.max_triangles.to_string(),
+                "small enough that its vertex buffer fits the device's largest storage buffer",
             );
         }
         let l = self.look;
@@ -630,6 +656,8 @@ pub struct SurfaceShading {
     pub material: SnowMaterialKind,
     /// The deepest print, as a fraction of the snow depth.
     pub deepest: f32,
+    /// Triangles the dicing pass made for it (the tessellated tier; 0 otherwise or when culled).
+    pub triangles: u32,
 }
 
 fn serialize_surface_id<S: serde::Serializer>(id: &SurfaceId, s: S) -> Result<S::Ok, S::Error> {
@@ -643,6 +671,9 @@ pub struct FrameReport {
     pub pass_times: Vec<PassTime>,
     /// Each surface drawn and its material.
     pub surfaces: Vec<SurfaceShading>,
+    /// Base triangles the dicing pass dropped for want of room
+    /// ([`DiceSettings::max_triangles`]); 0 when everything fit.
+    pub dice_overflow: u32,
 }
 
 impl FrameReport {
@@ -671,6 +702,8 @@ pub struct RenderOutput {
     pub basic_material_surfaces: Vec<SurfaceId>,
     /// Each surface drawn and its material.
     pub surfaces: Vec<SurfaceShading>,
+    /// Base triangles the dicing pass dropped for want of room (0 when everything fit).
+    pub dice_overflow: u32,
     /// CPU time from the call to the pixels being back, milliseconds.
     pub cpu_ms: f64,
 }
@@ -687,8 +720,22 @@ struct HeightfieldTexture {
     size: (u32, u32),
     /// Depression, normal x and z, ambient occlusion.
     shape: wgpu::TextureView,
-    /// Moon visibility.
+    /// Moon visibility, displaced snow.
     light: wgpu::TextureView,
+    /// Room for banks around each texel (the bank passes' scratch).
+    bank_scratch: wgpu::TextureView,
+    /// Bank heights, metres.
+    bank: wgpu::TextureView,
+    /// The textures of shape, light and bank, for readbacks.
+    textures: [wgpu::Texture; 3],
+}
+
+/// A surface's base mesh on the GPU, for the dicing pass.
+struct BaseMeshGpu {
+    buffer: wgpu::Buffer,
+    triangles: u32,
+    /// The surface's size and the geometry's version it was built for.
+    key: ([u32; 2], u64),
 }
 
 struct Targets {
@@ -765,6 +812,14 @@ pub struct Renderer {
     shadow_size: u32,
     targets: Targets,
     heightfields: HashMap<SurfaceId, HeightfieldTexture>,
+    /// The tessellated tier's pipelines and buffers.
+    tess: tessellate::gpu::TessGpu,
+    /// Per-surface settings of the tessellated tier, and their version.
+    geometry: HashMap<SurfaceId, SurfaceGeometry>,
+    geometry_version: u64,
+    base_meshes: HashMap<SurfaceId, BaseMeshGpu>,
+    /// The surfaces of the latest frame encoded, in slot order (for readbacks).
+    last_surfaces: Vec<SurfaceId>,
     meshes: Vec<GpuMesh>,
     timestamps: Option<Timestamps>,
     stats: StatsReadback,
@@ -882,6 +937,18 @@ fn buffer_slice(buffer: &wgpu::Buffer, s: usize, size: usize) -> wgpu::BindingRe
         offset: s as u64 * UNIFORM_STRIDE,
         size: std::num::NonZeroU64::new(size as u64),
     })
+}
+
+/// A half float's value.
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let frac = (h & 0x3ff) as f32;
+    sign * match exp {
+        0 => frac * 2f32.powi(-24),
+        31 => f32::INFINITY,
+        _ => (1.0 + frac / 1024.0) * 2f32.powi(exp - 15),
+    }
 }
 
 fn finite_mat(m: &Mat4) -> bool {
@@ -1252,6 +1319,14 @@ impl Renderer {
             timestamps: false,
         };
         let targets = create_targets(&device, config.width, config.height, config.supersample);
+        let tess = tessellate::gpu::TessGpu::new(
+            &device,
+            &frame_layout,
+            &shadow_layout,
+            filterable,
+            HDR_FORMAT,
+            DEPTH_FORMAT,
+        );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Gpu(e.to_string()));
         }
@@ -1314,6 +1389,11 @@ impl Renderer {
             shadow_size,
             targets,
             heightfields: HashMap::new(),
+            tess,
+            geometry: HashMap::new(),
+            geometry_version: 0,
+            base_meshes: HashMap::new(),
+            last_surfaces: Vec::new(),
             meshes: Vec::new(),
             timestamps,
             stats,
@@ -1344,6 +1424,29 @@ impl Renderer {
     /// Show the shaded frame or one of the material's terms.
     pub fn set_debug_view(&mut self, view: DebugView) {
         self.config.debug_view = view;
+    }
+
+    /// How a surface is drawn in the tessellated tier: its mesh, whether it is tessellated at all,
+    /// its banks and macro waves. Checked against the surface (a mesh must lie within its
+    /// rectangle); surfaces never given one get [`SurfaceGeometry::default`].
+    pub fn set_surface_geometry(
+        &mut self,
+        world: &SnowWorld,
+        surface: SurfaceId,
+        geometry: SurfaceGeometry,
+    ) -> RenderResult<()> {
+        let desc = world.surface(surface)?;
+        let layout = world.layout(surface)?;
+        let texel = (desc.size.x / layout.width as f32).min(desc.size.y / layout.height as f32);
+        geometry.validate(desc.size * 0.5, texel)?;
+        self.geometry.insert(surface, geometry);
+        self.geometry_version += 1;
+        Ok(())
+    }
+
+    /// The tessellated-tier settings of a surface.
+    pub fn surface_geometry(&self, surface: SurfaceId) -> SurfaceGeometry {
+        self.geometry.get(&surface).cloned().unwrap_or_default()
     }
 
     /// Change the output size (and supersampling).
@@ -1477,6 +1580,7 @@ impl Renderer {
             basic_material_surfaces: report.basic_material_surfaces(),
             pass_times: report.pass_times,
             surfaces: report.surfaces,
+            dice_overflow: report.dice_overflow,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
         })
     }
@@ -1519,6 +1623,171 @@ impl Renderer {
         Ok(self.latest.clone())
     }
 
+    /// Copy `size` bytes of a buffer at `offset` back to the CPU (waits for the GPU).
+    fn read_back(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> RenderResult<Vec<u8>> {
+        let size = size.div_ceil(4) * 4;
+        if size == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("render readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        self.map_staging(&staging)
+    }
+
+    fn map_staging(&self, staging: &wgpu::Buffer) -> RenderResult<Vec<u8>> {
+        let slice = staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| RenderError::Readback(e.to_string()))?
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Readback(format!("{e:?}")))?
+            .to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// Slot of a surface in the latest frame encoded.
+    fn last_slot(&self, surface: SurfaceId) -> RenderResult<usize> {
+        self.last_surfaces
+            .iter()
+            .position(|&id| id == surface)
+            .ok_or_else(|| RenderError::InvalidFrame {
+                what: format!("surface {}", surface.index()),
+                value: "not drawn in the latest frame".into(),
+                expected: "a surface of the latest frame rendered",
+            })
+    }
+
+    /// The diced mesh of a surface in the latest frame (the tessellated tier), read back from the
+    /// GPU's vertex and index buffers: its triangles and the vertices they use, before
+    /// displacement. Empty when the surface was not diced (another tier, culled, or switched off).
+    pub fn read_diced_mesh(&self, surface: SurfaceId) -> RenderResult<DicedMesh> {
+        let s = self.last_slot(surface)?;
+        let words = |b: &[u8]| -> Vec<u32> {
+            b.chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect()
+        };
+        let args_at = (tessellate::ARGS_BASE + tessellate::ARGS_STRIDE * s as u64) * 4;
+        let args = words(&self.read_back(&self.tess.counters.buffer, args_at, 20)?);
+        let (count, first) = (args[0] as u64, args[2] as u64);
+        if count == 0 {
+            return Ok(DicedMesh {
+                vertices: Vec::new(),
+                triangles: Vec::new(),
+            });
+        }
+        let indices = words(&self.read_back(&self.tess.indices.buffer, first * 4, count * 4)?);
+        let lo = indices.iter().copied().min().unwrap_or(0) as u64;
+        let hi = indices.iter().copied().max().unwrap_or(0) as u64;
+        let raw = self.read_back(
+            &self.tess.vertices.buffer,
+            lo * tessellate::VERTEX_BYTES,
+            (hi + 1 - lo) * tessellate::VERTEX_BYTES,
+        )?;
+        let floats: Vec<f32> = raw
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        let vertices = floats
+            .chunks_exact(8)
+            .map(|v| DicedVertex {
+                position: Vec3::new(v[0], v[1], v[2]),
+                kind: match v[3] as u32 {
+                    0 => DicedKind::Top,
+                    1 => DicedKind::SkirtTop,
+                    _ => DicedKind::SkirtBottom,
+                },
+            })
+            .collect();
+        let triangles = indices
+            .chunks_exact(3)
+            .map(|t| [t[0] - lo as u32, t[1] - lo as u32, t[2] - lo as u32])
+            .collect();
+        Ok(DicedMesh {
+            vertices,
+            triangles,
+        })
+    }
+
+    /// A surface's smoothed depression, displaced channel and bank heights as the latest frame's
+    /// heightfield and bank passes wrote them (the banks only in the tessellated tier, and only
+    /// for a deformed surface; otherwise what an earlier frame left, or zeros).
+    pub fn read_surface_fields(&self, surface: SurfaceId) -> RenderResult<SurfaceFields> {
+        self.last_slot(surface)?;
+        let tex = self
+            .heightfields
+            .get(&surface)
+            .ok_or_else(|| RenderError::Readback("the surface has no heightfield yet".into()))?;
+        let (w, h) = tex.size;
+        let row = (w * 8).div_ceil(256) * 256;
+        let mut channels = Vec::new();
+        for (texture, channel) in [
+            (&tex.textures[0], 0),
+            (&tex.textures[1], 1),
+            (&tex.textures[2], 0),
+        ] {
+            let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("field readback"),
+                size: (row * h) as u64,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.copy_texture_to_buffer(
+                texture.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &staging,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: Some(h),
+                    },
+                },
+                wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+            );
+            self.queue.submit([encoder.finish()]);
+            let data = self.map_staging(&staging)?;
+            let mut values = Vec::with_capacity((w * h) as usize);
+            for r in 0..h {
+                for c in 0..w {
+                    let o = (r * row + c * 8 + channel * 2) as usize;
+                    values.push(f16_to_f32(u16::from_le_bytes([data[o], data[o + 1]])));
+                }
+            }
+            channels.push(values);
+        }
+        let bank = channels.pop().unwrap_or_default();
+        let displaced = channels.pop().unwrap_or_default();
+        let depression = channels.pop().unwrap_or_default();
+        Ok(SurfaceFields {
+            width: w,
+            height: h,
+            depression,
+            displaced,
+            bank,
+        })
+    }
+
     /// The report of the latest frame whose GPU results have come back.
     pub fn latest_report(&self) -> Option<&FrameReport> {
         self.latest.as_ref()
@@ -1526,12 +1795,13 @@ impl Renderer {
 
     fn copy_stats(&mut self, encoder: &mut wgpu::CommandEncoder, surfaces: Vec<SurfaceId>) {
         let state_bytes = surfaces.len() as u64 * STATE_WORDS * 4;
+        let dice_bytes = tessellate::gpu::counters_bytes(surfaces.len());
         let ts_bytes = if self.timestamps.is_some() {
             PASSES.len() as u64 * 16
         } else {
             0
         };
-        let need = (state_bytes + ts_bytes).max(16);
+        let need = (state_bytes + dice_bytes + ts_bytes).max(16);
         if self.stats.buffer.size() < need {
             self.stats.buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("render stats readback"),
@@ -1549,13 +1819,20 @@ impl Renderer {
                 state_bytes,
             );
         }
+        encoder.copy_buffer_to_buffer(
+            &self.tess.counters.buffer,
+            0,
+            &self.stats.buffer,
+            state_bytes,
+            dice_bytes,
+        );
         if let Some(ts) = &self.timestamps {
             encoder.resolve_query_set(&ts.set, 0..2 * PASSES.len() as u32, &ts.resolve, 0);
             encoder.copy_buffer_to_buffer(
                 &ts.resolve,
                 0,
                 &self.stats.buffer,
-                state_bytes,
+                state_bytes + dice_bytes,
                 ts_bytes,
             );
         }
@@ -1624,6 +1901,8 @@ impl Renderer {
                 .enumerate()
                 .map(|(s, &id)| {
                     let base = s * STATE_WORDS as usize;
+                    let args = n * STATE_WORDS as usize
+                        + (tessellate::ARGS_BASE + tessellate::ARGS_STRIDE * s as u64) as usize;
                     SurfaceShading {
                         surface: id,
                         material: if word(base + STATE_TOUCHED as usize) == 0 {
@@ -1632,12 +1911,14 @@ impl Renderer {
                             SnowMaterialKind::Deformable
                         },
                         deepest: f32::from_bits(word(base + STATE_DEEPEST as usize)),
+                        triangles: word(args) / 3,
                     }
                 })
                 .collect();
             let mut pass_times = Vec::new();
             if let (true, Some(ts)) = (self.stats.timestamps, &self.timestamps) {
-                let start = n * STATE_WORDS as usize * 4;
+                let start =
+                    n * STATE_WORDS as usize * 4 + tessellate::gpu::counters_bytes(n) as usize;
                 let tick = |i: usize| {
                     let o = start + 8 * i;
                     let mut b = [0u8; 8];
@@ -1655,6 +1936,9 @@ impl Renderer {
             FrameReport {
                 pass_times,
                 surfaces,
+                dice_overflow: word(
+                    n * STATE_WORDS as usize + tessellate::COUNTER_OVERFLOW as usize,
+                ),
             }
         };
         self.stats.buffer.unmap();
@@ -1881,32 +2165,162 @@ impl Renderer {
         let stale = self.heightfields.get(&id).is_none_or(|t| t.size != size);
         if stale {
             let texture = |label| {
-                self.device
-                    .create_texture(&wgpu::TextureDescriptor {
-                        label: Some(label),
-                        size: wgpu::Extent3d {
-                            width: size.0,
-                            height: size.1,
-                            depth_or_array_layers: 1,
-                        },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: HEIGHTFIELD_FORMAT,
-                        usage: wgpu::TextureUsages::STORAGE_BINDING
-                            | wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
-                    })
-                    .create_view(&Default::default())
+                self.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d {
+                        width: size.0,
+                        height: size.1,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: HEIGHTFIELD_FORMAT,
+                    usage: wgpu::TextureUsages::STORAGE_BINDING
+                        | wgpu::TextureUsages::TEXTURE_BINDING
+                        | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                })
             };
+            let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+            let shape = texture("snow heightfield");
+            let light = texture("snow heightfield light");
+            let bank = texture("snow banks");
+            let scratch = texture("snow bank scratch");
             let entry = HeightfieldTexture {
                 size,
-                shape: texture("snow heightfield"),
-                light: texture("snow heightfield light"),
+                shape: view(&shape),
+                light: view(&light),
+                bank: view(&bank),
+                bank_scratch: view(&scratch),
+                textures: [shape, light, bank],
             };
             self.heightfields.insert(id, entry);
         }
         &self.heightfields[&id]
+    }
+
+    /// The tessellated tier's per-frame tables: which surfaces are diced (none in the other
+    /// tiers), their base meshes, dicing and bank parameters, and room for the diced mesh.
+    fn prepare_tessellation(
+        &mut self,
+        world: &SnowWorld,
+        frame: &RenderFrame<'_>,
+        uniform: &FrameUniform,
+    ) -> RenderResult<Vec<bool>> {
+        let n = frame.surfaces.len();
+        let mut tessellated = vec![false; n];
+        self.tess
+            .counters
+            .ensure(&self.device, tessellate::gpu::counters_bytes(n));
+        self.last_surfaces = frame.surfaces.iter().map(|(id, _)| *id).collect();
+        if self.config.tier != Tier::Tessellated {
+            return Ok(tessellated);
+        }
+        let cfg = self.config;
+        let (iw, ih) = (cfg.width * cfg.supersample, cfg.height * cfg.supersample);
+        let proj = frame.camera.projection(iw as f32 / ih as f32, NEAR, FAR);
+        let pixels_per_radian = ih as f32 * 0.5 * proj.y_axis.y;
+        let view_proj = Mat4::from_cols_array_2d(&uniform.view_proj);
+        let vertex_capacity = cfg.dice.max_triangles;
+        let index_capacity = cfg.dice.max_triangles * 3;
+        self.tess.vertices.ensure(
+            &self.device,
+            vertex_capacity as u64 * tessellate::VERTEX_BYTES,
+        );
+        self.tess
+            .indices
+            .ensure(&self.device, index_capacity as u64 * 4);
+        let stride = UNIFORM_STRIDE as usize;
+        let mut bank_bytes = vec![0u8; n.max(1) * stride];
+        let mut dice_bytes = vec![0u8; n.max(1) * stride];
+        for (s, (id, _)) in frame.surfaces.iter().enumerate() {
+            let g = self.geometry.get(id).cloned().unwrap_or_default();
+            if !g.tessellate {
+                continue;
+            }
+            tessellated[s] = true;
+            let desc = world.surface(*id)?;
+            let layout = world.layout(*id)?;
+            let texel = glam::Vec2::new(
+                desc.size.x / layout.width as f32,
+                desc.size.y / layout.height as f32,
+            );
+            let half = desc.size * 0.5;
+            let key = ([half.x.to_bits(), half.y.to_bits()], self.geometry_version);
+            if self.base_meshes.get(id).is_none_or(|b| b.key != key) {
+                let mesh = match &g.mesh {
+                    Some(m) => {
+                        m.validate(half)?;
+                        m.clone()
+                    }
+                    None => SurfaceMesh::rectangle(half),
+                };
+                let triangles = mesh.base_triangles();
+                use wgpu::util::DeviceExt;
+                let buffer = self
+                    .device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("snow base mesh"),
+                        contents: bytemuck::cast_slice(&triangles),
+                        usage: wgpu::BufferUsages::STORAGE,
+                    });
+                self.base_meshes.insert(
+                    *id,
+                    BaseMeshGpu {
+                        buffer,
+                        triangles: triangles.len() as u32,
+                        key,
+                    },
+                );
+            }
+            let base = &self.base_meshes[id];
+            let local_to_world = desc.local_to_world();
+            let eye = local_to_world.inverse().transform_point3(frame.camera.eye);
+            let dice = tessellate::DiceParams {
+                local_to_clip: (view_proj * local_to_world).to_cols_array_2d(),
+                eye: [eye.x, eye.y, eye.z, pixels_per_radian],
+                settings: [
+                    cfg.dice.target_edge_pixels,
+                    cfg.dice.max_level as f32,
+                    0.5 * texel.min_element(),
+                    cfg.dice.detail_floor,
+                ],
+                // Banks stay below the snow depth in practice; waves reach 5 cm at most.
+                extent: [
+                    desc.snow_depth,
+                    desc.snow_depth + 0.05 * g.macro_waves,
+                    0.0,
+                    0.0,
+                ],
+                grid: [layout.width, layout.height, s as u32, base.triangles],
+                capacity: [vertex_capacity, index_capacity, 0, 0],
+                half_size: [half.x, half.y, 0.0, 0.0],
+            };
+            let bank = tessellate::BankParams::new(
+                layout.width,
+                layout.height,
+                texel,
+                desc.snow_depth,
+                g.banks,
+            );
+            let o = s * stride;
+            dice_bytes[o..o + std::mem::size_of::<tessellate::DiceParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&dice));
+            bank_bytes[o..o + std::mem::size_of::<tessellate::BankParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&bank));
+        }
+        self.tess
+            .dice_params
+            .ensure(&self.device, dice_bytes.len() as u64);
+        self.queue
+            .write_buffer(&self.tess.dice_params.buffer, 0, &dice_bytes);
+        self.tess
+            .bank_params
+            .ensure(&self.device, bank_bytes.len() as u64);
+        self.queue
+            .write_buffer(&self.tess.bank_params.buffer, 0, &bank_bytes);
+        Ok(tessellated)
     }
 
     fn frame_uniform(&self, frame: &RenderFrame<'_>, shadow: &ShadowCascades) -> FrameUniform {
@@ -1931,8 +2345,9 @@ impl Renderer {
                 color: v4(l.color, 0.0),
             };
         }
+        // Surfaces the tessellated tier does not tessellate are relief mapped.
         let tier = match cfg.tier {
-            Tier::Relief => 0,
+            Tier::Relief | Tier::Tessellated => 0,
             Tier::Pom => 1,
         };
         FrameUniform {
@@ -2017,7 +2432,14 @@ impl Renderer {
                     look.occlusion,
                     search.shadow_taps as f32,
                 ],
-                pattern: [desc.center.x, desc.center.z, 0.0, 0.0],
+                pattern: [
+                    desc.center.x,
+                    desc.center.z,
+                    0.0,
+                    self.geometry
+                        .get(id)
+                        .map_or(1.0, |g: &SurfaceGeometry| g.macro_waves),
+                ],
             };
             let o = s * UNIFORM_STRIDE as usize;
             surface_bytes[o..o + std::mem::size_of::<SurfaceUniform>()]
@@ -2072,6 +2494,7 @@ impl Renderer {
         }
         self.state_buffer
             .ensure(&self.device, n.max(1) as u64 * STATE_WORDS * 4);
+        let tessellated = self.prepare_tessellation(world, frame, &uniform)?;
 
         // Instances: all of them grouped by mesh, then the shadow casters grouped by mesh.
         let mut order: Vec<usize> = (0..frame.instances.len()).collect();
@@ -2223,6 +2646,96 @@ impl Renderer {
                 ],
             }));
         }
+        // The tessellated tier's bind groups, per diced surface: banks (two passes), dice, draw.
+        struct TessGroups {
+            norm: wgpu::BindGroup,
+            gather: wgpu::BindGroup,
+            dice: wgpu::BindGroup,
+            draw: wgpu::BindGroup,
+            triangles: u32,
+        }
+        let mut tess_bgs: Vec<Option<TessGroups>> = Vec::with_capacity(n);
+        for (s, (id, _)) in frame.surfaces.iter().enumerate() {
+            if !tessellated[s] {
+                tess_bgs.push(None);
+                continue;
+            }
+            let tex = &self.heightfields[id];
+            let base = &self.base_meshes[id];
+            let t = &self.tess;
+            let bank_params = buffer_slice(
+                &t.bank_params.buffer,
+                s,
+                std::mem::size_of::<tessellate::BankParams>(),
+            );
+            let tv = wgpu::BindingResource::TextureView;
+            let norm = bind_group(
+                dev,
+                "bank norm",
+                &t.bank_layout,
+                &[
+                    bank_params.clone(),
+                    tv(&tex.shape),
+                    tv(&tex.light),
+                    tv(&tex.bank),
+                    tv(&tex.bank_scratch),
+                ],
+            );
+            let gather = bind_group(
+                dev,
+                "bank gather",
+                &t.bank_layout,
+                &[
+                    bank_params,
+                    tv(&tex.shape),
+                    tv(&tex.light),
+                    tv(&tex.bank_scratch),
+                    tv(&tex.bank),
+                ],
+            );
+            let dice = bind_group(
+                dev,
+                "dice",
+                &t.dice_layout,
+                &[
+                    buffer_slice(
+                        &t.dice_params.buffer,
+                        s,
+                        std::mem::size_of::<tessellate::DiceParams>(),
+                    ),
+                    base.buffer.as_entire_binding(),
+                    tv(&tex.shape),
+                    tv(&tex.bank),
+                    self.state_buffer.buffer.as_entire_binding(),
+                    t.vertices.buffer.as_entire_binding(),
+                    t.indices.buffer.as_entire_binding(),
+                    t.counters.buffer.as_entire_binding(),
+                ],
+            );
+            let draw = bind_group(
+                dev,
+                "tessellated snow surface",
+                &t.surface_layout,
+                &[
+                    buffer_slice(
+                        &self.surface_buffer.buffer,
+                        s,
+                        std::mem::size_of::<SurfaceUniform>(),
+                    ),
+                    tv(&tex.shape),
+                    tv(&tex.light),
+                    tv(&tex.bank),
+                    self.state_buffer.buffer.as_entire_binding(),
+                ],
+            );
+            tess_bgs.push(Some(TessGroups {
+                norm,
+                gather,
+                dice,
+                draw,
+                triangles: base.triangles,
+            }));
+        }
         let tonemap_bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tonemap inputs"),
             layout: &self.tonemap_layout,
@@ -2285,6 +2798,44 @@ impl Renderer {
                 );
             }
         }
+        {
+            let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(PASSES[pass::BANKS].name),
+                timestamp_writes: compute_ts(pass::BANKS),
+            });
+            // Both bank passes run over the deformed surfaces only (the heightfield's dispatch).
+            for (pipeline, norm) in [
+                (&self.tess.bank_norm, true),
+                (&self.tess.bank_gather, false),
+            ] {
+                p.set_pipeline(pipeline);
+                for (s, g) in tess_bgs.iter().enumerate() {
+                    if let Some(g) = g {
+                        p.set_bind_group(0, if norm { &g.norm } else { &g.gather }, &[]);
+                        p.dispatch_workgroups_indirect(
+                            &self.state_buffer.buffer,
+                            (s as u64 * STATE_WORDS + STATE_HEIGHTFIELD_DISPATCH) * 4,
+                        );
+                    }
+                }
+            }
+        }
+        // Every surface's draw arguments start at zero, whatever the tier.
+        encoder.clear_buffer(&self.tess.counters.buffer, 0, None);
+        {
+            let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(PASSES[pass::DICE].name),
+                timestamp_writes: compute_ts(pass::DICE),
+            });
+            // One surface after the other: `seal` closes each surface's run of indices.
+            for g in tess_bgs.iter().flatten() {
+                p.set_bind_group(0, &g.dice, &[]);
+                p.set_pipeline(&self.tess.dice);
+                p.dispatch_workgroups(g.triangles.min(65535), g.triangles.div_ceil(65535), 1);
+                p.set_pipeline(&self.tess.seal);
+                p.dispatch_workgroups(1, 1, 1);
+            }
+        }
         let set_mesh = |p: &mut wgpu::RenderPass<'_>, mesh: &GpuMesh| {
             p.set_vertex_buffer(0, mesh.vertices.slice(..));
             p.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
@@ -2323,6 +2874,52 @@ impl Renderer {
                     let m = &self.meshes[*mesh as usize];
                     set_mesh(&mut p, m);
                     p.draw_indexed(0..m.index_count, 0, range.clone());
+                }
+            }
+        }
+        // The displaced snow into both cascades, over the meshes' shadows.
+        for cascade in 0..2 {
+            let writes = ts.map(|t| wgpu::RenderPassTimestampWrites {
+                query_set: &t.set,
+                beginning_of_pass_write_index: (cascade == 0)
+                    .then_some(2 * pass::SNOW_SHADOW as u32),
+                end_of_pass_write_index: (cascade == 1).then_some(2 * pass::SNOW_SHADOW as u32 + 1),
+            });
+            let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(if cascade == 0 {
+                    "snow shadow (near cascade)"
+                } else {
+                    "snow shadow (far cascade)"
+                }),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.cascade_views[cascade],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: writes,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if tess_bgs.iter().any(Option::is_some) {
+                p.set_pipeline(&self.tess.shadow[cascade]);
+                p.set_bind_group(0, &shadow_bg, &[]);
+                p.set_vertex_buffer(0, self.tess.vertices.buffer.slice(..));
+                p.set_index_buffer(
+                    self.tess.indices.buffer.slice(..),
+                    wgpu::IndexFormat::Uint32,
+                );
+                for (s, g) in tess_bgs.iter().enumerate() {
+                    if let Some(g) = g {
+                        p.set_bind_group(1, &g.draw, &[]);
+                        p.draw_indexed_indirect(
+                            &self.tess.counters.buffer,
+                            (tessellate::ARGS_BASE + tessellate::ARGS_STRIDE * s as u64) * 4,
+                        );
+                    }
                 }
             }
         }
@@ -2378,7 +2975,12 @@ impl Renderer {
                 label: Some(PASSES[pass::SNOW].name),
                 color_attachments: &attachments,
                 depth_stencil_attachment: depth(keep),
-                timestamp_writes: render_ts(pass::SNOW),
+                // The pass's time spans this render pass and the tessellated one after it.
+                timestamp_writes: ts.map(|t| wgpu::RenderPassTimestampWrites {
+                    query_set: &t.set,
+                    beginning_of_pass_write_index: Some(2 * pass::SNOW as u32),
+                    end_of_pass_write_index: None,
+                }),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -2389,11 +2991,47 @@ impl Renderer {
             ] {
                 p.set_pipeline(pipeline);
                 for (s, bg) in surface_bgs.iter().enumerate() {
+                    if tessellated[s] {
+                        continue;
+                    }
                     p.set_bind_group(1, bg, &[]);
                     p.draw_indirect(
                         &self.state_buffer.buffer,
                         (s as u64 * STATE_WORDS + offset) * 4,
                     );
+                }
+            }
+        }
+        {
+            let attachments = color(wgpu::LoadOp::Load);
+            let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("snow (tessellated)"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: depth(keep),
+                timestamp_writes: ts.map(|t| wgpu::RenderPassTimestampWrites {
+                    query_set: &t.set,
+                    beginning_of_pass_write_index: None,
+                    end_of_pass_write_index: Some(2 * pass::SNOW as u32 + 1),
+                }),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if tess_bgs.iter().any(Option::is_some) {
+                p.set_pipeline(&self.tess.draw);
+                p.set_bind_group(0, &frame_bg, &[]);
+                p.set_vertex_buffer(0, self.tess.vertices.buffer.slice(..));
+                p.set_index_buffer(
+                    self.tess.indices.buffer.slice(..),
+                    wgpu::IndexFormat::Uint32,
+                );
+                for (s, g) in tess_bgs.iter().enumerate() {
+                    if let Some(g) = g {
+                        p.set_bind_group(1, &g.draw, &[]);
+                        p.draw_indexed_indirect(
+                            &self.tess.counters.buffer,
+                            (tessellate::ARGS_BASE + tessellate::ARGS_STRIDE * s as u64) * 4,
+                        );
+                    }
                 }
             }
         }

@@ -32,6 +32,13 @@ pub fn heightfield() -> String {
     join(&[crate::pool::TEXEL_WGSL, HEIGHTFIELD])
 }
 
+/// Snow banks from the displaced channel (tessellated tier).
+pub const BANKS: &str = include_str!("tessellate/banks.wgsl");
+/// Dicing of the snow surfaces' meshes (tessellated tier).
+pub const DICE: &str = include_str!("tessellate/dice.wgsl");
+/// The tessellated tier's snow: displacement, shading, shadow.
+pub const TESS_SURFACE: &str = include_str!("tessellate/tess_surface.wgsl");
+
 fn join(parts: &[&str]) -> String {
     parts.join("\n")
 }
@@ -39,6 +46,12 @@ fn join(parts: &[&str]) -> String {
 /// Module of the snow pass.
 pub fn surface() -> String {
     join(&[FRAME, SNOW, SURFACE])
+}
+
+/// Module of the tessellated tier's snow and snow shadow passes (it reuses the snow pass's
+/// bindings and heightfield contract).
+pub fn tess_surface() -> String {
+    join(&[FRAME, SNOW, SURFACE, TESS_SURFACE])
 }
 
 /// Module of the shadow and opaque passes.
@@ -71,5 +84,8 @@ pub fn all() -> Vec<(&'static str, String)> {
         ("tonemap", tonemap()),
         ("classify", classify()),
         ("heightfield", heightfield()),
+        ("tess_surface", tess_surface()),
+        ("banks", BANKS.to_owned()),
+        ("dice", DICE.to_owned()),
     ]
 }

@@ -1,0 +1,105 @@
+// banks.wgsl: snow banks (berms) from the displaced-snow channel, the talk's "projected
+// displacement". A fraction of the snow each texel's captures pushed down is moved sideways onto
+// the snow around it, within the bank width, and the rest is compacted. Two passes per deformed
+// surface, both gathers (no atomics):
+//   bank_norm:   N(y) = sum over x within the bank width of K(x - y) m(x), how much room for banks
+//                there is around texel y. m(x) = receptivity: 1 on untouched snow, fading to a
+//                floor of RECEPTIVITY_FLOOR at the bottom of trails (snow is pushed onto the snow
+//                beside a trail, not back into it, unless nothing else is within reach).
+//   bank_gather: bank(x) = fraction * depth * m(x) * sum over y of displaced(y) K(x - y) / N(y).
+// Summing bank(x) over x gives fraction * depth * sum of displaced(y) exactly: every source gives
+// away exactly what it pushed, normalized over where it lands (texels outside the surface are not
+// receivers), so the volume of the banks is the fraction of the pushed volume, up to rounding.
+// Reads: the surface's heightfield textures (heightfield.wgsl: smoothed depression in .x, the
+// displaced channel in the light texture's .g). Writes: the bank scratch (N) and the bank texture
+// (metres of snow added, .x). CPU reference: render::tessellate::cpu::bank_field.
+
+// Must match `BankParams` in src/render/tessellate/mod.rs.
+struct BankParams {
+    width: u32,
+    height: u32,
+    reach_x: i32,        // kernel half-width in texels along x
+    reach_z: i32,
+    texel_x: f32,
+    texel_z: f32,
+    radius: f32,         // bank width, metres
+    fraction: f32,       // share of the pushed volume that goes into banks
+    snow_depth: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+// Must match RECEPTIVITY_FLOOR and receptivity() in cpu.rs.
+const RECEPTIVITY_FLOOR: f32 = 0.001;
+
+@group(0) @binding(0) var<uniform> bank: BankParams;
+@group(0) @binding(1) var shape: texture_2d<f32>;
+@group(0) @binding(2) var light: texture_2d<f32>;
+@group(0) @binding(3) var scratch_in: texture_2d<f32>;
+@group(0) @binding(4) var out_texture: texture_storage_2d<rgba16float, write>;
+
+fn inside(c: i32, r: i32) -> bool {
+    return c >= 0 && r >= 0 && c < i32(bank.width) && r < i32(bank.height);
+}
+
+// Must match `receptivity` in cpu.rs.
+fn receptivity(depression: f32) -> f32 {
+    return max(1.0 - smoothstep(0.05, 0.35, depression), RECEPTIVITY_FLOOR);
+}
+
+// Must match `bank_kernel` in cpu.rs: a smooth bump of radius `bank.radius`.
+fn kernel(dc: i32, dr: i32) -> f32 {
+    let d = vec2<f32>(f32(dc) * bank.texel_x, f32(dr) * bank.texel_z);
+    let q = dot(d, d) / (bank.radius * bank.radius);
+    if q >= 1.0 {
+        return 0.0;
+    }
+    return (1.0 - q) * (1.0 - q);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn bank_norm(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= bank.width || gid.y >= bank.height {
+        return;
+    }
+    let c = i32(gid.x);
+    let r = i32(gid.y);
+    var n = 0.0;
+    for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
+        for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
+            if inside(c + dc, r + dr) {
+                let k = kernel(dc, dr);
+                if k > 0.0 {
+                    n += k * receptivity(textureLoad(shape, vec2<i32>(c + dc, r + dr), 0).x);
+                }
+            }
+        }
+    }
+    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(n, 0.0, 0.0, 1.0));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn bank_gather(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= bank.width || gid.y >= bank.height {
+        return;
+    }
+    let c = i32(gid.x);
+    let r = i32(gid.y);
+    var sum = 0.0;
+    for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
+        for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
+            if inside(c + dc, r + dr) {
+                let k = kernel(dc, dr);
+                let p = vec2<i32>(c + dc, r + dr);
+                let d = textureLoad(light, p, 0).g;
+                if k > 0.0 && d > 0.0 {
+                    sum += d * k / max(textureLoad(scratch_in, p, 0).x, 1e-6);
+                }
+            }
+        }
+    }
+    let m = receptivity(textureLoad(shape, vec2<i32>(c, r), 0).x);
+    let h = bank.fraction * bank.snow_depth * m * sum;
+    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(h, 0.0, 0.0, 1.0));
+}

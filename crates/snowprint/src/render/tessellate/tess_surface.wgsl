@@ -1,0 +1,162 @@
+// tess_surface.wgsl: the tessellated tier's snow, drawn from the vertices `dice.wgsl` wrote.
+// The vertex stage displaces each vertex of the top to the snow there: the base height, plus the
+// snow depth minus the depression (the heightfield pass's smoothed depression), plus the banks
+// (banks.wgsl), plus the macro "waves" of snow.wgsl's `snow_macro_height` (the same function whose
+// normal the relief tier shades with), pressed flat where the snow is packed. Skirt vertices at
+// the base stay there. The fragment stage shades the real surface with the deformable material
+// (snow.wgsl) without any search: the heightmap's normal tilted by the banks' slope, RNM detail,
+// the heightmap's AO, and the moon's shadow from the shadow map, which holds this same displaced
+// geometry (vs_tess_shadow), so trails shadow themselves and characters' shadows bend into them.
+// Prepended: frame.wgsl, snow.wgsl, surface.wgsl (its bindings 0-2 of group 1 and heightfield
+// contract are reused).
+// Reads: frame uniforms, shadow map, the surface's heightfield, light and bank textures, the
+// surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade.
+
+@group(1) @binding(3) var bank_texture: texture_2d<f32>;
+@group(1) @binding(4) var<storage, read> surface_state: array<u32>;
+
+// Must match STATE_WORDS and STATE_TOUCHED in src/render/gpu.rs.
+const TESS_STATE_WORDS: u32 = 16u;
+const TESS_STATE_TOUCHED: u32 = 11u;
+// Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
+// Must match MACRO_MEAN in src/render/tessellate/cpu.rs.
+const MACRO_MEAN: f32 = 0.025;
+
+struct TessVertex {
+    @location(0) position: vec4<f32>,   // xyz local (y: the base), w: 0 top, 1 skirt top, 2 skirt base
+    @location(1) outward: vec4<f32>,    // skirts: outward normal (local xz in x and z)
+}
+
+struct TessVarying {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) local: vec3<f32>,
+    @location(1) @interpolate(flat) outward: vec4<f32>,   // w: 1 on skirts
+}
+
+fn tess_touched() -> bool {
+    return surface_state[surface.index * TESS_STATE_WORDS + TESS_STATE_TOUCHED] != 0u;
+}
+
+fn bank_texel(c: vec2<i32>) -> f32 {
+    let size = vec2<i32>(surface.grid);
+    return textureLoad(bank_texture, clamp(c, vec2<i32>(0), size - 1), 0).x;
+}
+
+// Bank height (metres) at uv, bilinear by hand (also usable in the vertex stage).
+fn bank_height(uv: vec2<f32>) -> f32 {
+    let p = uv * surface.grid - 0.5;
+    let i = floor(p);
+    let f = p - i;
+    let c = vec2<i32>(i);
+    let a = mix(bank_texel(c), bank_texel(c + vec2<i32>(1, 0)), f.x);
+    let b = mix(bank_texel(c + vec2<i32>(0, 1)), bank_texel(c + vec2<i32>(1, 1)), f.x);
+    return mix(a, b, f.y);
+}
+
+// Snow top above the base at local xz, metres: depth minus depression, plus banks, plus the
+// macro waves (scaled by pattern.w, flattened where the snow is pressed).
+fn tess_snow_height(xz: vec2<f32>) -> f32 {
+    var dep = 0.0;
+    var bank = 0.0;
+    if tess_touched() {
+        let uv = snow_uv(surface, xz);
+        dep = manual_bilinear(uv).x;
+        bank = bank_height(uv);
+    }
+    let flatten = 1.0 - smoothstep(0.0, 0.5, dep);
+    let waves = surface.pattern.w * (snow_macro_height(xz + surface.pattern.xy) - MACRO_MEAN) * flatten;
+    return surface.snow_depth * (1.0 - dep) + bank + waves;
+}
+
+fn tess_local(v: TessVertex) -> vec3<f32> {
+    var p = v.position.xyz;
+    if v.position.w < 1.5 {
+        p.y += tess_snow_height(p.xz);
+    }
+    return p;
+}
+
+@vertex
+fn vs_tess(v: TessVertex) -> TessVarying {
+    let p = tess_local(v);
+    var out: TessVarying;
+    out.clip = frame.view_proj * (surface.local_to_world * vec4<f32>(p, 1.0));
+    out.local = p;
+    out.outward = vec4<f32>(v.outward.xyz, select(0.0, 1.0, v.position.w > 0.5));
+    return out;
+}
+
+// Which shadow cascade a shadow pipeline renders (0 near, 1 far).
+override TESS_SHADOW_CASCADE: u32 = 0u;
+
+@vertex
+fn vs_tess_shadow(v: TessVertex) -> @builtin(position) vec4<f32> {
+    var m = frame.shadow_far;
+    if TESS_SHADOW_CASCADE == 0u {
+        m = frame.shadow_near;
+    }
+    return m * (surface.local_to_world * vec4<f32>(tess_local(v), 1.0));
+}
+
+// Slope of the banks at uv (metres per metre along local x and z), central differences.
+fn bank_gradient(uv: vec2<f32>) -> vec2<f32> {
+    let du = vec2<f32>(1.0 / surface.grid.x, 0.0);
+    let dv = vec2<f32>(0.0, 1.0 / surface.grid.y);
+    let step = 2.0 * surface.half_size / surface.grid;
+    return vec2<f32>(
+        (bank_height(uv + du) - bank_height(uv - du)) / (2.0 * step.x),
+        (bank_height(uv + dv) - bank_height(uv - dv)) / (2.0 * step.y),
+    );
+}
+
+@fragment
+fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
+    let pixel = length(fwidth(in.local));
+    var m: SnowSample;
+    var hf = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    if in.outward.w > 0.5 {
+        // A skirt: the cut through the snow at an open edge, as the relief tier's box sides.
+        let face = normalize(vec3<f32>(in.outward.x, 0.0, in.outward.z));
+        m = snow_basic(surface, in.local, face, sky_tint(), pixel);
+    } else {
+        let uv = snow_uv(surface, in.local.xz);
+        if tess_touched() {
+            hf = snow_heightfield(surface, uv);
+            // The heightmap's normal tilted by the banks' slope.
+            let ny = max(sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)), 1e-3);
+            let g = vec2<f32>(-hf.y, -hf.z) / ny + bank_gradient(uv);
+            let n = normalize(vec3<f32>(-g.x, 1.0, -g.y));
+            hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
+        }
+        var hit: SnowHit;
+        // The depression drives the stages; the height of the hit is the filtered one.
+        hit.position = vec3<f32>(in.local.x, surface.snow_depth, in.local.z);
+        hit.found = 1u;
+        hit.side = 0u;
+        hit.shadow = 1.0;
+        hit.taps = 0u;
+        hit.t = 0.0;
+        m = snow_deformable(surface, hit, hf, vec3<f32>(0.0, 1.0, 0.0), sky_tint(), pixel);
+    }
+    var c = shade(m, in.local, 1.0);
+    switch frame.options.x {
+        case DEBUG_MATERIALS: {
+            c = mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
+        }
+        case DEBUG_DEPRESSION: {
+            c = debug_ramp(hf.x);
+        }
+        case DEBUG_OCCLUSION: {
+            c = vec3<f32>(m.ao);
+        }
+        case DEBUG_NORMALS: {
+            c = m.normal * 0.5 + 0.5;
+        }
+        case DEBUG_TAPS: {
+            // No search in this tier.
+            c = debug_ramp(0.0);
+        }
+        default: {}
+    }
+    return vec4<f32>(c, 1.0);
+}
