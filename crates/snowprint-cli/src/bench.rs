@@ -45,6 +45,9 @@ pub struct Row {
     pub fused: bool,
     /// Bits a channel of the pool.
     pub precision_bits: u32,
+    /// Snow refilling fast enough that every texel changes every frame, so no tile is skipped
+    /// (else only the tiles the deformers reach are updated).
+    pub snowing: bool,
     /// Median GPU time of the whole update, microseconds (or whole frames timed on the CPU).
     pub update_us: f64,
     /// Median GPU time per stage, microseconds.
@@ -217,6 +220,7 @@ struct Config {
     deformers: u32,
     passes: PassMode,
     precision: Precision,
+    snowing: bool,
 }
 
 fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
@@ -245,12 +249,11 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             (i / 64) as f32 * (side + 1.0),
         );
         let id = world
-            .add_surface(SurfaceDesc::new(
-                &format!("s{i}"),
-                center.into(),
-                [side, side],
-                0.3,
-            ))
+            .add_surface(SurfaceDesc {
+                // 30% of the depth a second: at least one unit a frame at 60 Hz even at 8 bits.
+                replenish_rate: if c.snowing { 0.3 } else { 0.0 },
+                ..SurfaceDesc::new(&format!("s{i}"), center.into(), [side, side], 0.3)
+            })
             .map_err(|e| e.to_string())?;
         ids.push(id);
         centers.push(center);
@@ -320,6 +323,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         deformers_per_surface: c.deformers,
         fused: world.config().passes == PassMode::Fused,
         precision_bits: c.precision.bits(),
+        snowing: c.snowing,
         update_us,
         stages_us: timestamps.then(|| StageTimesUs {
             capture: median(&mut cap),
@@ -363,16 +367,19 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         deformers,
         passes,
         precision: Precision::Bits16,
+        snowing: false,
     };
     let at = |precision, c: Config| Config { precision, ..c };
+    let snowing = |c: Config| Config { snowing: true, ..c };
     // The talk's frame, fused and as separate passes, at each precision; the sweeps use the
     // device's default passes and 16 bits.
     let (auto, fused, separate) = (PassMode::Auto, PassMode::Fused, PassMode::Separate);
     let mut configs = vec![
         cfg("talk_budget", 2, 512, 10, fused),
-        cfg("talk_budget", 2, 512, 10, separate),
-        at(Precision::Bits8, cfg("talk_budget", 2, 512, 10, fused)),
-        at(Precision::Bits32, cfg("talk_budget", 2, 512, 10, fused)),
+        snowing(cfg("talk_budget", 2, 512, 10, fused)),
+        snowing(cfg("talk_budget", 2, 512, 10, separate)),
+        snowing(at(Precision::Bits8, cfg("talk_budget", 2, 512, 10, fused))),
+        snowing(at(Precision::Bits32, cfg("talk_budget", 2, 512, 10, fused))),
     ];
     let (counts, resolutions, deformers): (&[u32], &[u32], &[u32]) = if quick {
         (&[1, 4, 16], &[64, 128, 256], &[1, 10, 100])
@@ -383,18 +390,31 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             &[1, 10, 100, 1000],
         )
     };
-    configs.extend(counts.iter().map(|&n| cfg("surfaces", n, 128, 10, auto)));
+    // The sweeps keep snow falling so that every texel is updated, as the copy baseline is.
+    configs.extend(
+        counts
+            .iter()
+            .map(|&n| snowing(cfg("surfaces", n, 128, 10, auto))),
+    );
     configs.extend(
         resolutions
             .iter()
-            .map(|&r| cfg("resolution", 16, r, 10, auto)),
+            .map(|&r| snowing(cfg("resolution", 16, r, 10, auto))),
     );
-    configs.extend(deformers.iter().map(|&d| cfg("deformers", 2, 512, d, auto)));
+    configs.extend(
+        deformers
+            .iter()
+            .map(|&d| snowing(cfg("deformers", 2, 512, d, auto))),
+    );
     if !quick {
         // The 1024 surfaces of 512^2: 1 GiB of heights at 16 bits, 512 MiB at 8.
         configs.push(cfg("many_512", 1024, 512, 1, fused));
-        configs.push(cfg("many_512", 1024, 512, 1, separate));
-        configs.push(at(Precision::Bits8, cfg("many_512", 1024, 512, 1, fused)));
+        configs.push(snowing(cfg("many_512", 1024, 512, 1, fused)));
+        configs.push(snowing(cfg("many_512", 1024, 512, 1, separate)));
+        configs.push(snowing(at(
+            Precision::Bits8,
+            cfg("many_512", 1024, 512, 1, fused),
+        )));
     }
     let bar = ProgressBar::new(configs.len() as u64);
     bar.set_style(
@@ -423,10 +443,11 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         }
     );
     println!(
-        "{:<12} {:>5} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}",
+        "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}",
         "sweep",
         "mode",
         "bits",
+        "snow",
         "surfaces",
         "res",
         "defs",
@@ -444,10 +465,11 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<12} {:>5} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2}",
+            "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2}",
             r.sweep,
             if r.fused { "fused" } else { "split" },
             r.precision_bits,
+            if r.snowing { "yes" } else { "no" },
             r.surfaces,
             r.resolution,
             r.deformers_per_surface,
