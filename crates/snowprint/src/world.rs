@@ -75,15 +75,15 @@ pub struct WorldConfig {
 /// How the accumulation chain is dispatched.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub enum PassMode {
-    /// Fused on GPUs, separate on software adapters (the default).
+    /// The default: fused, which is the faster on every adapter measured (an H100 and llvmpipe:
+    /// `docs/PERFORMANCE.md`).
     #[default]
     Auto,
     /// Blur and merge in one pass: one dispatch instead of two and no scratch round trip, at the
     /// price of staging each tile's capture apron in workgroup memory, which suits GPUs, where a
     /// pass costs more than its memory traffic. (Normals, when kept, follow in their own pass.)
     Fused,
-    /// Separate passes; [`SnowWorld::read_last_blurred`] can then show stage 1's output. Cheaper on
-    /// software adapters, where every load counts and a pass costs little.
+    /// Separate passes; [`SnowWorld::read_last_blurred`] can then show stage 1's output.
     Separate,
 }
 
@@ -299,11 +299,7 @@ impl SnowWorld {
         }
         config.atlas_side = config.atlas_side.clamp(64, gpu.caps.max_texture_side);
         if config.passes == PassMode::Auto {
-            config.passes = if gpu.info.device_type == wgpu::DeviceType::Cpu {
-                PassMode::Separate
-            } else {
-                PassMode::Fused
-            };
+            config.passes = PassMode::Fused;
         }
         config.max_resolution = config.max_resolution.clamp(1, config.atlas_side);
         let alloc = SlotAllocator::new(config.pool_bytes);
