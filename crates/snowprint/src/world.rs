@@ -250,6 +250,8 @@ pub struct SnowWorld {
     winding: Growable,
     /// One flag per 16x16 tile of each captured surface: set by the capture where it wrote.
     tiles: Growable,
+    /// The flagged tiles as a list with its indirect dispatch (see `accumulate::TILE_LIST_HEADER`).
+    tile_list: Growable,
     scratch: Growable,
     last: LastFrame,
     profiling: bool,
@@ -376,6 +378,12 @@ impl SnowWorld {
                 4 * 4096,
             ),
             tiles: Growable::new(&device, "capture tiles", U::STORAGE | U::COPY_DST, 4 * 256),
+            tile_list: Growable::new(
+                &device,
+                "capture tile list",
+                U::STORAGE | U::INDIRECT | U::COPY_DST,
+                4 * 512,
+            ),
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
             queue: gpu.queue.clone(),
             caps: gpu.caps.clone(),
@@ -563,7 +571,8 @@ impl SnowWorld {
                 + self.draws.buffer.size()
                 + self.capture.buffer.size()
                 + self.winding.buffer.size()
-                + self.tiles.buffer.size(),
+                + self.tiles.buffer.size()
+                + self.tile_list.buffer.size(),
             format: self.config.format,
         }
     }
@@ -733,6 +742,14 @@ impl SnowWorld {
                 draws: d0..draws.len() as u32,
             });
         }
+        // Surfaces that refill snow first: the fused grid covers records 0..dense; the others are
+        // updated only where the capture listed a tile.
+        jobs.sort_by_key(|j| j.record.replenish_units == 0);
+        let dense = jobs
+            .iter()
+            .take_while(|j| j.record.replenish_units > 0)
+            .count() as u32;
+        let listed = jobs[dense as usize..].iter().any(|j| j.captured);
         let mut stats = FrameStats {
             updated: jobs.len() as u32,
             primitives: prims.len() as u32,
@@ -789,7 +806,8 @@ impl SnowWorld {
                 texels: [r.width as f32, r.height as f32],
                 tiles: r.tiles,
                 tiles_x: r.width.div_ceil(FUSED_WORKGROUP),
-                pad: [0; 2],
+                record: j as u32,
+                pad: 0,
             };
             let o = k * UNIFORM_STRIDE as usize;
             let size = std::mem::size_of::<CaptureView>();
@@ -822,6 +840,10 @@ impl SnowWorld {
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
         self.tiles
             .ensure(&self.device, (tiles_len.max(1) as u64) * 4);
+        self.tile_list.ensure(
+            &self.device,
+            (accumulate::TILE_LIST_HEADER + 2 * tiles_len as u64) * 4,
+        );
 
         let atlas_index = self.atlas(atlas_side);
         let atlas_view = &self.atlases[atlas_index].2;
@@ -855,6 +877,10 @@ impl SnowWorld {
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: self.tiles.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: self.tile_list.buffer.as_entire_binding(),
                 },
             ],
         });
@@ -915,7 +941,14 @@ impl SnowWorld {
                 pool.as_entire_binding(),
                 winding.as_entire_binding(),
                 self.tiles.buffer.as_entire_binding(),
+                self.tile_list.buffer.as_entire_binding(),
             ],
+        );
+        let seal_bg = bind_group(
+            &self.device,
+            "seal",
+            &self.acc.seal_layout,
+            &[self.tile_list.buffer.as_entire_binding()],
         );
         let ts = if self.profiling {
             self.timestamps.as_ref()
@@ -942,6 +975,11 @@ impl SnowWorld {
         enc.clear_buffer(&self.capture.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
         enc.clear_buffer(&self.winding.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
         enc.clear_buffer(&self.tiles.buffer, 0, Some(tiles_len.max(1) as u64 * 4));
+        enc.clear_buffer(
+            &self.tile_list.buffer,
+            0,
+            Some(accumulate::TILE_LIST_HEADER * 4),
+        );
         for batch in 0..batches {
             let q = next_query(Stage::Capture, &mut stages);
             {
@@ -1034,13 +1072,30 @@ impl SnowWorld {
                     end_of_pass_write_index: Some(q + 1),
                 }),
             });
-            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, bg, &[]);
-            let side = if matches!(stage, Stage::Fused) {
-                FUSED_WORKGROUP
-            } else {
-                WORKGROUP
-            };
+            if matches!(stage, Stage::Fused) {
+                // Every tile of the surfaces that refill snow; then only the listed tiles of the
+                // others, as many workgroups as the capture listed.
+                if dense > 0 {
+                    pass.set_pipeline(pipeline);
+                    pass.dispatch_workgroups(
+                        max_w.div_ceil(FUSED_WORKGROUP),
+                        max_h.div_ceil(FUSED_WORKGROUP),
+                        dense,
+                    );
+                }
+                if listed {
+                    pass.set_pipeline(&self.acc.seal);
+                    pass.set_bind_group(0, &seal_bg, &[]);
+                    pass.dispatch_workgroups(1, 1, 1);
+                    pass.set_pipeline(&self.acc.fused_listed);
+                    pass.set_bind_group(0, bg, &[]);
+                    pass.dispatch_workgroups_indirect(&self.tile_list.buffer, 0);
+                }
+                continue;
+            }
+            pass.set_pipeline(pipeline);
+            let side = WORKGROUP;
             let units_w = if matches!(stage, Stage::Merge) {
                 max_w.div_ceil(unit)
             } else {

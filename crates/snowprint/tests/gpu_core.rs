@@ -936,6 +936,51 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
     }
 }
 
+/// One fused update of surfaces that refill snow (every tile, by the grid) and surfaces that do not
+/// (only the tiles the capture listed): each agrees with the separate passes, frame after frame, and
+/// the still surfaces keep their earlier prints where nothing presses them again.
+#[test]
+fn fused_update_mixes_snowing_and_still_surfaces() {
+    let mut fused = world_with(CaptureMode::Depth, true);
+    let mut separate = world_with(CaptureMode::Depth, false);
+    let mut ids = Vec::new();
+    for (i, rate) in [0.0, 0.4, 0.0, 0.2].into_iter().enumerate() {
+        let mut desc = SurfaceDesc::new("m", [i as f32 * 8.0, 0.0, 0.0], [5.0, 4.0], 0.3);
+        desc.replenish_rate = rate;
+        ids.push((
+            fused.add_surface(desc.clone()).unwrap(),
+            separate.add_surface(desc.clone()).unwrap(),
+            desc,
+        ));
+    }
+    for frame in 0..4usize {
+        // Each frame presses the crowd's members from `frame % 3` on, over every surface.
+        let deformers: Vec<Deformer> = ids
+            .iter()
+            .flat_map(|(_, _, d)| crowd(d.center).into_iter().skip(frame % 3))
+            .collect();
+        fused.step(0.1, &deformers).unwrap();
+        separate.step(0.1, &deformers).unwrap();
+        for (a, b, desc) in &ids {
+            let (g, c) = (
+                fused.read_channels(*a).unwrap(),
+                separate.read_channels(*b).unwrap(),
+            );
+            let worst = (0..g.0.len())
+                .map(|i| g.0[i].abs_diff(c.0[i]).max(g.1[i].abs_diff(c.1[i])))
+                .max()
+                .unwrap_or(0);
+            assert!(
+                worst <= 1,
+                "frame {frame}, surface at {:?} (refill {}): {worst} units apart",
+                desc.center,
+                desc.replenish_rate
+            );
+            assert!(g.0.iter().any(|&v| v > 0));
+        }
+    }
+}
+
 /// An animated mesh is given as posed vertices each frame: the capture follows the new vertices.
 #[test]
 fn posed_mesh_vertices_move_the_imprint() {

@@ -3,10 +3,13 @@
 // (18x18) in workgroup memory, blurs each texel from there, then merges the tile's units (two
 // texels along x at 8 bits, one otherwise; 16 is even, so a unit never straddles tiles) into the
 // heights region. A texel's new value depends only on its own old value, so updating in place is
-// safe whatever order the workgroups run in. A tile whose flag the capture left unset, on a
-// surface with no snow to refill, is left alone: its workgroup reads one word and leaves.
-// Reads: `records`, `tiles`, `capture`, `winding`, each record's heights region in `pool`.
-// Writes: the same heights region.
+// safe whatever order the workgroups run in.
+// Two entry points share that work: `fused`, a grid over every tile of the records that refill snow
+// (their every texel changes; a tile the capture did not flag skips the capture buffers), and
+// `fused_listed`, one workgroup per tile in the capture's tile list for the records that do not
+// (only what a deformer reached changes), dispatched indirectly (seal.wgsl writes the arguments).
+// Reads: `records`, `tiles`, `tile_list`, `capture`, `winding`, each record's heights in `pool`.
+// Writes: the same heights regions.
 // CPU reference: accumulate::cpu::blur then merge_channels. Maths: maths.wgsl, capture_read.wgsl.
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
@@ -14,6 +17,7 @@
 @group(0) @binding(2) var<storage, read_write> pool: array<u32>;
 @group(0) @binding(3) var<storage, read> winding: array<i32>;
 @group(0) @binding(4) var<storage, read> tiles: array<u32>;
+@group(0) @binding(5) var<storage, read> tile_list: array<u32>;
 
 const SIDE: i32 = 16;
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
@@ -41,7 +45,31 @@ fn fused(
     if !has_capture && rec.replenish_units == 0u {
         return;
     }
-    let tile = vec2<i32>(wid.xy) * SIDE;
+    update_tile(rec, wid.xy, has_capture, lid, local.xy);
+}
+
+@compute @workgroup_size(16, 16, 1)
+fn fused_listed(
+    @builtin(local_invocation_index) lid: u32,
+    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(workgroup_id) wid: vec3<u32>,
+) {
+    let i = wid.x + wid.y * 65535u;
+    if i >= tile_list[3] {
+        return;
+    }
+    let rec = records[tile_list[4u + 2u * i]];
+    // A record that refills snow has all its tiles updated by `fused`.
+    if rec.replenish_units != 0u {
+        return;
+    }
+    let t = tile_list[5u + 2u * i];
+    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, lid, local.xy);
+}
+
+// Blur and merge one tile of a surface, in place. Called from uniform control flow.
+fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, lid: u32, local: vec2<u32>) {
+    let tile = vec2<i32>(tile_id) * SIDE;
     let dep_origin = tile - vec2<i32>(1);
     if has_capture {
         for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {

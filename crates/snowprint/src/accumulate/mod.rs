@@ -26,8 +26,13 @@ pub const BLUR_SHADER: &str = include_str!("blur.wgsl");
 pub const MERGE_SHADER: &str = include_str!("merge.wgsl");
 /// Normals (without the shared prelude).
 pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
-/// All three in one pass (without the shared prelude).
+/// Blur and merge in one pass (without the shared prelude).
 pub const FUSED_SHADER: &str = include_str!("fused.wgsl");
+/// The indirect arguments of the listed fused pass (without the shared prelude).
+pub const SEAL_SHADER: &str = include_str!("seal.wgsl");
+/// Words before the entries of the capture's tile list: the dispatch arguments and the count.
+/// Must match `capture.wgsl`, `fused.wgsl` and `seal.wgsl`.
+pub const TILE_LIST_HEADER: u64 = 4;
 /// The arithmetic shared by every stage.
 pub const MATHS: &str = include_str!("maths.wgsl");
 /// Reading the capture buffer (for the passes that bind it).
@@ -66,15 +71,21 @@ pub struct AccumulatePipelines {
     pub merge: wgpu::ComputePipeline,
     /// Normals.
     pub normals: wgpu::ComputePipeline,
-    /// Blur and merge fused.
+    /// Blur and merge fused, over every tile of the records that refill snow.
     pub fused: wgpu::ComputePipeline,
+    /// Blur and merge fused, over the capture's listed tiles of the records that do not.
+    pub fused_listed: wgpu::ComputePipeline,
+    /// Writes the listed pass's indirect dispatch.
+    pub seal: wgpu::ComputePipeline,
+    /// Layout of the seal's group 0: the tile list.
+    pub seal_layout: wgpu::BindGroupLayout,
     /// Layout of the blur's group 0.
     pub blur_layout: wgpu::BindGroupLayout,
     /// Layout of the merge's group 0.
     pub merge_layout: wgpu::BindGroupLayout,
     /// Layout of the normals' group 0.
     pub normals_layout: wgpu::BindGroupLayout,
-    /// Layout of the fused pass's group 0: records, capture, pool, winding, tile flags.
+    /// Layout of the fused passes' group 0: records, capture, pool, winding, tile flags, tile list.
     pub fused_layout: wgpu::BindGroupLayout,
 }
 
@@ -106,7 +117,12 @@ impl AccumulatePipelines {
                 compute_storage(2, false),
                 compute_storage(3, true),
                 compute_storage(4, true),
+                compute_storage(5, true),
             ],
+        });
+        let seal_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("seal"),
+            entries: &[compute_storage(0, false)],
         });
         let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("normals"),
@@ -141,6 +157,9 @@ impl AccumulatePipelines {
             merge: make("merge", MERGE_SHADER, &merge_layout),
             normals: make("normals", NORMALS_SHADER, &normals_layout),
             fused: make("fused", FUSED_SHADER, &fused_layout),
+            fused_listed: make("fused_listed", FUSED_SHADER, &fused_layout),
+            seal: make("seal_tiles", SEAL_SHADER, &seal_layout),
+            seal_layout,
             blur_layout,
             merge_layout,
             normals_layout,
@@ -161,6 +180,7 @@ mod tests {
             ("merge", with_prelude(MERGE_SHADER)),
             ("normals", with_prelude(NORMALS_SHADER)),
             ("fused", with_prelude(FUSED_SHADER)),
+            ("seal", with_prelude(SEAL_SHADER)),
             ("capture", crate::capture::SHADER.to_owned()),
         ] {
             let module = naga::front::wgsl::parse_str(&src)

@@ -9,7 +9,9 @@
 // Writes: `capture`, the surface's texels at `view.offset` (cleared to 0 = nothing before the pass),
 // and `winding` at the same texels (cleared to 0): how many mesh solids contain the ground point
 // under each texel; `tiles` at `view.tiles` (cleared to 0): 1 for every 16x16 tile of the update
-// whose blur reads a texel written here, so the fused update skips the tiles nothing touched.
+// whose blur reads a texel written here, so the fused update skips the tiles nothing touched; and
+// `tile_list` (count cleared to 0): each tile the first time it is flagged, as (record, tile), so
+// the update can be dispatched over the flagged tiles alone.
 
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
@@ -19,7 +21,8 @@ struct CaptureView {
     texels: vec2<f32>,      // the surface's heightmap width and height
     tiles: u32,             // first tile flag of the surface in `tiles`
     tiles_x: u32,           // tiles a row
-    pad: vec2<u32>,
+    record: u32,            // the surface's record in the update
+    pad: u32,
 }
 // Must match `CaptureView` in capture/mod.rs.
 
@@ -40,6 +43,10 @@ struct Primitive {
 @group(0) @binding(2) var<storage, read_write> capture: array<atomic<u32>>;
 @group(0) @binding(3) var<storage, read_write> winding: array<atomic<i32>>;
 @group(0) @binding(4) var<storage, read_write> tiles: array<atomic<u32>>;
+// Words 0-2: indirect dispatch arguments (written by the update's seal pass); 3: entries; from 4:
+// two words an entry, the record and (tile y << 16 | tile x). Must match TILE_LIST_HEADER in
+// accumulate/mod.rs.
+@group(0) @binding(5) var<storage, read_write> tile_list: array<atomic<u32>>;
 
 // Side of the update's tiles. Must match FUSED_WORKGROUP in accumulate/mod.rs.
 const TILE: u32 = 16u;
@@ -52,7 +59,13 @@ fn mark_tiles(frag: vec2<f32>) {
     let t1 = vec2<u32>(clamp(cell + vec2<i32>(1), vec2<i32>(0), last)) / TILE;
     for (var ty = t0.y; ty <= t1.y; ty++) {
         for (var tx = t0.x; tx <= t1.x; tx++) {
-            atomicStore(&tiles[view.tiles + ty * view.tiles_x + tx], 1u);
+            let i = view.tiles + ty * view.tiles_x + tx;
+            // Most fragments find their tiles flagged already: only the first lists a tile.
+            if atomicLoad(&tiles[i]) == 0u && atomicExchange(&tiles[i], 1u) == 0u {
+                let n = atomicAdd(&tile_list[3], 1u);
+                atomicStore(&tile_list[4u + 2u * n], view.record);
+                atomicStore(&tile_list[5u + 2u * n], (ty << 16u) | tx);
+            }
         }
     }
 }

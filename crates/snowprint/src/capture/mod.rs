@@ -65,8 +65,10 @@ pub struct CaptureView {
     pub tiles: u32,
     /// Tiles a row (16x16 texels each).
     pub tiles_x: u32,
+    /// The surface's record in the update (listed with each flagged tile).
+    pub record: u32,
     /// Padding to the uniform's 16-byte size.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// An analytic deformer in surface-local coordinates. Must match `Primitive` in `capture.wgsl`.
@@ -320,6 +322,7 @@ impl CapturePipelines {
                 fragment_storage(2),
                 fragment_storage(3),
                 fragment_storage(4),
+                fragment_storage(5),
             ],
         });
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -1,0 +1,13 @@
+// The indirect dispatch of `fused_listed` (fused.wgsl): one workgroup per entry of the capture's
+// tile list, in rows of 65535 (the largest dispatch along one axis).
+// Reads: the list's entry count (word 3). Writes: the dispatch arguments (words 0-2).
+
+@group(0) @binding(0) var<storage, read_write> tile_list: array<u32>;
+
+@compute @workgroup_size(1, 1, 1)
+fn seal_tiles() {
+    let n = tile_list[3];
+    tile_list[0] = min(n, 65535u);
+    tile_list[1] = (n + 65534u) / 65535u;
+    tile_list[2] = 1u;
+}
