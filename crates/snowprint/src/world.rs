@@ -68,6 +68,13 @@ pub struct WorldConfig {
     pub max_resolution: u32,
     /// How blur, merge and normals are dispatched.
     pub passes: PassMode,
+    /// With [`PassMode::Fused`], the fewest tiles (16x16 texels) of captured surfaces that do not
+    /// refill snow for which the update is dispatched over the capture's list of touched tiles
+    /// rather than over every tile (where untouched ones leave at once). The list costs a fixed
+    /// few microseconds (an extra dispatch and an indirect one), a skipped tile under a
+    /// nanosecond: default 16384 (sixteen 512^2 surfaces), from the H100 figures in
+    /// `docs/PERFORMANCE.md`. 0 always lists; `u32::MAX` never does.
+    pub list_tiles_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
 }
@@ -95,6 +102,7 @@ impl Default for WorldConfig {
             atlas_side: 2048,
             max_resolution: crate::surface::MAX_RESOLUTION,
             passes: PassMode::Auto,
+            list_tiles_from: 16384,
             format: PoolFormat::default(),
         }
     }
@@ -749,7 +757,19 @@ impl SnowWorld {
             .iter()
             .take_while(|j| j.record.replenish_units > 0)
             .count() as u32;
-        let listed = jobs[dense as usize..].iter().any(|j| j.captured);
+        let still_tiles: u64 = jobs[dense as usize..]
+            .iter()
+            .filter(|j| j.captured)
+            .map(|j| {
+                let r = &j.record;
+                (r.width.div_ceil(FUSED_WORKGROUP) * r.height.div_ceil(FUSED_WORKGROUP)) as u64
+            })
+            .sum();
+        let listed = self.config.passes == PassMode::Fused
+            && still_tiles > 0
+            && still_tiles >= self.config.list_tiles_from as u64;
+        // Without the list, the grid covers every record.
+        let grid = if listed { dense } else { jobs.len() as u32 };
         let mut stats = FrameStats {
             updated: jobs.len() as u32,
             primitives: prims.len() as u32,
@@ -806,7 +826,7 @@ impl SnowWorld {
                 texels: [r.width as f32, r.height as f32],
                 tiles: r.tiles,
                 tiles_x: r.width.div_ceil(FUSED_WORKGROUP),
-                record: j as u32,
+                record: if listed { j as u32 } else { capture::NO_LIST },
                 pad: 0,
             };
             let o = k * UNIFORM_STRIDE as usize;
@@ -1076,12 +1096,12 @@ impl SnowWorld {
             if matches!(stage, Stage::Fused) {
                 // Every tile of the surfaces that refill snow; then only the listed tiles of the
                 // others, as many workgroups as the capture listed.
-                if dense > 0 {
+                if grid > 0 {
                     pass.set_pipeline(pipeline);
                     pass.dispatch_workgroups(
                         max_w.div_ceil(FUSED_WORKGROUP),
                         max_h.div_ceil(FUSED_WORKGROUP),
-                        dense,
+                        grid,
                     );
                 }
                 if listed {

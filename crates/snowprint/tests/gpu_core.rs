@@ -29,6 +29,16 @@ fn world_with(mode: CaptureMode, fused: bool) -> SnowWorld {
 }
 
 fn world_format(mode: CaptureMode, fused: bool, format: PoolFormat) -> SnowWorld {
+    world_listing(mode, fused, format, WorldConfig::default().list_tiles_from)
+}
+
+/// A world whose fused update lists touched tiles from `list_tiles_from` tiles on (0: always).
+fn world_listing(
+    mode: CaptureMode,
+    fused: bool,
+    format: PoolFormat,
+    list_tiles_from: u32,
+) -> SnowWorld {
     SnowWorld::new(
         common::gpu(),
         WorldConfig {
@@ -44,6 +54,7 @@ fn world_format(mode: CaptureMode, fused: bool, format: PoolFormat) -> SnowWorld
                 PassMode::Separate
             },
             format,
+            list_tiles_from,
             ..Default::default()
         },
     )
@@ -862,7 +873,8 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
             precision,
             normals: true,
         };
-        let mut fused = world_format(CaptureMode::Depth, true, format);
+        // Always listing: the cases without snowfall update only the listed tiles.
+        let mut fused = world_listing(CaptureMode::Depth, true, format, 0);
         let mut separate = world_format(CaptureMode::Depth, false, format);
         let mut desc = SurfaceDesc::new("f", [0.5, 2.0, 1.0], size, 0.3);
         desc.yaw_degrees = yaw;
@@ -937,11 +949,19 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
 }
 
 /// One fused update of surfaces that refill snow (every tile, by the grid) and surfaces that do not
-/// (only the tiles the capture listed): each agrees with the separate passes, frame after frame, and
-/// the still surfaces keep their earlier prints where nothing presses them again.
+/// (only the tiles the capture listed, or the grid skipping unflagged tiles): each agrees with the
+/// separate passes, frame after frame, and the still surfaces keep their earlier prints where
+/// nothing presses them again.
 #[test]
 fn fused_update_mixes_snowing_and_still_surfaces() {
-    let mut fused = world_with(CaptureMode::Depth, true);
+    for list_tiles_from in [0, u32::MAX] {
+        mixed_frames(list_tiles_from);
+    }
+}
+
+fn mixed_frames(list_tiles_from: u32) {
+    let format = PoolFormat::default();
+    let mut fused = world_listing(CaptureMode::Depth, true, format, list_tiles_from);
     let mut separate = world_with(CaptureMode::Depth, false);
     let mut ids = Vec::new();
     for (i, rate) in [0.0, 0.4, 0.0, 0.2].into_iter().enumerate() {
@@ -972,7 +992,7 @@ fn fused_update_mixes_snowing_and_still_surfaces() {
                 .unwrap_or(0);
             assert!(
                 worst <= 1,
-                "frame {frame}, surface at {:?} (refill {}): {worst} units apart",
+                "listing from {list_tiles_from} tiles, frame {frame}, surface at {:?} (refill {}): {worst} units apart",
                 desc.center,
                 desc.replenish_rate
             );

@@ -21,7 +21,7 @@ struct CaptureView {
     texels: vec2<f32>,      // the surface's heightmap width and height
     tiles: u32,             // first tile flag of the surface in `tiles`
     tiles_x: u32,           // tiles a row
-    record: u32,            // the surface's record in the update
+    record: u32,            // the surface's record in the update, or NO_LIST
     pad: u32,
 }
 // Must match `CaptureView` in capture/mod.rs.
@@ -50,6 +50,8 @@ struct Primitive {
 
 // Side of the update's tiles. Must match FUSED_WORKGROUP in accumulate/mod.rs.
 const TILE: u32 = 16u;
+// `view.record` when the update does not use the list. Must match NO_LIST in capture/mod.rs.
+const NO_LIST: u32 = 0xffffffffu;
 
 // Flag every tile holding a texel within one of this one (the blur's reach).
 fn mark_tiles(frag: vec2<f32>) {
@@ -60,6 +62,10 @@ fn mark_tiles(frag: vec2<f32>) {
     for (var ty = t0.y; ty <= t1.y; ty++) {
         for (var tx = t0.x; tx <= t1.x; tx++) {
             let i = view.tiles + ty * view.tiles_x + tx;
+            if view.record == NO_LIST {
+                atomicStore(&tiles[i], 1u);
+                continue;
+            }
             // Most fragments find their tiles flagged already: only the first lists a tile.
             if atomicLoad(&tiles[i]) == 0u && atomicExchange(&tiles[i], 1u) == 0u {
                 let n = atomicAdd(&tile_list[3], 1u);

@@ -47,6 +47,9 @@ pub fn decode_depth(code: u32) -> f32 {
 /// Most sub-steps an analytic deformer is split into along its motion in one update.
 pub const MAX_SUBSTEPS: u32 = 32;
 
+/// `record` of a [`CaptureView`] whose flagged tiles are not listed (the update runs its grid).
+pub const NO_LIST: u32 = u32::MAX;
+
 /// Uniform block of one surface's capture. Must match `CaptureView` in `capture.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -65,7 +68,7 @@ pub struct CaptureView {
     pub tiles: u32,
     /// Tiles a row (16x16 texels each).
     pub tiles_x: u32,
-    /// The surface's record in the update (listed with each flagged tile).
+    /// The surface's record in the update (listed with each flagged tile), or [`NO_LIST`].
     pub record: u32,
     /// Padding to the uniform's 16-byte size.
     pub pad: u32,
