@@ -205,7 +205,23 @@ fn diced_mesh_is_crack_free_and_denser_closer() {
     eprintln!("from above: {trench} triangles over the trench, {open} over as much open snow");
     assert!(trench > 1.5 * open, "trench {trench}, open {open}");
 
-    // Looking away: everything is culled.
+    // Behind the camera but inside the moon's near shadow cascade (a 12 m square around what the
+    // camera looks at): still diced, because its snow shadows what the camera sees.
+    render(
+        &mut r,
+        &world,
+        roof,
+        Vec3::new(0.0, 3.0, 2.5),
+        Vec3::new(0.0, 2.5, 5.0),
+    );
+    let behind = r.read_diced_mesh(roof).expect("mesh");
+    eprintln!(
+        "behind the camera, in the shadow cascade: {} triangles",
+        behind.triangles.len()
+    );
+    assert!(!behind.triangles.is_empty());
+
+    // Looking away, the shadow cascade far from the roof too: everything is culled.
     render(
         &mut r,
         &world,

@@ -2296,6 +2296,8 @@ impl Renderer {
                 grid: [layout.width, layout.height, s as u32, base.triangles],
                 capacity: [vertex_capacity, index_capacity, 0, 0],
                 half_size: [half.x, half.y, 0.0, 0.0],
+                local_to_shadow: (Mat4::from_cols_array_2d(&uniform.shadow_near) * local_to_world)
+                    .to_cols_array_2d(),
             };
             let bank = tessellate::BankParams::new(
                 layout.width,

@@ -1,7 +1,8 @@
 // dice.wgsl: runtime dicing of a snow surface's mesh on the GPU (the talk's tessellation, without
 // hull and domain shaders). One workgroup per triangle of the surface's base mesh (the rectangle
 // of the surface cut into cells, or a mesh the user gave, in the surface's local frame):
-//   1. cull the triangle's box (base mesh up to the highest the snow can reach) against the view;
+//   1. cull the triangle's box (base mesh up to the highest the snow can reach) against the view
+//      and the moon's near shadow cascade (snow just out of view still shadows what is in it);
 //   2. a level per edge, a function of the edge alone (its endpoints in a canonical order, lower
 //      vertex id first): projected length in pixels over the target, scaled by the relief of the
 //      heightfield along the edge (finer where there are prints and banks), at most one segment
@@ -29,6 +30,7 @@ struct DiceParams {
     grid: vec4<u32>,         // xy: heightfield size, z: surface slot, w: base triangles
     capacity: vec4<u32>,     // x: vertex capacity, y: index capacity
     half_size: vec4<f32>,    // xy: half the surface's sides
+    local_to_shadow: mat4x4<f32>, // surface-local to the moon's near shadow cascade
 }
 
 // Must match `BaseTriangle` in mod.rs.
@@ -221,14 +223,20 @@ fn is_border(t: BaseTriangle, e: u32) -> bool {
     return (t.ids.w & (1u << e)) != 0u;
 }
 
-// Whether the box of the triangle (from its base up to the highest snow) is outside the view.
+// Whether the box of the triangle (from its base up to the highest snow) is outside both the view
+// and the near shadow cascade: then it neither shows nor shadows anything that shows.
 fn culled(t: BaseTriangle) -> bool {
     let lo = min(min(t.a.xyz, t.b.xyz), t.c.xyz);
     let hi = max(max(t.a.xyz, t.b.xyz), t.c.xyz) + vec3<f32>(0.0, dice.extent.x + dice.extent.y, 0.0);
+    return outside(dice.local_to_clip, lo, hi) && outside(dice.local_to_shadow, lo, hi);
+}
+
+// Whether a box lies wholly beyond one plane of a clip space (depth 0 to w).
+fn outside(to_clip: mat4x4<f32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     var out_l = true; var out_r = true; var out_b = true; var out_t = true; var out_n = true; var out_f = true;
     for (var i = 0u; i < 8u; i++) {
         let p = vec3<f32>(select(lo.x, hi.x, (i & 1u) != 0u), select(lo.y, hi.y, (i & 2u) != 0u), select(lo.z, hi.z, (i & 4u) != 0u));
-        let q = dice.local_to_clip * vec4<f32>(p, 1.0);
+        let q = to_clip * vec4<f32>(p, 1.0);
         out_l = out_l && q.x < -q.w;
         out_r = out_r && q.x > q.w;
         out_b = out_b && q.y < -q.w;

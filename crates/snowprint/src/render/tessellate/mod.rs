@@ -350,6 +350,8 @@ pub struct DiceParams {
     pub capacity: [u32; 4],
     /// Half the surface's sides; zw unused.
     pub half_size: [f32; 4],
+    /// Surface-local to the moon's near shadow cascade (clip space).
+    pub local_to_shadow: [[f32; 4]; 4],
 }
 
 /// One surface for the bank passes. Must match `BankParams` in `banks.wgsl`.
