@@ -9,7 +9,8 @@ use std::collections::HashMap;
 use glam::{Quat, Vec2, Vec3};
 use snowprint::render::tessellate::{BankSettings, DicedKind, DicedMesh, SurfaceGeometry, cpu};
 use snowprint::render::{
-    Environment, RenderConfig, RenderError, RenderFrame, RenderOutput, Renderer, SurfaceMesh, Tier,
+    DebugView, Environment, RenderConfig, RenderError, RenderFrame, RenderOutput, Renderer,
+    SurfaceMesh, Tier,
 };
 use snowprint::{
     Camera, Deformer, GroundMaterial, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId, WorldConfig,
@@ -264,6 +265,77 @@ fn a_user_mesh_is_diced_crack_free() {
     let mesh = r.read_diced_mesh(roof).expect("mesh");
     let tops = check_crack_free(&mesh, Vec2::new(2.0, 1.5));
     assert!(tops > 6 * 9, "{tops} top triangles");
+}
+
+/// Snow on a gable roof (a user mesh pitched along x) shades as sloped: in the normals view, the
+/// slope facing +z and the one facing -z differ in the normal's z, though nothing pressed the snow
+/// (the heightmap alone would make both flat).
+#[test]
+fn snow_on_a_pitched_mesh_shades_with_its_slope() {
+    let world = {
+        let mut w = SnowWorld::new(common::gpu(), WorldConfig::default()).expect("world");
+        w.add_surface(SurfaceDesc::new("gable", [0.0; 3], [4.0, 3.0], 0.15))
+            .expect("roof");
+        w
+    };
+    let roof = world.surfaces().next().expect("a surface").0;
+    let mut r = renderer(&world);
+    r.set_debug_view(DebugView::Normals);
+    // Eaves at z = -1.5 and 1.5, ridge at z = 0, 0.4 m up.
+    let positions = vec![
+        Vec3::new(-2.0, 0.0, -1.5),
+        Vec3::new(2.0, 0.0, -1.5),
+        Vec3::new(2.0, 0.4, 0.0),
+        Vec3::new(-2.0, 0.4, 0.0),
+        Vec3::new(2.0, 0.0, 1.5),
+        Vec3::new(-2.0, 0.0, 1.5),
+    ];
+    let triangles = vec![[0, 2, 1], [0, 3, 2], [3, 4, 2], [3, 5, 4]];
+    r.set_surface_geometry(
+        &world,
+        roof,
+        SurfaceGeometry {
+            mesh: Some(SurfaceMesh {
+                positions,
+                triangles,
+            }),
+            ..Default::default()
+        },
+    )
+    .expect("geometry");
+    let camera = Camera {
+        eye: Vec3::new(0.0, 7.0, 0.5),
+        target: Vec3::ZERO,
+        fov_y_degrees: 50.0,
+    };
+    let out = render(&mut r, &world, roof, camera.eye, camera.target);
+    let view_proj =
+        camera.projection(out.width as f32 / out.height as f32, 0.05, 600.0) * camera.view();
+    // Mean blue (the normal's z) of a 5 x 5 patch around a point of the snow on each slope.
+    let blue = |p: Vec3| {
+        let c = view_proj.project_point3(p);
+        let (x, y) = (
+            ((c.x * 0.5 + 0.5) * out.width as f32) as i32,
+            ((0.5 - c.y * 0.5) * out.height as f32) as i32,
+        );
+        let mut sum = 0.0;
+        for dy in -2..=2 {
+            for dx in -2..=2 {
+                let (px, py) = ((x + dx) as u32, (y + dy) as u32);
+                sum += out.rgba8[((py * out.width + px) * 4 + 2) as usize] as f32;
+            }
+        }
+        sum / 25.0
+    };
+    let (back, front) = (
+        blue(Vec3::new(0.0, 0.2 + 0.15, -0.75)),
+        blue(Vec3::new(0.0, 0.2 + 0.15, 0.75)),
+    );
+    eprintln!("normals view, blue: slope facing -z {back:.1}, facing +z {front:.1}");
+    assert!(
+        front > back + 20.0,
+        "the two slopes shade alike: blue {back:.1} and {front:.1}"
+    );
 }
 
 #[test]

@@ -194,6 +194,16 @@ fn inner_side(e: u32, m: u32) -> vec2<u32> {
     }
 }
 
+// Slope of a base triangle's plane (dy/dx, dy/dz in the surface's frame), which top vertices carry
+// so that the snow on a pitched roof shades as sloped (vertical triangles count as flat).
+fn base_slope(t: BaseTriangle) -> vec2<f32> {
+    var n = cross(t.b.xyz - t.a.xyz, t.c.xyz - t.a.xyz);
+    if abs(n.y) < 1e-6 {
+        return vec2<f32>(0.0);
+    }
+    return vec2<f32>(-n.x / n.y, -n.z / n.y);
+}
+
 fn put_vertex(at: u32, p: vec3<f32>, kind: f32, n: vec2<f32>) {
     vertices[2u * at] = vec4<f32>(p, kind);
     vertices[2u * at + 1u] = vec4<f32>(n.x, 0.0, n.y, 0.0);
@@ -310,7 +320,7 @@ fn dice_surface(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id)
     if n == 1u {
         // Every edge at level 1: the base triangle itself.
         if li < 3u {
-            put_vertex(vertex_base + li, corner(t, li), KIND_TOP, vec2<f32>(0.0));
+            put_vertex(vertex_base + li, corner(t, li), KIND_TOP, base_slope(t));
         }
         if li == 0u {
             put_triangle(next_i, 0u, 1u, 2u);
@@ -331,12 +341,12 @@ fn dice_surface(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id)
                     e = 2u;
                 }
             }
-            put_vertex(vertex_base + k, outer_point(t, e, kk), KIND_TOP, vec2<f32>(0.0));
+            put_vertex(vertex_base + k, outer_point(t, e, kk), KIND_TOP, base_slope(t));
         }
         // Inner lattice points.
         for (var j = 1u; j <= n - 2u; j++) {
             for (var i = 1u + li; i <= n - 1u - j; i += 64u) {
-                put_vertex(vertex_base + inner_index(i, j), inner_point(t, i, j), KIND_TOP, vec2<f32>(0.0));
+                put_vertex(vertex_base + inner_index(i, j), inner_point(t, i, j), KIND_TOP, base_slope(t));
             }
         }
         // Inner triangles, up then down, row by row.

@@ -24,13 +24,13 @@ const MACRO_MEAN: f32 = 0.025;
 
 struct TessVertex {
     @location(0) position: vec4<f32>,   // xyz local (y: the base), w: 0 top, 1 skirt top, 2 skirt base
-    @location(1) outward: vec4<f32>,    // skirts: outward normal (local xz in x and z)
+    @location(1) outward: vec4<f32>,    // skirts: outward normal; top: the base's slope (xz)
 }
 
 struct TessVarying {
     @builtin(position) clip: vec4<f32>,
     @location(0) local: vec3<f32>,
-    @location(1) @interpolate(flat) outward: vec4<f32>,   // w: 1 on skirts
+    @location(1) @interpolate(flat) outward: vec4<f32>,   // w: 1 on skirts; top: base slope in xz
 }
 
 fn tess_touched() -> bool {
@@ -120,14 +120,16 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
         m = snow_basic(surface, in.local, face, sky_tint(), pixel);
     } else {
         let uv = snow_uv(surface, in.local.xz);
+        // The snow top's slope: the base mesh's (a pitched roof), plus the heightmap's and the
+        // banks' where something pressed the snow.
+        var g = in.outward.xz;
         if tess_touched() {
             hf = snow_heightfield(surface, uv);
-            // The heightmap's normal tilted by the banks' slope.
             let ny = max(sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)), 1e-3);
-            let g = vec2<f32>(-hf.y, -hf.z) / ny + bank_gradient(uv);
-            let n = normalize(vec3<f32>(-g.x, 1.0, -g.y));
-            hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
+            g += vec2<f32>(-hf.y, -hf.z) / ny + bank_gradient(uv);
         }
+        let n = normalize(vec3<f32>(-g.x, 1.0, -g.y));
+        hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
         var hit: SnowHit;
         // The depression drives the stages; the height of the hit is the filtered one.
         hit.position = vec3<f32>(in.local.x, surface.snow_depth, in.local.z);
