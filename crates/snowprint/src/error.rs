@@ -137,6 +137,25 @@ pub enum SnowError {
     /// A scene file is not valid.
     #[error("{0}")]
     Scene(String),
+    /// Heights given to [`crate::PoolFormat::encode`] or `decode` do not match the heightmap's
+    /// size.
+    #[error(
+        "a {width} x {height} heightmap at {precision} needs {expected} {what}, but {got} were given"
+    )]
+    HeightsLength {
+        /// Texels along x.
+        width: u32,
+        /// Texels along z.
+        height: u32,
+        /// The pool's precision.
+        precision: crate::pool::Precision,
+        /// What was counted (texels a channel, or words).
+        what: &'static str,
+        /// How many it needs.
+        expected: usize,
+        /// How many were given.
+        got: usize,
+    },
 }
 
 /// Result alias of the library.

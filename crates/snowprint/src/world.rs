@@ -1217,10 +1217,9 @@ impl SnowWorld {
     pub fn read_channels(&self, id: SurfaceId) -> Result<(Vec<u32>, Vec<u32>)> {
         let s = self.state(id)?;
         let words = self.read_packed(id)?;
-        Ok(self
-            .config
+        self.config
             .format
-            .decode(s.layout.width, s.layout.height, &words))
+            .decode(s.layout.width, s.layout.height, &words)
     }
 
     /// Read a surface's current heightmap back to the CPU (waits for the GPU), in 16-bit units

@@ -129,16 +129,20 @@ impl PoolFormat {
         (self.heights_bytes(width, height) + normals).div_ceil(SLOT_ALIGN) * SLOT_ALIGN
     }
 
-    /// Encode channels (row-major, `width x height`) into the words of a heights region.
+    /// Encode channels (row-major, `width x height` texels each, values up to
+    /// [`Precision::channel_max`]; higher bits are dropped) into the words of a heights region.
     pub fn encode(
         &self,
         width: u32,
         height: u32,
         depression: &[u32],
         displaced: &[u32],
-    ) -> Vec<u32> {
+    ) -> crate::Result<Vec<u32>> {
         let (w, h) = (width as usize, height as usize);
-        match self.precision {
+        for channel in [depression, displaced] {
+            self.check(width, height, "texels a channel", w * h, channel.len())?;
+        }
+        Ok(match self.precision {
             Precision::Bits8 => {
                 let rw = self.row_words(width) as usize;
                 let mut out = vec![0u32; rw * h];
@@ -157,13 +161,41 @@ impl PoolFormat {
                 .map(|(&d, &p)| (d & 0xffff) | (p << 16))
                 .collect(),
             Precision::Bits32 => depression.iter().chain(displaced).copied().collect(),
+        })
+    }
+
+    fn check(
+        &self,
+        width: u32,
+        height: u32,
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    ) -> crate::Result<()> {
+        if expected == got {
+            return Ok(());
         }
+        Err(crate::SnowError::HeightsLength {
+            width,
+            height,
+            precision: self.precision,
+            what,
+            expected,
+            got,
+        })
     }
 
     /// Decode the words of a heights region into `(depression, displaced)` channels, row-major.
-    pub fn decode(&self, width: u32, height: u32, words: &[u32]) -> (Vec<u32>, Vec<u32>) {
+    pub fn decode(
+        &self,
+        width: u32,
+        height: u32,
+        words: &[u32],
+    ) -> crate::Result<(Vec<u32>, Vec<u32>)> {
         let (w, h) = (width as usize, height as usize);
-        match self.precision {
+        let expected = (self.heights_bytes(width, height) / 4) as usize;
+        self.check(width, height, "words", expected, words.len())?;
+        Ok(match self.precision {
             Precision::Bits8 => {
                 let rw = self.row_words(width) as usize;
                 let half = |x: usize, y: usize| (words[y * rw + x / 2] >> (16 * (x % 2))) & 0xffff;
@@ -180,7 +212,7 @@ impl PoolFormat {
                 words.iter().map(|&v| v >> 16).collect(),
             ),
             Precision::Bits32 => (words[..w * h].to_vec(), words[w * h..2 * w * h].to_vec()),
-        }
+        })
     }
 }
 
@@ -384,13 +416,20 @@ mod tests {
             let max = p.channel_max();
             let dep: Vec<u32> = (0..21u32).map(|i| max - i * 3).collect();
             let disp: Vec<u32> = (0..21u32).map(|i| i * 5).collect();
-            let words = f.encode(w, h, &dep, &disp);
+            let words = f.encode(w, h, &dep, &disp).unwrap();
             assert_eq!(words.len() as u64 * 4, f.heights_bytes(w, h));
-            assert_eq!(f.decode(w, h, &words), (dep, disp), "{p}");
+            assert_eq!(f.decode(w, h, &words).unwrap(), (dep, disp.clone()), "{p}");
+            // A wrong length is one sentence, not a panic.
+            let e = f.decode(w, h, &words[1..]).unwrap_err().to_string();
+            assert!(
+                e.contains("7 x 3 heightmap") && e.contains("were given"),
+                "{e}"
+            );
+            assert!(f.encode(w, h, &[1, 2], &disp).is_err());
         }
         // 8 bits: texel (1, 0) sits in the high half of word 0, depression in its low byte.
         let f = PoolFormat::new(Precision::Bits8);
-        let words = f.encode(3, 1, &[1, 2, 3], &[4, 5, 6]);
+        let words = f.encode(3, 1, &[1, 2, 3], &[4, 5, 6]).unwrap();
         assert_eq!(words, vec![0x0502_0401, 0x0000_0603]);
     }
 
