@@ -10,7 +10,7 @@ struct SurfaceRecord {
     height: u32,
     atlas_x: u32,         // where the surface's capture lies in the capture atlas
     atlas_y: u32,
-    mode: u32,            // 0 = depth capture, 1 = mask capture
+    mode: u32,            // bit 0: mask capture (else depth); bit 1: MODE_MESHES
     replenish_units: u32, // channel units (1/channel_max(PRECISION) of the snow depth) refilled
     batch: u32,           // capture batch; NO_CAPTURE when nothing touched the surface
     mask_fraction: f32,   // mask capture: fraction of the snow depth a covered texel is pressed
@@ -24,6 +24,8 @@ struct SurfaceRecord {
 const NO_CAPTURE: u32 = 0xffffffffu;
 const MODE_DEPTH: u32 = 0u;
 const MODE_MASK: u32 = 1u;
+// Bit of `mode` set when mesh solids were drawn over the surface: only then is `winding` read.
+const MODE_MESHES: u32 = 2u;
 const NO_NORMALS: u32 = 0xffffffffu;
 
 // Bits a channel of the pool's heightmaps (8, 16 or 32): set when the world compiles its passes.

@@ -735,6 +735,10 @@ impl SnowWorld {
                     mode: match capture_cfg.mode {
                         CaptureMode::Depth => 0,
                         CaptureMode::Mask => 1,
+                    } | if draws.len() as u32 > d0 {
+                        crate::pool::MODE_MESHES
+                    } else {
+                        0
                     },
                     replenish_units: units,
                     batch: NO_CAPTURE,
@@ -856,8 +860,11 @@ impl SnowWorld {
         }
         self.capture
             .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
-        self.winding
-            .ensure(&self.device, (scratch_len.max(1) as u64) * 4);
+        // Winding counts only mesh solids: a frame of analytic deformers needs none.
+        let winding_len = if draws.is_empty() { 0 } else { scratch_len };
+        if winding_len > 0 {
+            self.winding.ensure(&self.device, winding_len as u64 * 4);
+        }
         self.tiles
             .ensure(&self.device, (tiles_len.max(1) as u64) * 4);
         self.tile_list.ensure(
@@ -993,7 +1000,9 @@ impl SnowWorld {
             });
         // Nothing captured yet: 0 is the code of "no deformer over this texel".
         enc.clear_buffer(&self.capture.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
-        enc.clear_buffer(&self.winding.buffer, 0, Some(scratch_len.max(1) as u64 * 4));
+        if winding_len > 0 {
+            enc.clear_buffer(&self.winding.buffer, 0, Some(winding_len as u64 * 4));
+        }
         enc.clear_buffer(&self.tiles.buffer, 0, Some(tiles_len.max(1) as u64 * 4));
         enc.clear_buffer(
             &self.tile_list.buffer,
@@ -1272,11 +1281,16 @@ impl SnowWorld {
             r.scratch as u64 * 4,
             (r.width * r.height) as u64 * 4,
         )?;
-        let winding = self.download(
-            &self.winding.buffer,
-            r.scratch as u64 * 4,
-            (r.width * r.height) as u64 * 4,
-        )?;
+        // The winding buffer holds this surface's texels only when meshes were drawn over it.
+        let winding = if r.mode & crate::pool::MODE_MESHES != 0 {
+            self.download(
+                &self.winding.buffer,
+                r.scratch as u64 * 4,
+                (r.width * r.height) as u64 * 4,
+            )?
+        } else {
+            vec![0; (r.width * r.height) as usize * 4]
+        };
         let codes: &[u32] = bytemuck::cast_slice(&bytes);
         let winding: &[i32] = bytemuck::cast_slice(&winding);
         // As capture_read.wgsl reads it: inside a mesh solid at the ground, depth 0.

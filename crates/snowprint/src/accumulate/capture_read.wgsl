@@ -7,7 +7,7 @@ fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     let cy = u32(clamp(y, 0, i32(rec.height) - 1));
     let i = rec.scratch + cy * rec.width + cx;
     var code = capture[i];
-    if winding[i] > 0 {
+    if (rec.mode & MODE_MESHES) != 0u && winding[i] > 0 {
         code = ONE_BITS; // depth 0: the ground
     }
     return capture_depression(rec, code);

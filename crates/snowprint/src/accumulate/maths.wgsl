@@ -18,7 +18,7 @@ const TAPS = array<vec2<f32>, 4>(
 // Depression (0 = untouched, 1 = pressed to the ground) of a stored capture value.
 fn capture_depression(rec: SurfaceRecord, code: u32) -> f32 {
     let z = bitcast<f32>(ONE_BITS - code);
-    if rec.mode == MODE_MASK {
+    if (rec.mode & MODE_MASK) != 0u {
         return select(0.0, rec.mask_fraction, z < 1.0);
     }
     let h = z * rec.frustum_height;

@@ -235,7 +235,7 @@ pub struct SurfaceRecord {
     pub atlas_x: u32,
     /// Capture atlas y of the surface's rectangle.
     pub atlas_y: u32,
-    /// 0 = depth capture, 1 = mask capture.
+    /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`].
     pub mode: u32,
     /// Depression units refilled this update.
     pub replenish_units: u32,
@@ -257,6 +257,9 @@ pub struct SurfaceRecord {
 
 /// `batch` of a record whose surface had nothing to capture this update.
 pub const NO_CAPTURE: u32 = u32::MAX;
+/// Bit of [`SurfaceRecord::mode`] set when mesh solids were drawn over the surface this update:
+/// only then does the update read the capture's winding buffer.
+pub const MODE_MESHES: u32 = 2;
 /// `normals` of a record in a pool that keeps no normals.
 pub const NO_NORMALS: u32 = u32::MAX;
 
