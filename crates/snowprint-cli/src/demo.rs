@@ -37,8 +37,10 @@ pub trait DemoScene {
     fn surfaces(&self) -> &[(SurfaceId, GroundMaterial)];
     /// Street lamps and other point lights.
     fn lights(&self) -> &[PointLight];
-    /// Moon, sky and haze.
-    fn environment(&self) -> Environment;
+    /// Moon, sky and haze (both demos: the moonlit night).
+    fn environment(&self) -> Environment {
+        Environment::moonlit_night()
+    }
     /// Advance the snow of `world` from `t0` to `t1`: whatever presses the snow meanwhile, with
     /// its poses at both ends (by `SnowWorld::step`, or per surface by `SnowWorld::update`).
     fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String>;

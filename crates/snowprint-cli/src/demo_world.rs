@@ -8,7 +8,7 @@
 
 use glam::{Mat4, Vec3};
 use snowprint::demo::DemoWorld;
-use snowprint::render::{Environment, Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
+use snowprint::render::{Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
 use snowprint::{Camera, GroundMaterial, Mesh, MeshId, SnowWorld, SurfaceId, SurfaceUpdate};
 
 use super::DemoScene;
@@ -190,10 +190,6 @@ impl DemoScene for LibraryDemo {
 
     fn lights(&self) -> &[PointLight] {
         &self.lights
-    }
-
-    fn environment(&self) -> Environment {
-        Environment::moonlit_night()
     }
 
     fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {

@@ -7,7 +7,7 @@
 //! is both drawn and pressed into the snow, as in the talk.
 
 use glam::{Mat4, Quat, Vec3};
-use snowprint::render::{Environment, Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
+use snowprint::render::{Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
 use snowprint::{
     Camera, Deformer, GroundMaterial, Mesh, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
 };
@@ -827,10 +827,6 @@ impl DemoScene for StandIn {
 
     fn lights(&self) -> &[PointLight] {
         &self.lights
-    }
-
-    fn environment(&self) -> Environment {
-        Environment::moonlit_night()
     }
 
     fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {

@@ -16,7 +16,7 @@ use crate::capture::{
 };
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
-use crate::gpu::resources::{Growable, bind_group};
+use crate::gpu::resources::{Growable, UNIFORM_STRIDE, bind_group, uniform_block};
 use crate::gpu::{Capabilities, GpuContext};
 use crate::heightmap::Heightmap;
 use crate::mesh::{Mesh, MeshId};
@@ -200,8 +200,6 @@ struct MeshGpu {
     vertex_count: usize,
     radius: f32,
 }
-
-const UNIFORM_STRIDE: u64 = 256;
 
 /// One surface's work in a frame.
 struct Job {
@@ -764,10 +762,7 @@ impl SnowWorld {
         let still_tiles: u64 = jobs[dense as usize..]
             .iter()
             .filter(|j| j.captured)
-            .map(|j| {
-                let r = &j.record;
-                (r.width.div_ceil(FUSED_WORKGROUP) * r.height.div_ceil(FUSED_WORKGROUP)) as u64
-            })
+            .map(|j| j.record.tile_count() as u64)
             .sum();
         let listed = self.config.passes == PassMode::Fused
             && still_tiles > 0
@@ -805,7 +800,7 @@ impl SnowWorld {
             r.scratch = scratch_len;
             scratch_len += r.width * r.height;
             r.tiles = tiles_len;
-            tiles_len += r.width.div_ceil(FUSED_WORKGROUP) * r.height.div_ceil(FUSED_WORKGROUP);
+            tiles_len += r.tile_count();
         }
         stats.captured = captured.len() as u32;
         stats.capture_batches = batches;
@@ -877,52 +872,30 @@ impl SnowWorld {
         let max_w = jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         let max_h = jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
 
-        let view_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("capture view"),
-            layout: &self.capture_pipes.view_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &self.views.buffer,
-                        offset: 0,
-                        size: std::num::NonZeroU64::new(std::mem::size_of::<CaptureView>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.prims.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.capture.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: self.winding.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: self.tiles.buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: self.tile_list.buffer.as_entire_binding(),
-                },
+        // One uniform block of each table per draw, chosen by dynamic offset.
+        let view_bg = bind_group(
+            &self.device,
+            "capture view",
+            &self.capture_pipes.view_layout,
+            &[
+                uniform_block(&self.views.buffer, 0, std::mem::size_of::<CaptureView>()),
+                self.prims.buffer.as_entire_binding(),
+                self.capture.buffer.as_entire_binding(),
+                self.winding.buffer.as_entire_binding(),
+                self.tiles.buffer.as_entire_binding(),
+                self.tile_list.buffer.as_entire_binding(),
             ],
-        });
-        let draw_bg = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("capture mesh draw"),
-            layout: &self.capture_pipes.draw_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &self.draws.buffer,
-                    offset: 0,
-                    size: std::num::NonZeroU64::new(64),
-                }),
-            }],
-        });
+        );
+        let draw_bg = bind_group(
+            &self.device,
+            "capture mesh draw",
+            &self.capture_pipes.draw_layout,
+            &[uniform_block(
+                &self.draws.buffer,
+                0,
+                std::mem::size_of::<MeshDraw>(),
+            )],
+        );
         // Each pass binds whole buffers in binding order; the layouts name what it reads and writes.
         let (records, capture, winding, scratch, pool) = (
             &self.records.buffer,
@@ -1082,10 +1055,7 @@ impl SnowWorld {
             passes.push((Stage::Normals, &self.acc.normals, &normals_bg));
         }
         // The merge writes a unit (two texels at 8 bits) per invocation.
-        let unit = match self.config.format.precision {
-            crate::pool::Precision::Bits8 => 2,
-            _ => 1,
-        };
+        let unit = self.config.format.precision.unit_texels();
         for &(stage, pipeline, bg) in &passes {
             let q = next_query(stage, &mut stages);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -66,6 +66,24 @@ pub(crate) fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::Bin
     }
 }
 
+/// Spacing of the per-draw uniform blocks in one buffer, bytes: WebGPU's largest minimum
+/// dynamic-offset alignment, so a block can be chosen by dynamic offset on every device.
+pub(crate) const UNIFORM_STRIDE: u64 = 256;
+
+/// Block `index` (its first `size` bytes) of a buffer of uniform blocks spaced
+/// [`UNIFORM_STRIDE`] apart.
+pub(crate) fn uniform_block(
+    buffer: &wgpu::Buffer,
+    index: usize,
+    size: usize,
+) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer,
+        offset: index as u64 * UNIFORM_STRIDE,
+        size: std::num::NonZeroU64::new(size as u64),
+    })
+}
+
 /// A bind group of `resources` at bindings 0, 1, 2, ... in order.
 pub(crate) fn bind_group(
     device: &wgpu::Device,

@@ -74,6 +74,16 @@ impl Precision {
     pub fn texel_bytes(self) -> u64 {
         2 * self.bits() as u64 / 8
     }
+
+    /// Texels one invocation of the update writes together without racing its neighbours: the
+    /// two texels of a word at 8 bits, one otherwise. Must match `unit_texels` in
+    /// `texel_write.wgsl`.
+    pub fn unit_texels(self) -> u32 {
+        match self {
+            Precision::Bits8 => 2,
+            Precision::Bits16 | Precision::Bits32 => 1,
+        }
+    }
 }
 
 impl std::fmt::Display for Precision {
@@ -102,12 +112,9 @@ impl PoolFormat {
         }
     }
 
-    /// 32-bit words of one row of the heights region.
+    /// 32-bit words of one row of the heights region (a plane's, at 32 bits).
     pub fn row_words(&self, width: u32) -> u32 {
-        match self.precision {
-            Precision::Bits8 => width.div_ceil(2),
-            Precision::Bits16 | Precision::Bits32 => width,
-        }
+        width.div_ceil(self.precision.unit_texels())
     }
 
     /// Bytes of the heights region of a `width x height` heightmap.
@@ -253,6 +260,14 @@ pub struct SurfaceRecord {
     pub texel_z: f32,
     /// First of the surface's tile flags written by the capture (see `capture.wgsl`).
     pub tiles: u32,
+}
+
+impl SurfaceRecord {
+    /// The update's 16x16 tiles (the fused pass's workgroups) over the surface.
+    pub fn tile_count(&self) -> u32 {
+        self.width.div_ceil(crate::accumulate::FUSED_WORKGROUP)
+            * self.height.div_ceil(crate::accumulate::FUSED_WORKGROUP)
+    }
 }
 
 /// `batch` of a record whose surface had nothing to capture this update.

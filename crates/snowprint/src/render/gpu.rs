@@ -20,7 +20,7 @@ pub const STATE_DEEPEST: u64 = 12;
 /// Vertices of a surface's box: five faces of two triangles (no bottom).
 pub const BOX_VERTICES: u32 = 30;
 /// Alignment of uniform blocks addressed by offset.
-pub const UNIFORM_STRIDE: u64 = 256;
+pub const UNIFORM_STRIDE: u64 = crate::gpu::resources::UNIFORM_STRIDE;
 /// Point lights the frame uniform holds. Must match `MAX_POINT_LIGHTS` in `frame.wgsl`.
 pub const MAX_POINT_LIGHTS: usize = 8;
 

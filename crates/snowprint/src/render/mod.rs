@@ -58,7 +58,7 @@ pub mod graph;
 pub mod shaders;
 pub mod tessellate;
 
-use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform};
+use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -872,6 +872,19 @@ fn depth_state(compare: wgpu::CompareFunction, write: bool) -> Option<wgpu::Dept
     })
 }
 
+/// Depth state of everything drawn into the moon's shadow cascades (meshes, and the tessellated
+/// tier's snow): nearest wins, biased against acne by slope.
+fn shadow_depth_state() -> Option<wgpu::DepthStencilState> {
+    depth_state(wgpu::CompareFunction::Less, true).map(|d| wgpu::DepthStencilState {
+        bias: wgpu::DepthBiasState {
+            constant: 2,
+            slope_scale: 2.0,
+            clamp: 0.0,
+        },
+        ..d
+    })
+}
+
 fn create_targets(device: &wgpu::Device, width: u32, height: u32, supersample: u32) -> Targets {
     let texture = |label, w, h, format, usage| {
         device.create_texture(&wgpu::TextureDescriptor {
@@ -928,15 +941,6 @@ fn create_targets(device: &wgpu::Device, width: u32, height: u32, supersample: u
         readback,
         padded_row,
     }
-}
-
-/// Block `s` (of `size` bytes) of a buffer of uniform blocks spaced [`UNIFORM_STRIDE`] apart.
-fn buffer_slice(buffer: &wgpu::Buffer, s: usize, size: usize) -> wgpu::BindingResource<'_> {
-    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-        buffer,
-        offset: s as u64 * UNIFORM_STRIDE,
-        size: std::num::NonZeroU64::new(size as u64),
-    })
 }
 
 /// A half float's value.
@@ -1118,17 +1122,7 @@ impl Renderer {
                     buffers: &mesh_buffers,
                 },
                 primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: wgpu::StencilState::default(),
-                    bias: wgpu::DepthBiasState {
-                        constant: 2,
-                        slope_scale: 2.0,
-                        clamp: 0.0,
-                    },
-                }),
+                depth_stencil: shadow_depth_state(),
                 multisample: wgpu::MultisampleState::default(),
                 fragment: None,
                 multiview_mask: None,
@@ -1325,7 +1319,6 @@ impl Renderer {
             &shadow_layout,
             filterable,
             HDR_FORMAT,
-            DEPTH_FORMAT,
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Gpu(e.to_string()));
@@ -2555,28 +2548,17 @@ impl Renderer {
             self.heightfield_texture(*id, sizes[s]);
         }
         let dev = &self.device;
-        let frame_bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &self.frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.frame_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&self.shadow_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(&self.shadow_sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&self.linear_sampler),
-                },
+        let frame_bg = bind_group(
+            dev,
+            "frame",
+            &self.frame_layout,
+            &[
+                self.frame_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&self.shadow_view),
+                wgpu::BindingResource::Sampler(&self.shadow_sampler),
+                wgpu::BindingResource::Sampler(&self.linear_sampler),
             ],
-        });
+        );
         let shadow_bg = bind_group(
             dev,
             "shadow frame",
@@ -2599,54 +2581,39 @@ impl Renderer {
         let mut surface_bgs = Vec::with_capacity(n);
         for (s, (id, _)) in frame.surfaces.iter().enumerate() {
             let tex = &self.heightfields[id];
-            hf_bgs.push(dev.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("heightfield"),
-                layout: &self.heightfield_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: world.pool_buffer().as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: buffer_slice(
-                            &self.heightfield_params.buffer,
-                            s,
-                            std::mem::size_of::<HeightfieldParams>(),
-                        ),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&tex.shape),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&tex.light),
-                    },
+            let (shape, light) = (
+                wgpu::BindingResource::TextureView(&tex.shape),
+                wgpu::BindingResource::TextureView(&tex.light),
+            );
+            hf_bgs.push(bind_group(
+                dev,
+                "heightfield",
+                &self.heightfield_layout,
+                &[
+                    world.pool_buffer().as_entire_binding(),
+                    uniform_block(
+                        &self.heightfield_params.buffer,
+                        s,
+                        std::mem::size_of::<HeightfieldParams>(),
+                    ),
+                    shape.clone(),
+                    light.clone(),
                 ],
-            }));
-            surface_bgs.push(dev.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("snow surface"),
-                layout: &self.surface_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: buffer_slice(
-                            &self.surface_buffer.buffer,
-                            s,
-                            std::mem::size_of::<SurfaceUniform>(),
-                        ),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&tex.shape),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&tex.light),
-                    },
+            ));
+            surface_bgs.push(bind_group(
+                dev,
+                "snow surface",
+                &self.surface_layout,
+                &[
+                    uniform_block(
+                        &self.surface_buffer.buffer,
+                        s,
+                        std::mem::size_of::<SurfaceUniform>(),
+                    ),
+                    shape,
+                    light,
                 ],
-            }));
+            ));
         }
         // The tessellated tier's bind groups, per diced surface: banks (two passes), dice, draw.
         struct TessGroups {
@@ -2665,7 +2632,7 @@ impl Renderer {
             let tex = &self.heightfields[id];
             let base = &self.base_meshes[id];
             let t = &self.tess;
-            let bank_params = buffer_slice(
+            let bank_params = uniform_block(
                 &t.bank_params.buffer,
                 s,
                 std::mem::size_of::<tessellate::BankParams>(),
@@ -2700,7 +2667,7 @@ impl Renderer {
                 "dice",
                 &t.dice_layout,
                 &[
-                    buffer_slice(
+                    uniform_block(
                         &t.dice_params.buffer,
                         s,
                         std::mem::size_of::<tessellate::DiceParams>(),
@@ -2719,7 +2686,7 @@ impl Renderer {
                 "tessellated snow surface",
                 &t.surface_layout,
                 &[
-                    buffer_slice(
+                    uniform_block(
                         &self.surface_buffer.buffer,
                         s,
                         std::mem::size_of::<SurfaceUniform>(),
@@ -2738,20 +2705,15 @@ impl Renderer {
                 triangles: base.triangles,
             }));
         }
-        let tonemap_bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tonemap inputs"),
-            layout: &self.tonemap_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&self.targets.color_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&self.targets.depth_view),
-                },
+        let tonemap_bg = bind_group(
+            dev,
+            "tonemap inputs",
+            &self.tonemap_layout,
+            &[
+                wgpu::BindingResource::TextureView(&self.targets.color_view),
+                wgpu::BindingResource::TextureView(&self.targets.depth_view),
             ],
-        });
+        );
         let tonemap = self.tonemap_pipeline(format);
 
         // The passes, in the order of PASSES.

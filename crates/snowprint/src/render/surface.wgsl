@@ -162,31 +162,39 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
     }
     let hf = snow_heightfield(surface, snow_uv(surface, hit.position.xz));
     let m = snow_deformable(surface, hit, hf, in.face, sky_tint(), pixel);
-    var c = shade(m, hit.position, hit.shadow);
-    switch frame.options.x {
-        case DEBUG_MATERIALS: {
-            c = mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
-        }
-        case DEBUG_DEPRESSION: {
-            c = debug_ramp(hf.x);
-        }
-        case DEBUG_OCCLUSION: {
-            c = vec3<f32>(m.ao);
-        }
-        case DEBUG_NORMALS: {
-            c = m.normal * 0.5 + 0.5;
-        }
-        case DEBUG_TAPS: {
-            c = debug_ramp(f32(hit.taps) / 48.0);
-        }
-        default: {}
-    }
+    let c = deformable_view(shade(m, hit.position, hit.shadow), m, hf.x, f32(hit.taps) / 48.0);
     var out: SnowOut;
     out.color = vec4<f32>(c, 1.0);
     let world = surface.local_to_world * vec4<f32>(hit.position, 1.0);
     let clip = frame.view_proj * world;
     out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
     return out;
+}
+
+// What a pixel of the deformable material shows in the frame's debug view (`shaded` otherwise):
+// the material's stages, the depression, the occlusion, the normal, or the search's taps (as a
+// fraction of 48). Shared by the relief and tessellated tiers.
+fn deformable_view(shaded: vec3<f32>, m: SnowSample, depression: f32, taps: f32) -> vec3<f32> {
+    switch frame.options.x {
+        case DEBUG_MATERIALS: {
+            return mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
+        }
+        case DEBUG_DEPRESSION: {
+            return debug_ramp(depression);
+        }
+        case DEBUG_OCCLUSION: {
+            return vec3<f32>(m.ao);
+        }
+        case DEBUG_NORMALS: {
+            return m.normal * 0.5 + 0.5;
+        }
+        case DEBUG_TAPS: {
+            return debug_ramp(taps);
+        }
+        default: {
+            return shaded;
+        }
+    }
 }
 
 // The basic snow material (the talk's first material): untouched snow, no heightmap, no search.

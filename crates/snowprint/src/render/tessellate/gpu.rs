@@ -57,7 +57,6 @@ impl TessGpu {
         shadow_layout: &wgpu::BindGroupLayout,
         filterable: bool,
         hdr: wgpu::TextureFormat,
-        depth: wgpu::TextureFormat,
     ) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
@@ -172,13 +171,7 @@ impl TessGpu {
             },
             // Skirts face outwards whichever way a mesh is wound: no culling.
             primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: depth,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
+            depth_stencil: crate::render::depth_state(wgpu::CompareFunction::LessEqual, true),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &surface_module,
@@ -211,18 +204,7 @@ impl TessGpu {
                     buffers: &buffers,
                 },
                 primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: depth,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: wgpu::StencilState::default(),
-                    // As the meshes' shadow pass.
-                    bias: wgpu::DepthBiasState {
-                        constant: 2,
-                        slope_scale: 2.0,
-                        clamp: 0.0,
-                    },
-                }),
+                depth_stencil: crate::render::shadow_depth_state(),
                 multisample: wgpu::MultisampleState::default(),
                 fragment: None,
                 multiview_mask: None,

@@ -140,25 +140,6 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
         hit.t = 0.0;
         m = snow_deformable(surface, hit, hf, vec3<f32>(0.0, 1.0, 0.0), sky_tint(), pixel);
     }
-    var c = shade(m, in.local, 1.0);
-    switch frame.options.x {
-        case DEBUG_MATERIALS: {
-            c = mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
-        }
-        case DEBUG_DEPRESSION: {
-            c = debug_ramp(hf.x);
-        }
-        case DEBUG_OCCLUSION: {
-            c = vec3<f32>(m.ao);
-        }
-        case DEBUG_NORMALS: {
-            c = m.normal * 0.5 + 0.5;
-        }
-        case DEBUG_TAPS: {
-            // No search in this tier.
-            c = debug_ramp(0.0);
-        }
-        default: {}
-    }
-    return vec4<f32>(c, 1.0);
+    // No search in this tier: no taps.
+    return vec4<f32>(deformable_view(shade(m, in.local, 1.0), m, hf.x, 0.0), 1.0);
 }
