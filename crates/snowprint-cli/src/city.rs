@@ -109,7 +109,8 @@ fn city_map(
         let map = snow.read_heightmap(ids[i]).map_err(|e| e.to_string())?;
         let layout = s.desc.layout();
         let to_world = s.desc.local_to_world();
-        let resident = map.is_some();
+        // Surfaces without a slot (paged out, or never touched) are drawn greyer.
+        let resident = snow.world_id(ids[i]).is_some();
         for row in 0..layout.height {
             for col in 0..layout.width {
                 let local = Vec3::new(
@@ -124,9 +125,7 @@ fn city_map(
                 if px >= width || pz >= height {
                     continue;
                 }
-                let d = map.as_ref().map_or(0.0, |m| {
-                    m.depression[(row * layout.width + col) as usize] as f32 / 65535.0
-                });
+                let d = map.depression[(row * layout.width + col) as usize] as f32 / 65535.0;
                 let ground = match s.kind {
                     SurfaceKind::Roof => [150.0, 72.0, 58.0],
                     SurfaceKind::Street => [92.0, 92.0, 98.0],

@@ -5,12 +5,10 @@ use std::path::Path;
 
 use snowprint::manager::{CameraView, ManagedDeformer, ManagerConfig, SnowManager, ZoneId, plot};
 use snowprint::scene::Scene;
-use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap};
+use snowprint::{Deformer, GpuContext, GpuOptions};
 
 /// Aspect ratio the manager's visibility test assumes for a scene camera.
 const ASPECT: f32 = 16.0 / 9.0;
-/// Most extra frames run with no deformers at the end so that imprints still queued land.
-const DRAIN_FRAMES: u32 = 600;
 
 /// The manager's settings for a scene: the scene's `[budget]` over the talk's defaults.
 pub fn manager_config(scene: &Scene) -> ManagerConfig {
@@ -86,29 +84,18 @@ pub fn simulate(
     }
     bar.finish_and_clear();
     // Let the imprints still queued land before reading the heightmaps.
-    let camera = scene
-        .camera
-        .as_ref()
-        .map(|c| CameraView::new(&c.at(frames as f32 * dt), ASPECT));
-    let mut drained = 0;
-    while snow.planner().pending_surfaces() > 0 && drained < DRAIN_FRAMES {
-        snow.tick(dt, camera.as_ref(), &[])
-            .map_err(|e| e.to_string())?;
-        drained += 1;
+    snow.flush().map_err(|e| e.to_string())?;
+    let merged = snow.planner().imprints_merged();
+    if merged > 0 {
+        eprintln!(
+            "snowprint: {merged} queued imprints were merged into covering sweeps because a waiting \
+             surface's queue passed queue_cap: those trails are pressed at least as deep as made, \
+             and a little wider"
+        );
     }
     let maps = ids
         .iter()
-        .zip(&scene.surfaces)
-        .map(|(&id, desc)| {
-            Ok(snow
-                .read_heightmap(id)
-                .map_err(|e| e.to_string())?
-                .unwrap_or_else(|| {
-                    // No heightmap held (inactive, or evicted): untouched snow as far as anyone can see.
-                    let l = desc.layout();
-                    Heightmap::from_packed(l.width, l.height, &vec![0; l.texels() as usize])
-                }))
-        })
+        .map(|&id| snow.read_heightmap(id).map_err(|e| e.to_string()))
         .collect::<Result<Vec<_>, String>>()?;
     crate::simulate::write_dump(scene, &maps, frames, dt, dump)?;
     if let Some(path) = report {

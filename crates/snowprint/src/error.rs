@@ -137,6 +137,22 @@ pub enum SnowError {
     /// A scene file is not valid.
     #[error("{0}")]
     Scene(String),
+    /// A surface snapshot that does not fit the world it is restored into.
+    #[error("the snapshot of surface {name:?} cannot be restored: {reason}")]
+    Snapshot {
+        /// The surface.
+        name: String,
+        /// What does not match.
+        reason: String,
+    },
+    /// A save file that cannot be read (corrupt, truncated, foreign or from a newer version).
+    #[error("save file {}: {reason}", path.display())]
+    SaveFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong, and what to do.
+        reason: String,
+    },
     /// Heights given to [`crate::PoolFormat::encode`] or `decode` do not match the heightmap's
     /// size.
     #[error(

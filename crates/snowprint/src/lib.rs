@@ -50,5 +50,5 @@ pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
     CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, SnowWorld, StageTimes,
-    SurfaceUpdate, WorldConfig,
+    SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };

@@ -11,8 +11,8 @@ use proptest::prelude::*;
 use snowprint::manager::city::{self, WalkerPath};
 use snowprint::manager::queue;
 use snowprint::manager::{
-    CameraView, Lookup, ManagedDeformer, ManagedId, ManagerConfig, Planner, SnowManager, UNLIMITED,
-    ZoneId,
+    CameraView, Lookup, ManagedDeformer, ManagedId, ManagerConfig, Planner, ResidencyChange,
+    SnowManager, UNLIMITED, ZoneId,
 };
 use snowprint::pool::PoolFormat;
 
@@ -154,12 +154,13 @@ fn scenario() -> impl Strategy<Value = Scenario> {
         5f32..80.0,
     )
         .prop_map(
-            |(k, pool, slack, player_slots, retain, cap, reach)| ManagerConfig {
+            |(k, pool, slack, player_slots, page_limit, cap, reach)| ManagerConfig {
                 updates_per_frame: k,
                 pool_bytes: pool,
                 distance_slack_frames: slack,
                 player_slots,
-                retain_inactive: retain,
+                // A page store that holds about two slots, or no limit.
+                page_bytes: if page_limit { 200_000 } else { u64::MAX },
                 queue_cap: cap,
                 active_distance: reach,
                 replenish_interval: 0.05,
@@ -223,9 +224,10 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
 
     /// Every tick: at most K updates, only of resident surfaces, each once; pool bytes exactly the
-    /// sum of the resident slots and never over the budget; inactive surfaces hold no heightmap
-    /// (unless retained); and no resident surface waits longer than the stated bound
-    /// `S + floor((n - 1) / (K - reserved))`.
+    /// sum of the resident slots and never over the budget; a heightmap is given up only for
+    /// memory (an eviction in a tick that admits another surface) or a zone unload, and then
+    /// paged, within the page store's budget; and no resident surface waits longer than the
+    /// stated bound `S + floor((n - 1) / (K - reserved))`.
     #[test]
     fn budget_pool_and_starvation_bounds_hold(sc in scenario()) {
         let mut p = sc.planner(Lookup::QuadTree);
@@ -237,6 +239,23 @@ proptest! {
             let deformers = sc.deformers(frame);
             let plan = p.tick(dt, sc.camera.as_ref(), &deformers).expect("valid input").clone();
             due_history.push(plan.stats.due);
+            let evictions = plan.changes.iter().filter(|c| matches!(c, ResidencyChange::Evict(_))).count();
+            let admissions = plan.changes.iter().filter(|c| matches!(c, ResidencyChange::Admit(_))).count();
+            prop_assert!(evictions == 0 || admissions > 0, "evicted {} without admitting anything", evictions);
+            for c in &plan.changes {
+                if let ResidencyChange::Evict(id) = c {
+                    prop_assert!(p.is_paged(*id), "an evicted heightmap is paged");
+                }
+            }
+            let paged: u64 = (0..sc.surfaces.len() as u32)
+                .map(ManagedId::from_index)
+                .filter(|&id| p.is_paged(id))
+                .map(|id| slot_bytes(p.surface(id).unwrap().layout()))
+                .sum();
+            // Evictions stay within the page store's budget; a zone unload pages whatever it
+            // must (the game asked for it), and later evictions then wait for room.
+            let unloaded = sc.zone_events.iter().any(|&(f, _, load)| !load && f <= frame);
+            prop_assert!(unloaded || paged <= sc.config.page_bytes, "{} paged bytes over {}", paged, sc.config.page_bytes);
             prop_assert_eq!(plan.stats.frame, frame);
             prop_assert!(plan.updates.len() <= k, "{} updates with a budget of {}", plan.updates.len(), k);
             let mut seen = std::collections::HashSet::new();
@@ -255,9 +274,7 @@ proptest! {
             prop_assert!(bytes <= p.pool_budget());
             prop_assert_eq!(plan.stats.resident, resident.len());
             for &id in &resident {
-                if !sc.config.retain_inactive {
-                    prop_assert!(p.is_active(id), "an inactive surface holds a heightmap");
-                }
+                prop_assert!(!p.is_paged(id));
                 prop_assert!(p.zone_loaded(sc.surfaces[id.index() as usize].1));
                 // Still waiting: within the bound too.
                 if let Some(since) = p.due_since(id) {
@@ -307,7 +324,7 @@ proptest! {
                 }
             }
             let plan = p.tick(0.02, sc.camera.as_ref(), &deformers).unwrap();
-            prop_assert_eq!(plan.stats.imprints_dropped + plan.stats.imprints_merged, 0);
+            prop_assert_eq!(plan.stats.imprints_merged, 0);
             for u in &plan.updates {
                 applied.entry(u.surface).or_default().extend_from_slice(&u.imprints);
             }
@@ -457,7 +474,7 @@ fn stacked_surfaces_are_told_apart() {
 }
 
 #[test]
-fn unloading_a_zone_frees_its_slots_and_loading_brings_surfaces_back() {
+fn unloading_a_zone_pages_its_surfaces_out_and_loading_pages_them_back_in() {
     let mut p = Planner::new(&ManagerConfig::default()).unwrap();
     let a = p.add_surface(&flat("a", 0.0, 0.0, 0.0), ZoneId(1)).unwrap();
     let b = p
@@ -468,7 +485,7 @@ fn unloading_a_zone_frees_its_slots_and_loading_brings_surfaces_back() {
     assert!(p.is_resident(a) && p.is_resident(b));
     let used = p.pool_used();
     assert_eq!(p.unload_zone(ZoneId(1)), vec![a]);
-    assert!(!p.is_resident(a));
+    assert!(!p.is_resident(a) && p.is_paged(a));
     assert_eq!(
         p.pool_used(),
         used - slot_bytes(p.surface(a).unwrap().layout())
@@ -488,8 +505,10 @@ fn unloading_a_zone_frees_its_slots_and_loading_brings_surfaces_back() {
     assert_eq!(plan.stats.touched, 0, "unloaded surfaces are not looked up");
     assert!(!p.is_resident(a));
     p.load_zone(ZoneId(1));
-    p.tick(0.02, Some(&cam), &[]).unwrap();
-    assert!(p.is_resident(a));
+    // Paged back in at once, even where no camera sees it.
+    let plan = p.tick(0.02, None, &[]).unwrap();
+    assert_eq!(plan.changes, vec![ResidencyChange::Admit(a)]);
+    assert!(p.is_resident(a) && !p.is_paged(a));
 }
 
 #[test]
@@ -498,7 +517,6 @@ fn a_full_pool_evicts_the_least_useful_and_never_goes_over() {
     let one = PoolFormat::default().slot_bytes(100, 100);
     let config = ManagerConfig {
         pool_bytes: 2 * one + 1000,
-        retain_inactive: true,
         ..ManagerConfig::default()
     };
     let mut p = Planner::new(&config).unwrap();
@@ -517,11 +535,13 @@ fn a_full_pool_evicts_the_least_useful_and_never_goes_over() {
     p.tick(0.02, None, &[ManagedDeformer::new(foot([10.0, 0.25, 0.0]))])
         .unwrap();
     assert!(p.is_resident(s[0]) && p.is_resident(s[1]));
-    // Both go inactive but are retained; s2 is touched: the least recently useful (s0) goes.
+    // Both go inactive and keep their heightmaps; s2 is touched: the least recently useful (s0) is
+    // paged out.
     let plan = p
         .tick(0.02, None, &[ManagedDeformer::new(foot([20.0, 0.25, 0.0]))])
         .unwrap();
     assert_eq!(plan.stats.evicted, vec!["s0".to_owned()]);
+    assert!(p.is_paged(s[0]));
     assert!(p.is_resident(s[1]) && p.is_resident(s[2]));
     assert!(p.pool_used() <= p.pool_budget());
     // s2 (touched) and s3 (touched by the player): s1, inactive, goes; nothing touched is evicted.
@@ -572,33 +592,61 @@ fn a_full_pool_evicts_the_least_useful_and_never_goes_over() {
 }
 
 #[test]
-fn inactive_surfaces_hold_no_heightmap_by_default() {
+fn inactive_surfaces_keep_their_heightmaps_while_the_pool_has_room() {
     let mut p = Planner::new(&ManagerConfig::default()).unwrap();
     let a = p.add_surface(&flat("a", 0.0, 0.0, 0.0), ZoneId(0)).unwrap();
     p.tick(0.02, None, &[ManagedDeformer::new(foot([0.0, 0.25, 0.0]))])
         .unwrap();
     assert!(p.is_resident(a));
-    let plan = p.tick(0.02, None, &[]).unwrap();
-    assert_eq!(plan.stats.evicted, vec!["a".to_owned()]);
-    assert_eq!(p.pool_used(), 0);
-    // Out of the camera's reach is inactive too.
+    // Nothing touches it, no camera sees it: inactive, and still holding its heightmap.
+    for _ in 0..5 {
+        let plan = p.tick(0.02, None, &[]).unwrap();
+        assert!(plan.stats.evicted.is_empty() && plan.changes.is_empty());
+    }
+    assert!(p.is_resident(a) && !p.is_active(a));
     let cam = looking_down_at(0.0, 0.0);
-    p.tick(0.02, Some(&cam), &[]).unwrap();
-    assert!(p.is_resident(a));
     let far = CameraView {
         eye: Vec3::new(200.0, 30.0, 0.0),
         target: Vec3::new(0.0, 0.0, 0.0),
         ..cam
     };
     p.tick(0.02, Some(&far), &[]).unwrap();
-    assert!(!p.is_resident(a), "beyond active_distance");
+    assert!(p.is_resident(a), "beyond active_distance, kept");
     let behind = CameraView {
         eye: Vec3::new(10.0, 2.0, 0.0),
         target: Vec3::new(20.0, 2.0, 0.0),
         ..cam
     };
     p.tick(0.02, Some(&behind), &[]).unwrap();
-    assert!(!p.is_resident(a), "behind the camera");
+    assert!(p.is_resident(a), "behind the camera, kept");
+    assert!(!p.is_paged(a));
+}
+
+#[test]
+fn a_full_page_store_keeps_heightmaps_in_the_pool() {
+    // Room for one 4 m x 4 m surface in the pool and none in the page store: the second surface
+    // touched waits rather than evict (and lose) the first one's heightmap.
+    let one = PoolFormat::default().slot_bytes(100, 100);
+    let config = ManagerConfig {
+        pool_bytes: one + 1000,
+        page_bytes: one - 1,
+        ..ManagerConfig::default()
+    };
+    let mut p = Planner::new(&config).unwrap();
+    let a = p.add_surface(&flat("a", 0.0, 0.0, 0.0), ZoneId(0)).unwrap();
+    let b = p
+        .add_surface(&flat("b", 10.0, 0.0, 0.0), ZoneId(0))
+        .unwrap();
+    p.tick(0.02, None, &[ManagedDeformer::new(foot([0.0, 0.25, 0.0]))])
+        .unwrap();
+    p.tick(0.02, None, &[]).unwrap();
+    let plan = p
+        .tick(0.02, None, &[ManagedDeformer::new(foot([10.0, 0.25, 0.0]))])
+        .unwrap();
+    assert!(plan.changes.is_empty(), "{:?}", plan.changes);
+    assert_eq!(plan.stats.waiting_for_memory, 1);
+    assert!(p.is_resident(a) && !p.is_resident(b));
+    assert_eq!(p.queued_imprints(b), 1);
 }
 
 #[test]
@@ -764,7 +812,7 @@ fn run_twenty(updates_per_frame: usize, frames: u64) -> (Vec<Heightmap>, u64, us
     }
     let maps = ids
         .iter()
-        .map(|&id| m.read_heightmap(id).expect("readback").expect("resident"))
+        .map(|&id| m.read_heightmap(id).expect("readback"))
         .collect();
     (maps, max_wait, most)
 }
@@ -871,7 +919,7 @@ fn dragged_spheres_on_a_budget_press_at_least_as_deep() {
             }
         }
         ids.iter()
-            .map(|&id| m.read_heightmap(id).unwrap().unwrap())
+            .map(|&id| m.read_heightmap(id).unwrap())
             .collect()
     };
     let budget = run(2);
@@ -891,7 +939,7 @@ fn dragged_spheres_on_a_budget_press_at_least_as_deep() {
 }
 
 /// A city on the default 2 MiB pool: the manager evicts, never exceeds the budget, and a surface
-/// without a slot reads back as `None`.
+/// without a slot reads back from its page (or as untouched snow when it never held one).
 #[test]
 fn a_city_runs_inside_two_mebibytes() {
     let c = city::generate(5, 60, 12);
@@ -915,11 +963,17 @@ fn a_city_runs_inside_two_mebibytes() {
         .filter(|&&id| m.planner().is_resident(id))
         .count();
     assert!(resident > 0 && resident < ids.len());
+    let paged = ids.iter().filter(|&&id| m.planner().is_paged(id)).count();
+    assert!(paged > 0, "the city evicted something");
+    assert_eq!(m.stats().paged_surfaces, paged);
+    assert_eq!(m.pages().len(), paged);
     for &id in &ids {
         assert_eq!(
-            m.read_heightmap(id).unwrap().is_some(),
-            m.planner().is_resident(id)
+            m.world_id(id).is_some(),
+            m.planner().is_resident(id),
+            "a world heightmap exactly for the resident surfaces"
         );
+        m.read_heightmap(id).unwrap();
     }
     let json = serde_json::to_string(m.stats()).unwrap();
     for key in [
@@ -934,9 +988,16 @@ fn a_city_runs_inside_two_mebibytes() {
     ] {
         assert!(json.contains(key), "{json}");
     }
-    // Unloading every zone frees the whole pool.
+    // Unloading every zone frees the whole pool and pages every heightmap that was resident.
+    let before: Vec<Heightmap> = ids
+        .iter()
+        .map(|&id| m.read_heightmap(id).unwrap())
+        .collect();
     for s in &c.surfaces {
         m.unload_zone(s.zone).unwrap();
     }
     assert_eq!(m.world().memory().pool_used, 0);
+    for (&id, map) in ids.iter().zip(&before) {
+        assert_eq!(&m.read_heightmap(id).unwrap(), map, "paged bit for bit");
+    }
 }

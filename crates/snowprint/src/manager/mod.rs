@@ -34,6 +34,7 @@
 //! order and the memory accounting.
 
 pub mod city;
+pub mod pages;
 pub mod planner;
 pub mod plot;
 pub mod quadtree;
@@ -44,7 +45,7 @@ use glam::{Vec3, Vec4};
 pub use planner::{Lookup, Plan, PlannedUpdate, Planner, ResidencyChange};
 pub use quadtree::{Aabb, SurfaceIndex};
 
-use crate::deformer::Deformer;
+use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::gpu::GpuContext;
 use crate::heightmap::Heightmap;
@@ -52,6 +53,7 @@ use crate::mesh::{Mesh, MeshId};
 use crate::surface::{SurfaceDesc, SurfaceId};
 use crate::view::Camera;
 use crate::world::{CaptureConfig, SnowWorld, SurfaceUpdate, WorldConfig};
+use pages::{Page, PageStore};
 
 /// Handle of a surface in a [`SnowManager`] (or a [`Planner`]); stable whether or not the surface
 /// holds a heightmap.
@@ -133,13 +135,15 @@ pub struct ManagerConfig {
     pub distance_slack_frames: u32,
     /// Updates a frame reserved for the player's surfaces, at most `K - 1` (default 1).
     pub player_slots: usize,
-    /// Most imprints queued on one surface between two of its updates (default 256); see
-    /// [`queue`].
+    /// Most imprints kept queued on a surface that waits for its update (default 1024, about
+    /// 96 bytes each); past it, neighbouring entries merge into covering sweeps (see [`queue`]). A
+    /// surface updated in a frame takes its whole queue, however long.
     pub queue_cap: usize,
-    /// Keep the heightmaps of surfaces that became inactive until their memory is wanted (least
-    /// recently useful first), instead of freeing them at once (default `false`: inactive surfaces
-    /// hold no heightmap).
-    pub retain_inactive: bool,
+    /// Bytes the page store may hold (evicted heightmaps, compressed); default unlimited
+    /// (`u64::MAX`). A surface is evicted only when the store has room for its whole slot, so a
+    /// heightmap is never lost for want of it: when the store is full, candidates for a slot wait.
+    /// A zone unload pages its surfaces whatever the store holds (the game asked for it).
+    pub page_bytes: u64,
     /// Seconds between the updates of a surface that only needs its snowfall refilled (default
     /// 0.25).
     pub replenish_interval: f32,
@@ -159,8 +163,8 @@ impl Default for ManagerConfig {
             active_distance: 60.0,
             distance_slack_frames: 8,
             player_slots: 1,
-            queue_cap: 256,
-            retain_inactive: false,
+            queue_cap: 1024,
+            page_bytes: u64::MAX,
             replenish_interval: 0.25,
             capture: CaptureConfig::default(),
             atlas_side: 2048,
@@ -360,10 +364,19 @@ pub struct TickStats {
     pub waiting_for_memory: usize,
     /// Imprints queued, over all surfaces, after this frame's updates.
     pub queued_imprints: usize,
-    /// Imprints merged into their predecessor because a queue was full (trail straightened).
+    /// Queued imprints merged into covering sweeps this frame because a waiting surface's queue
+    /// passed `queue_cap` (conservative: the kept sweep presses at least what the merged ones
+    /// did). Nothing is ever dropped.
     pub imprints_merged: u64,
-    /// Imprints dropped because a queue was full and nothing could be merged.
-    pub imprints_dropped: u64,
+    /// Bytes of heightmaps read back from the GPU and paged out since the last frame (evictions
+    /// and zone unloads), before compression.
+    pub paged_out_bytes: u64,
+    /// Bytes of heightmaps paged back in and written to the GPU this frame.
+    pub paged_in_bytes: u64,
+    /// Bytes the page store holds after this frame (compressed).
+    pub page_store_bytes: u64,
+    /// Surfaces whose heightmap is paged out after this frame.
+    pub paged_surfaces: usize,
 }
 
 /// A [`SnowWorld`] run by a [`Planner`]: see the module docs.
@@ -372,7 +385,23 @@ pub struct SnowManager {
     planner: Planner,
     /// Per managed surface: its handle in the world while it holds a heightmap.
     world_ids: Vec<Option<SurfaceId>>,
+    /// Heightmaps of surfaces without a slot that had one.
+    pages: PageStore,
+    /// Mesh deformers by the manager's [`MeshId`].
+    meshes: Vec<ManagedMesh>,
+    /// World meshes of earlier posings that queued imprints may still name.
+    retired: Vec<MeshId>,
+    /// Bytes paged out between ticks (zone unloads), reported by the next tick.
+    paged_between: u64,
     stats: TickStats,
+}
+
+/// A mesh deformer: its current posing and the world mesh that holds it.
+#[derive(Clone, Debug)]
+pub(crate) struct ManagedMesh {
+    pub(crate) name: String,
+    pub(crate) mesh: Mesh,
+    pub(crate) world: MeshId,
 }
 
 impl std::fmt::Debug for SnowManager {
@@ -380,6 +409,7 @@ impl std::fmt::Debug for SnowManager {
         f.debug_struct("SnowManager")
             .field("surfaces", &self.planner.len())
             .field("resident", &self.stats.resident)
+            .field("paged", &self.pages.len())
             .field("pool_used", &self.planner.pool_used())
             .finish()
     }
@@ -389,29 +419,38 @@ impl SnowManager {
     /// A manager with its own world (pool of `config.pool_bytes`, clamped to the device).
     pub fn new(gpu: &GpuContext, config: ManagerConfig) -> Result<Self> {
         config.validate()?;
-        let world = SnowWorld::new(
-            gpu,
-            WorldConfig {
-                capture: config.capture,
-                pool_bytes: config.pool_bytes,
-                atlas_side: config.atlas_side,
-                // The planner sizes slots by the talk's rule (`SurfaceDesc::layout`, 512 a side).
-                max_resolution: crate::surface::MAX_RESOLUTION,
-                format: config.format,
-                ..WorldConfig::default()
-            },
-        )?;
+        let world = SnowWorld::new(gpu, Self::world_config(&config))?;
         // The planner mirrors the world's allocator: same budget after the world's clamping.
         let planner = Planner::new(&ManagerConfig {
             pool_bytes: world.memory().pool_budget,
             ..config
         })?;
-        Ok(Self {
+        Ok(Self::with_parts(world, planner))
+    }
+
+    fn world_config(config: &ManagerConfig) -> WorldConfig {
+        WorldConfig {
+            capture: config.capture,
+            pool_bytes: config.pool_bytes,
+            atlas_side: config.atlas_side,
+            // The planner sizes slots by the talk's rule (`SurfaceDesc::layout`, 512 a side).
+            max_resolution: crate::surface::MAX_RESOLUTION,
+            format: config.format,
+            ..WorldConfig::default()
+        }
+    }
+
+    fn with_parts(world: SnowWorld, planner: Planner) -> Self {
+        Self {
             world,
             planner,
             world_ids: Vec::new(),
+            pages: PageStore::default(),
+            meshes: Vec::new(),
+            retired: Vec::new(),
+            paged_between: 0,
             stats: TickStats::default(),
-        })
+        }
     }
 
     /// Register a surface in a zone. It holds no heightmap until it becomes active.
@@ -421,72 +460,194 @@ impl SnowManager {
         Ok(id)
     }
 
-    /// Remove a surface for good (its heightmap, if any, is freed).
+    /// Remove a surface for good (its heightmap, resident or paged, is freed).
     pub fn remove_surface(&mut self, id: ManagedId) -> Result<()> {
         self.planner.remove_surface(id)?;
-        self.free_world(id)
-    }
-
-    fn free_world(&mut self, id: ManagedId) -> Result<()> {
+        self.pages.take(id.0);
         if let Some(w) = self.world_ids.get_mut(id.0 as usize).and_then(Option::take) {
             self.world.remove_surface(w)?;
         }
         Ok(())
     }
 
-    /// Load a zone: its surfaces may become active again (with fresh heightmaps).
+    /// Load a zone: the surfaces that held heightmaps when it unloaded page them back in at the
+    /// next ticks (as the pool has room), the others when they become active.
     pub fn load_zone(&mut self, zone: ZoneId) {
         self.planner.load_zone(zone);
     }
 
-    /// Unload a zone: its surfaces free their heightmaps now and their queued imprints are dropped.
-    /// Returns the surfaces that held a heightmap.
+    /// Unload a zone: its surfaces page their heightmaps out now and give their slots up; their
+    /// queued imprints wait for the zone to load. Returns the surfaces that held a heightmap.
     pub fn unload_zone(&mut self, zone: ZoneId) -> Result<Vec<ManagedId>> {
         let freed = self.planner.unload_zone(zone);
-        for &id in &freed {
-            self.free_world(id)?;
-        }
+        self.paged_between += self.page_out(&freed)?;
         Ok(freed)
     }
 
-    /// Register a mesh deformer shape (see [`SnowWorld::add_mesh`]).
+    /// Snapshot the world surfaces of `ids` (one GPU round trip), keep them as pages and free
+    /// their slots. Returns the bytes read back.
+    fn page_out(&mut self, ids: &[ManagedId]) -> Result<u64> {
+        let world: Vec<SurfaceId> = ids
+            .iter()
+            .filter_map(|id| self.world_ids[id.0 as usize])
+            .collect();
+        let snaps = self.world.snapshot_surfaces(&world)?;
+        let mut bytes = 0;
+        let mut snaps = snaps.into_iter();
+        for id in ids {
+            if let Some(w) = self.world_ids[id.0 as usize].take() {
+                let snap = snaps.next().ok_or_else(|| {
+                    SnowError::Readback("a page-out returned fewer surfaces than asked".into())
+                })?;
+                bytes += snap.words.len() as u64 * 4;
+                self.pages.put(id.0, Page::compress(snap));
+                self.world.remove_surface(w)?;
+            }
+        }
+        Ok(bytes)
+    }
+
+    /// Register a mesh deformer shape (see [`SnowWorld::add_mesh`]). The handle is the manager's:
+    /// use it in [`Shape::Mesh`] of the deformers given to [`SnowManager::tick`].
     pub fn add_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<MeshId> {
-        let id = self.world.add_mesh(name, mesh)?;
-        self.planner.set_mesh_radius(id, mesh.bounding_radius())?;
-        Ok(id)
+        let world = self.world.add_mesh(name, mesh)?;
+        self.planner
+            .set_mesh_radius(world, mesh.bounding_radius())?;
+        self.meshes.push(ManagedMesh {
+            name: name.to_owned(),
+            mesh: mesh.clone(),
+            world,
+        });
+        Ok(MeshId(self.meshes.len() as u32 - 1))
+    }
+
+    /// The handle of the mesh registered under `name`, if any (the first, if several).
+    pub fn mesh_named(&self, name: &str) -> Option<MeshId> {
+        self.meshes
+            .iter()
+            .position(|m| m.name == name)
+            .map(|i| MeshId(i as u32))
+    }
+
+    fn mesh(&self, id: MeshId) -> Result<&ManagedMesh> {
+        self.meshes
+            .get(id.0 as usize)
+            .ok_or(SnowError::StaleHandle {
+                what: "mesh",
+                index: id.0,
+            })
     }
 
     /// Re-pose a mesh deformer (see [`SnowWorld::pose_mesh`]). Imprints of the mesh still queued
-    /// are captured with the newest posing.
+    /// keep the posing they were made with: when any are queued, the new posing goes into a new
+    /// world mesh and the old one is freed once no queue names it.
     pub fn pose_mesh(&mut self, id: MeshId, positions: &[Vec3]) -> Result<()> {
-        self.world.pose_mesh(id, positions)?;
-        let r = positions.iter().map(|p| p.length()).fold(0.0, f32::max);
-        self.planner.set_mesh_radius(id, r)
+        let m = self.mesh(id)?;
+        let world = m.world;
+        if positions.len() != m.mesh.positions.len() {
+            return Err(SnowError::PoseMismatch {
+                mesh: id.0,
+                got: positions.len(),
+                expected: m.mesh.positions.len(),
+            });
+        }
+        let posed = Mesh {
+            positions: positions.to_vec(),
+            indices: m.mesh.indices.clone(),
+        };
+        let name = m.name.clone();
+        posed.validate(&name)?;
+        let r = posed.bounding_radius();
+        if self.planner.queues_hold_mesh(world) {
+            let new = self.world.add_mesh(&name, &posed)?;
+            self.planner.set_mesh_radius(new, r)?;
+            self.retired.push(world);
+            self.meshes[id.0 as usize].world = new;
+        } else {
+            self.world.pose_mesh(world, positions)?;
+            self.planner.set_mesh_radius(world, r)?;
+            // What the last updates pressed with the old posing no longer covers the new one.
+            self.planner.forget_applied_mesh(world);
+        }
+        self.meshes[id.0 as usize].mesh = posed;
+        Ok(())
     }
 
-    /// Run one frame: decide (see [`Planner::tick`]), free and give heightmaps, then update at most
-    /// `updates_per_frame` surfaces on the GPU with everything that touched them since their last
-    /// update. Bad input is an error before anything changes.
+    /// Run one frame: decide (see [`Planner::tick`]), page heightmaps out and in, then update at
+    /// most `updates_per_frame` surfaces on the GPU with everything that touched them since their
+    /// last update. Bad input is an error before anything changes.
     pub fn tick(
         &mut self,
         dt: f32,
         camera: Option<&CameraView>,
         deformers: &[ManagedDeformer],
     ) -> Result<TickStats> {
+        // Mesh handles are the manager's; the planner and the world see the current world mesh.
+        let mut translated = Vec::new();
+        let deformers = if deformers
+            .iter()
+            .any(|d| matches!(d.deformer.shape, Shape::Mesh(_)))
+        {
+            for d in deformers {
+                let mut d = *d;
+                if let Shape::Mesh(id) = d.deformer.shape {
+                    d.deformer.shape = Shape::Mesh(self.mesh(id)?.world);
+                }
+                translated.push(d);
+            }
+            &translated[..]
+        } else {
+            deformers
+        };
         self.planner.tick(dt, camera, deformers)?;
+        let paged_between = std::mem::take(&mut self.paged_between);
         let plan = self.planner.last_plan();
+        let evict: Vec<ManagedId> = plan
+            .changes
+            .iter()
+            .filter_map(|c| match *c {
+                ResidencyChange::Evict(id) => Some(id),
+                ResidencyChange::Admit(_) => None,
+            })
+            .collect();
+        // Every heightmap to evict is read back in one round trip, before any slot is reused.
+        let snaps = {
+            let world: Vec<SurfaceId> = evict
+                .iter()
+                .filter_map(|id| self.world_ids[id.0 as usize])
+                .collect();
+            self.world.snapshot_surfaces(&world)?
+        };
+        let mut snaps = snaps.into_iter();
+        let (mut paged_out, mut paged_in) = (paged_between, 0);
         let mut failed = Vec::new();
         for change in &plan.changes {
             match *change {
                 ResidencyChange::Evict(id) => {
                     if let Some(w) = self.world_ids[id.0 as usize].take() {
+                        let snap = snaps.next().ok_or_else(|| {
+                            SnowError::Readback("a page-out returned fewer surfaces".into())
+                        })?;
+                        paged_out += snap.words.len() as u64 * 4;
+                        self.pages.put(id.0, Page::compress(snap));
                         self.world.remove_surface(w)?;
                     }
                 }
                 ResidencyChange::Admit(id) => {
-                    let desc = self.planner.surface(id)?.clone();
-                    match self.world.add_surface(desc) {
-                        Ok(w) => self.world_ids[id.0 as usize] = Some(w),
+                    let at = self.planner.slot(id).map(|s| s.offset);
+                    let result = match self.pages.get(id.0) {
+                        Some(page) => {
+                            let snap = page.decompress()?;
+                            paged_in += snap.words.len() as u64 * 4;
+                            self.world.restore_surface(&snap, at)
+                        }
+                        None => self.world.add_surface(self.planner.surface(id)?.clone()),
+                    };
+                    match result {
+                        Ok(w) => {
+                            self.pages.take(id.0);
+                            self.world_ids[id.0 as usize] = Some(w);
+                        }
                         Err(SnowError::PoolExhausted { name, .. }) => {
                             tracing::warn!(
                                 "the pool refused surface {name:?} that the planner expected to fit"
@@ -516,6 +677,7 @@ impl SnowManager {
         for id in failed {
             self.planner.admission_failed(id);
         }
+        self.free_retired_meshes()?;
         let memory = self.world.memory();
         if memory.pool_used != self.planner.pool_used() {
             tracing::warn!(
@@ -526,8 +688,53 @@ impl SnowManager {
         }
         stats.pool_bytes_used = memory.pool_used;
         stats.pool_bytes_budget = memory.pool_budget;
+        stats.paged_out_bytes = paged_out;
+        stats.paged_in_bytes = paged_in;
+        stats.page_store_bytes = self.pages.bytes();
+        stats.paged_surfaces = self.pages.len();
         self.stats = stats.clone();
         Ok(stats)
+    }
+
+    /// Free the world meshes of earlier posings that no queue names any more.
+    fn free_retired_meshes(&mut self) -> Result<()> {
+        let mut k = 0;
+        while k < self.retired.len() {
+            let m = self.retired[k];
+            if self.planner.queues_hold_mesh(m) {
+                k += 1;
+            } else {
+                self.world.remove_mesh(m)?;
+                self.retired.swap_remove(k);
+            }
+        }
+        Ok(())
+    }
+
+    /// Land every queued imprint now, whatever the budget: ticks of `dt = 0` with no camera and
+    /// no deformers and no budget, paging surfaces in and out as the pool allows, until no queue
+    /// holds anything (imprints over unloaded zones wait for their zone). Returns the ticks run.
+    /// A game calls it before it reads every surface (a save needs no flush: it keeps the queues).
+    pub fn flush(&mut self) -> Result<u32> {
+        let budget = self.planner.config().updates_per_frame;
+        self.planner.set_updates_per_frame(UNLIMITED);
+        let mut ticks = 0;
+        let mut last = usize::MAX;
+        let result = loop {
+            let pending = self.planner.pending_loaded_surfaces();
+            // Each round updates every resident surface with a queue and admits more; a round
+            // that changes nothing means only unloaded zones still wait.
+            if pending == 0 || (pending >= last && ticks > self.planner.len() as u32 + 2) {
+                break Ok(ticks);
+            }
+            last = pending;
+            if let Err(e) = self.tick(0.0, None, &[]) {
+                break Err(e);
+            }
+            ticks += 1;
+        };
+        self.planner.set_updates_per_frame(budget);
+        result
     }
 
     /// The statistics of the last tick.
@@ -535,14 +742,23 @@ impl SnowManager {
         &self.stats
     }
 
-    /// A surface's heightmap, read back from the GPU, or `None` when it holds none (inactive, or
-    /// waiting for memory). Imprints still queued are not in it yet.
-    pub fn read_heightmap(&self, id: ManagedId) -> Result<Option<Heightmap>> {
-        self.planner.surface(id)?;
-        match self.world_ids.get(id.0 as usize).copied().flatten() {
-            Some(w) => Ok(Some(self.world.read_heightmap(w)?)),
-            None => Ok(None),
+    /// A surface's heightmap: read back from the GPU while it holds a slot, from its page when it
+    /// is paged out, and untouched snow when it never held one. Imprints still queued are not in
+    /// it yet (see [`SnowManager::flush`]).
+    pub fn read_heightmap(&self, id: ManagedId) -> Result<Heightmap> {
+        let desc = self.planner.surface(id)?;
+        if let Some(w) = self.world_ids.get(id.0 as usize).copied().flatten() {
+            return self.world.read_heightmap(w);
         }
+        if let Some(page) = self.pages.get(id.0) {
+            return page.decompress()?.heightmap();
+        }
+        let l = desc.layout();
+        Ok(Heightmap::from_packed(
+            l.width,
+            l.height,
+            &vec![0; l.texels() as usize],
+        ))
     }
 
     /// The world handle of a surface while it holds a heightmap (for renderers).
@@ -566,6 +782,11 @@ impl SnowManager {
     /// The world (heightmaps on the GPU, memory report).
     pub fn world(&self) -> &SnowWorld {
         &self.world
+    }
+
+    /// The page store (heightmaps of surfaces without a slot).
+    pub fn pages(&self) -> &PageStore {
+        &self.pages
     }
 
     /// Measure GPU stages with timestamp queries (see [`SnowWorld::set_profiling`]).

@@ -11,10 +11,11 @@
 //! 2. **Activity.** A surface of a loaded zone is active while it is in the camera's frustum
 //!    (the bounding sphere of its box) and within `active_distance` of the eye (its box), while
 //!    something touches it, or while imprints wait in its queue. A surface that stops being active
-//!    gives its slot up (or, with `retain_inactive`, keeps it until the memory is wanted).
+//!    keeps its slot until the memory is wanted.
 //! 3. **Residency.** Active surfaces without a slot ask for one, most useful first; when the pool
-//!    has no room, less useful residents are evicted (see [`Planner`] for the order). The planner
-//!    keeps its own copy of the world's first-fit allocator, so it knows exactly what fits.
+//!    has no room, less useful residents are evicted (see [`Planner`] for the order): their
+//!    heightmaps are paged out, and paged back in when they are admitted again. The planner keeps
+//!    its own copy of the world's first-fit allocator, so it knows exactly what fits.
 //! 4. **Budget.** Of the resident surfaces due for an update, at most `updates_per_frame` are chosen:
 //!    the player's surfaces first (up to `player_slots`), then earliest deadline first, where a
 //!    surface's deadline is the frame it became due plus a slack that grows with its distance.
@@ -24,7 +25,7 @@ use std::collections::{HashMap, VecDeque};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::quadtree::{Aabb, SurfaceIndex};
-use super::queue::{self, Push};
+use super::queue;
 use super::{CameraView, ManagedDeformer, ManagedId, ManagerConfig, TickStats, ZoneId};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
@@ -57,9 +58,10 @@ pub enum Lookup {
 /// the planner's copy).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ResidencyChange {
-    /// Free the surface's heightmap (its contents are lost).
+    /// Page the surface's heightmap out (to the manager's page store) and free its slot.
     Evict(ManagedId),
-    /// Give the surface a fresh, untouched heightmap.
+    /// Give the surface a slot: its paged heightmap when it has one
+    /// ([`Planner::is_paged`] before the tick), else fresh, untouched snow.
     Admit(ManagedId),
 }
 
@@ -154,6 +156,10 @@ const REMOVED: u8 = 2;
 const LISTED: u8 = 4;
 /// Snow falls on it (replenish rate above 0).
 const SNOWFALL: u8 = 8;
+/// Its heightmap is in the page store (it was evicted, or its zone unloaded).
+const PAGED: u8 = 16;
+/// Resident when its zone was unloaded: paged back in as soon as the zone loads and there is room.
+const WANTED: u8 = 32;
 
 /// What the per-tick passes over touched, active and waiting surfaces read and write, in one cache
 /// line per surface: a city with hundreds of surfaces waiting for memory is walked several times a
@@ -201,6 +207,21 @@ struct Managed {
     last_update_time: f64,
     /// Until when (seconds) snowfall still has something to refill.
     pressed_until: f64,
+}
+
+impl Managed {
+    fn new(desc: SurfaceDesc) -> Self {
+        Self {
+            desc,
+            slot: None,
+            resident_pos: 0,
+            queue: VecDeque::new(),
+            applied: Vec::new(),
+            due_since: None,
+            last_update_time: 0.0,
+            pressed_until: 0.0,
+        }
+    }
 }
 
 /// What the touch test reads of a surface, in one cache line: a tick tests thousands of candidates
@@ -309,6 +330,11 @@ pub struct Planner {
     sweeps: Vec<(Vec3, Vec3, f32)>,
     /// Names of surfaces evicted between ticks (zone unloads, removals), reported by the next tick.
     evicted_between: Vec<String>,
+    /// Slot bytes of the paged surfaces: a bound on what the page store holds (a page is never
+    /// larger than its slot), checked against `ManagerConfig::page_bytes` before evicting.
+    paged_bound: u64,
+    /// Entries merged by [`queue::bound`] since the planner was made.
+    merged_total: u64,
     plan: Plan,
 }
 
@@ -339,6 +365,8 @@ impl Planner {
             scratch: Vec::new(),
             sweeps: Vec::new(),
             evicted_between: Vec::new(),
+            paged_bound: 0,
+            merged_total: 0,
             plan: Plan::default(),
         })
     }
@@ -414,16 +442,7 @@ impl Planner {
             top,
             zone as u32,
         ));
-        self.surfaces.push(Managed {
-            desc: desc.clone(),
-            slot: None,
-            resident_pos: 0,
-            queue: VecDeque::new(),
-            applied: Vec::new(),
-            due_since: None,
-            last_update_time: 0.0,
-            pressed_until: 0.0,
-        });
+        self.surfaces.push(Managed::new(desc.clone()));
         self.zone_members[zone].push(index);
         self.index_dirty = true;
         Ok(ManagedId(index))
@@ -443,8 +462,12 @@ impl Planner {
     /// Remove a surface for good. Returns whether it held a slot (the caller frees the world's).
     pub fn remove_surface(&mut self, id: ManagedId) -> Result<bool> {
         self.get(id)?;
-        let had = self.release(id.0, true);
+        let had = self.release(id.0, true, false);
         let i = id.0 as usize;
+        if self.status[i].has(PAGED) {
+            self.status[i].set(PAGED, false);
+            self.paged_bound -= self.status[i].bytes as u64;
+        }
         self.status[i].set(REMOVED, true);
         self.clear_queue(id.0);
         self.surfaces[i].applied = Vec::new();
@@ -457,14 +480,20 @@ impl Planner {
         self.status[index as usize].queue_len = 0;
     }
 
-    /// Free a surface's slot, if it has one. `between` = outside a tick (reported by the next).
-    fn release(&mut self, index: u32, between: bool) -> bool {
+    /// Free a surface's slot, if it has one, paging its heightmap out when `page`. `between` =
+    /// outside a tick (reported by the next).
+    fn release(&mut self, index: u32, between: bool, page: bool) -> bool {
         let s = &mut self.surfaces[index as usize];
         let Some(slot) = s.slot.take() else {
             return false;
         };
         self.alloc.free(slot);
-        self.status[index as usize].set(RESIDENT, false);
+        let st = &mut self.status[index as usize];
+        st.set(RESIDENT, false);
+        if page && !st.has(PAGED) {
+            st.set(PAGED, true);
+            self.paged_bound += st.bytes as u64;
+        }
         s.due_since = None;
         s.applied.clear();
         let pos = s.resident_pos;
@@ -484,25 +513,37 @@ impl Planner {
         true
     }
 
-    /// Mark a zone loaded (its surfaces may become active again, with fresh heightmaps).
+    /// Mark a zone loaded: the surfaces that held a heightmap when it was unloaded ask for their
+    /// slots back at the next tick (their pages come back in as room allows), the others when they
+    /// become active; queued imprints land as they do.
     pub fn load_zone(&mut self, zone: ZoneId) {
         let z = self.zone_index(zone);
-        self.zone_loaded[z] = true;
+        if !self.zone_loaded[z] {
+            self.zone_loaded[z] = true;
+            for &m in &self.zone_members[z] {
+                let st = &mut self.status[m as usize];
+                if st.has(WANTED) && !st.has(REMOVED) && !st.has(LISTED) {
+                    st.set(LISTED, true);
+                    self.queued.push(m);
+                }
+            }
+        }
     }
 
-    /// Unload a zone: its surfaces give their slots up at once and their queued imprints are
-    /// dropped (the zone is no longer streamed). Returns the surfaces that held a slot, whose world
-    /// heightmaps the caller must free. A zone never seen before is created unloaded.
+    /// Unload a zone: its surfaces page their heightmaps out and give their slots up at once;
+    /// their queued imprints wait until the zone is loaded again (deformers over an unloaded zone
+    /// are ignored). Returns the surfaces that held a slot, whose world heightmaps the caller must
+    /// page out and free. A zone never seen before is created unloaded.
     pub fn unload_zone(&mut self, zone: ZoneId) -> Vec<ManagedId> {
         let z = self.zone_index(zone);
         self.zone_loaded[z] = false;
         let members = std::mem::take(&mut self.zone_members[z]);
         let mut freed = Vec::new();
         for &m in &members {
-            if self.release(m, true) {
+            if self.release(m, true, true) {
                 freed.push(ManagedId(m));
+                self.status[m as usize].set(WANTED, true);
             }
-            self.clear_queue(m);
             self.status[m as usize].active = 0;
         }
         self.zone_members[z] = members;
@@ -541,7 +582,7 @@ impl Planner {
             .get(id.0 as usize)
             .is_some_and(|s| s.slot.is_some())
         {
-            self.release(id.0, true);
+            self.release(id.0, true, false);
             self.evicted_between.pop();
         }
     }
@@ -580,6 +621,61 @@ impl Planner {
     /// Whether a surface holds a heightmap.
     pub fn is_resident(&self, id: ManagedId) -> bool {
         self.get(id).is_ok_and(|s| s.slot.is_some())
+    }
+
+    /// Whether a surface's heightmap is paged out (evicted, or its zone unloaded).
+    pub fn is_paged(&self, id: ManagedId) -> bool {
+        self.get(id).is_ok() && self.status[id.0 as usize].has(PAGED)
+    }
+
+    /// Queue entries merged into covering sweeps since the planner was made (see
+    /// [`queue::bound`]).
+    pub fn imprints_merged(&self) -> u64 {
+        self.merged_total
+    }
+
+    /// Whether any queue holds an imprint of this (world) mesh.
+    pub fn queues_hold_mesh(&self, mesh: MeshId) -> bool {
+        let shape = Shape::Mesh(mesh);
+        self.queued.iter().any(|&i| {
+            self.status[i as usize].queue_len > 0
+                && self.surfaces[i as usize]
+                    .queue
+                    .iter()
+                    .any(|d| d.shape == shape)
+        })
+    }
+
+    /// Forget what the last updates pressed with a mesh (it was re-posed in place: the same pose
+    /// no longer presses the same shape).
+    pub fn forget_applied_mesh(&mut self, mesh: MeshId) {
+        let shape = Shape::Mesh(mesh);
+        for &i in &self.resident {
+            self.surfaces[i as usize]
+                .applied
+                .retain(|d| d.shape != shape);
+        }
+    }
+
+    /// Change the budget of updates a frame (a flush runs with [`super::UNLIMITED`]).
+    pub fn set_updates_per_frame(&mut self, k: usize) {
+        self.config.updates_per_frame = k.max(1);
+    }
+
+    /// Surfaces of loaded zones with imprints waiting (resident or not).
+    pub fn pending_loaded_surfaces(&self) -> usize {
+        self.queued
+            .iter()
+            .filter(|&&s| {
+                let st = &self.status[s as usize];
+                st.queue_len > 0 && !st.has(REMOVED) && self.zone_loaded[st.zone as usize]
+            })
+            .count()
+    }
+
+    /// The imprints queued on a surface, oldest first.
+    pub fn queue(&self, id: ManagedId) -> Result<impl Iterator<Item = &Deformer>> {
+        Ok(self.get(id)?.queue.iter())
     }
 
     /// The pool placement the planner expects the world to give this surface.
@@ -685,8 +781,9 @@ impl Planner {
                         what: "mesh",
                         index: id.0,
                     })?;
-                // Meshes are captured at their pose only.
-                Ok((d.pose.position, d.pose.position, r))
+                // The world draws a moving mesh at sub-steps along its motion: the ball of its
+                // bound swept from the previous pose holds them all.
+                Ok((d.previous.unwrap_or(d.pose).position, d.pose.position, r))
             }
             shape => {
                 let r = shape.bounding_radius().unwrap_or(0.0);
@@ -755,7 +852,6 @@ impl Planner {
             evicted: std::mem::take(&mut self.evicted_between),
             ..TickStats::default()
         };
-        let cap = self.config.queue_cap;
         let mut scratch = std::mem::take(&mut self.scratch);
 
         // 1. Touches.
@@ -780,11 +876,7 @@ impl Planner {
                 }
                 let m = &mut self.surfaces[i as usize];
                 let skip_applied = !st.has(SNOWFALL);
-                match queue::push(&mut m.queue, &m.applied, skip_applied, d.deformer, cap) {
-                    Push::Merged => self.plan.stats.imprints_merged += 1,
-                    Push::DroppedOldest => self.plan.stats.imprints_dropped += 1,
-                    _ => {}
-                }
+                queue::push(&mut m.queue, &m.applied, skip_applied, d.deformer);
                 st.queue_len = m.queue.len() as u32;
                 if st.queue_len > 0 && !st.has(LISTED) {
                     st.set(LISTED, true);
@@ -827,7 +919,7 @@ impl Planner {
         while k < self.queued.len() {
             let i = self.queued[k];
             let s = &mut self.status[i as usize];
-            if s.queue_len == 0 || s.has(REMOVED) {
+            if (s.queue_len == 0 && !s.has(WANTED)) || s.has(REMOVED) {
                 s.set(LISTED, false);
                 self.queued.swap_remove(k);
                 continue;
@@ -848,11 +940,9 @@ impl Planner {
             })
             .collect();
         gone.sort_unstable();
+        // An inactive surface keeps its heightmap until the memory is wanted.
         for i in gone {
             self.surfaces[i as usize].due_since = None;
-            if !self.config.retain_inactive {
-                self.release(i, false);
-            }
         }
         self.active = std::mem::take(&mut self.active_next);
         self.active_next = previous;
@@ -863,6 +953,9 @@ impl Planner {
 
         // 4. Budget.
         self.schedule(now, focus);
+
+        // 5. The queues of surfaces still waiting are bounded, conservatively.
+        self.bound_queues();
 
         self.scratch = scratch;
         let st = &mut self.plan.stats;
@@ -881,6 +974,28 @@ impl Planner {
         st.queued_imprints = queued;
         st.waiting_for_memory = waiting_for_memory;
         Ok(&self.plan)
+    }
+
+    /// Bound the queue of every surface left waiting this tick (see [`queue::bound`]).
+    fn bound_queues(&mut self) {
+        let cap = self.config.queue_cap;
+        let mut merged = 0;
+        for k in 0..self.queued.len() {
+            let i = self.queued[k] as usize;
+            if (self.status[i].queue_len as usize) <= cap {
+                continue;
+            }
+            let radii = &self.mesh_radius;
+            let radius = |shape: &Shape| match shape {
+                Shape::Mesh(id) => radii.get(id.0 as usize).copied().flatten().unwrap_or(0.0),
+                s => s.bounding_radius().unwrap_or(0.0),
+            };
+            let q = &mut self.surfaces[i].queue;
+            merged += queue::bound(q, cap, radius) as u64;
+            self.status[i].queue_len = q.len() as u32;
+        }
+        self.plan.stats.imprints_merged = merged;
+        self.merged_total += merged;
     }
 
     fn activate(&mut self, i: u32, now: u64) {
@@ -966,6 +1081,8 @@ impl Planner {
             chosen.clear();
             let mut trial: Option<SlotAllocator> = None;
             let mut fits = false;
+            // Every eviction pages a heightmap out: the page store must have room for it.
+            let mut paged = self.paged_bound;
             for (v, rank) in victims.iter().enumerate().skip(weakest_alive) {
                 if evicted[v] {
                     continue;
@@ -976,6 +1093,10 @@ impl Planner {
                 let Some(slot) = self.surfaces[rank.index as usize].slot else {
                     continue;
                 };
+                paged += self.status[rank.index as usize].bytes as u64;
+                if paged > self.config.page_bytes {
+                    break;
+                }
                 let t = trial.get_or_insert_with(|| self.alloc.clone());
                 t.free(slot);
                 chosen.push(v);
@@ -991,7 +1112,7 @@ impl Planner {
             }
             for &v in &chosen {
                 evicted[v] = true;
-                self.release(victims[v].index, false);
+                self.release(victims[v].index, false, true);
             }
             if let Some(slot) = self.alloc.alloc(bytes) {
                 self.give_slot(cand.index, slot);
@@ -1001,13 +1122,21 @@ impl Planner {
 
     fn give_slot(&mut self, index: u32, slot: Slot) {
         let s = &mut self.surfaces[index as usize];
+        let st = &mut self.status[index as usize];
         s.slot = Some(slot);
         s.resident_pos = self.resident.len();
-        s.last_update_time = self.time;
-        s.pressed_until = 0.0;
+        if st.has(PAGED) {
+            // Its heightmap comes back as it was: snowfall refills from its last update on.
+            st.set(PAGED, false);
+            self.paged_bound -= st.bytes as u64;
+        } else {
+            s.last_update_time = self.time;
+            s.pressed_until = 0.0;
+        }
         s.applied.clear();
         s.due_since = None;
-        self.status[index as usize].set(RESIDENT, true);
+        st.set(WANTED, false);
+        st.set(RESIDENT, true);
         self.resident.push(index);
         self.plan
             .changes

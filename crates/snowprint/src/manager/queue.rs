@@ -15,10 +15,11 @@
 //! - an entry whose swept shape holds a queued one replaces it;
 //! - a sphere that keeps moving in a straight line extends its queued sweep.
 //!
-//! Only past [`crate::manager::ManagerConfig::queue_cap`] entries does the queue give something up:
-//! a continuing motion is merged into its predecessor as one straight sweep (the trail is
-//! straightened between the kept points, not lost); failing that, the oldest entry is dropped and
-//! counted.
+//! Nothing is ever dropped. A surface updated in a frame takes its whole queue, however long.
+//! Only the queue of a surface that waits (for the budget or for memory) is bounded, by
+//! [`crate::manager::ManagerConfig::queue_cap`]: past it, [`bound`] merges neighbouring entries
+//! into one sphere swept along a segment whose capsule holds both (conservative: what it keeps
+//! presses at least everywhere the merged entries pressed, and a little more around them).
 
 use std::collections::VecDeque;
 
@@ -42,10 +43,6 @@ pub enum Push {
     Redundant,
     /// Replaced or extended a queued entry without changing the union of shapes.
     Absorbed,
-    /// The queue was full: merged into its predecessor as one straight sweep (lossy: straightened).
-    Merged,
-    /// The queue was full and nothing could be merged: the oldest entry was dropped (lossy).
-    DroppedOldest,
 }
 
 /// Start pose of an entry's sweep.
@@ -86,8 +83,10 @@ fn point_segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
 ///
 /// Exact cases only: the same shape and a sweep whose ends lie on the other's sweep for spheres
 /// (a swept sphere is a capsule along the segment); for other analytic shapes, a resting entry at
-/// either end of the other's sweep or an identical entry; for meshes (captured at their pose, not
-/// swept), the same pose.
+/// either end of the other's sweep or an identical entry; for meshes (drawn at sub-steps along
+/// their motion, always at its end, not at its start), the same entry or one resting where the
+/// other's motion ends. A re-posed mesh has a new [`crate::MeshId`] in the queue (see
+/// [`crate::manager::SnowManager::pose_mesh`]), so its new posture is never taken for the old.
 pub fn contains(outer: &Deformer, inner: &Deformer) -> bool {
     if outer.shape != inner.shape {
         return false;
@@ -105,7 +104,9 @@ pub fn contains(outer: &Deformer, inner: &Deformer) -> bool {
             let on = |v: Vec3| v == a || v == b || point_segment_distance(v, a, b) <= EPS;
             on(p) && on(q)
         }
-        Shape::Mesh(_) => outer.pose == inner.pose,
+        Shape::Mesh(_) => {
+            outer == inner || (start(inner) == inner.pose && inner.pose == outer.pose)
+        }
         _ => {
             if outer == inner || (start(outer) == start(inner) && outer.pose == inner.pose) {
                 return true;
@@ -139,13 +140,13 @@ fn straight_extension(prev: &Deformer, next: &Deformer) -> Option<Deformer> {
 
 /// Push one frame's deformer into a surface's queue. `applied` is what the surface's last update
 /// captured; it is consulted only when `skip_applied` (no snowfall on the surface, so pressing the
-/// same shape again cannot change the heightmap). `cap` is the most entries kept.
+/// same shape again cannot change the heightmap). Nothing is dropped: see [`bound`] for how a
+/// waiting surface's queue is kept short.
 pub fn push(
     queue: &mut VecDeque<Deformer>,
     applied: &[Deformer],
     skip_applied: bool,
     d: Deformer,
-    cap: usize,
 ) -> Push {
     let scan_from = queue.len().saturating_sub(SCAN);
     // The common case first, by exact comparison: a deformer resting where a queued sweep of the
@@ -186,24 +187,102 @@ pub fn push(
     if skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) {
         return Push::Redundant;
     }
-    if queue.len() < cap.max(1) {
-        queue.push_back(d);
-        return Push::Queued;
-    }
-    // Full: merge a continuing motion into its predecessor as one sweep.
-    if !matches!(d.shape, Shape::Mesh(_)) {
-        let from = start(&d);
-        for i in (scan_from..queue.len()).rev() {
-            let q = queue[i];
-            if q.shape == d.shape && q.pose == from {
-                queue[i] = Deformer::moving(d.shape, start(&q), d.pose);
-                return Push::Merged;
+    queue.push_back(d);
+    Push::Queued
+}
+
+/// The capsule `(a, b, radius)` that holds an entry's swept shape, given the radius of a ball
+/// around the shape's origin that holds the shape.
+fn capsule(d: &Deformer, radius: f32) -> (Vec3, Vec3, f32) {
+    (start(d).position, d.pose.position, radius)
+}
+
+/// A sphere swept along a segment whose capsule holds both capsules. The capsule around a segment
+/// is convex and a point's distance to a segment is convex along another segment, so holding both
+/// ends of each capsule's segment (with their radii) holds the capsules.
+fn cover(a: (Vec3, Vec3, f32), b: (Vec3, Vec3, f32)) -> (Vec3, Vec3, f32) {
+    let ends = [(a.0, a.2), (a.1, a.2), (b.0, b.2), (b.1, b.2)];
+    let (mut p, mut q, mut far) = (a.0, a.1, -1.0);
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let d = ends[i].0.distance_squared(ends[j].0);
+            if d > far {
+                (p, q, far) = (ends[i].0, ends[j].0, d);
             }
         }
     }
-    queue.pop_front();
-    queue.push_back(d);
-    Push::DroppedOldest
+    let r = ends
+        .iter()
+        .map(|&(v, r)| point_segment_distance(v, p, q) + r)
+        .fold(0.0, f32::max);
+    // Rounding must never make the cover smaller than what it holds.
+    (p, q, r * (1.0 + 1e-6) + EPS)
+}
+
+/// Volume of a capsule: what a merge adds is judged by it.
+fn capsule_volume(c: (Vec3, Vec3, f32)) -> f32 {
+    let r = c.2;
+    std::f32::consts::PI * r * r * (c.0.distance(c.1) + 4.0 / 3.0 * r)
+}
+
+/// Keep a waiting surface's queue to at most `cap` entries by merging neighbours (in queue order,
+/// which is the order of the frames) into covering swept spheres, cheapest first (the least added
+/// capsule volume). `radius` gives the radius of a ball holding a shape around its origin (for
+/// meshes, their registered bound). Returns the number of merges; every merged entry is held by
+/// what replaces it, so nothing it pressed is lost.
+pub fn bound(queue: &mut VecDeque<Deformer>, cap: usize, radius: impl Fn(&Shape) -> f32) -> usize {
+    let cap = cap.max(1);
+    let mut merges = 0;
+    while queue.len() > cap {
+        let caps: Vec<(Vec3, Vec3, f32)> =
+            queue.iter().map(|d| capsule(d, radius(&d.shape))).collect();
+        // The cost of merging each neighbour pair, cheapest first.
+        let mut pairs: Vec<(f32, usize)> = (0..caps.len() - 1)
+            .map(|i| {
+                let c = cover(caps[i], caps[i + 1]);
+                let cost =
+                    capsule_volume(c) - capsule_volume(caps[i]) - capsule_volume(caps[i + 1]);
+                (cost, i)
+            })
+            .collect();
+        pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        // Merge disjoint pairs, as many as needed (at most half the queue each round).
+        let mut need = queue.len() - cap;
+        let mut taken = vec![false; caps.len()];
+        let mut merged: Vec<Option<(Vec3, Vec3, f32)>> = vec![None; caps.len()];
+        for &(_, i) in &pairs {
+            if need == 0 {
+                break;
+            }
+            if taken[i] || taken[i + 1] {
+                continue;
+            }
+            taken[i] = true;
+            taken[i + 1] = true;
+            merged[i] = Some(cover(caps[i], caps[i + 1]));
+            need -= 1;
+            merges += 1;
+        }
+        let old = std::mem::take(queue);
+        let mut skip = false;
+        for (i, d) in old.into_iter().enumerate() {
+            if skip {
+                skip = false;
+                continue;
+            }
+            if let Some((a, b, r)) = merged[i] {
+                queue.push_back(Deformer::moving(
+                    Shape::Sphere { radius: r },
+                    Pose::at(a.to_array()),
+                    Pose::at(b.to_array()),
+                ));
+                skip = true;
+            } else {
+                queue.push_back(d);
+            }
+        }
+    }
+    merges
 }
 
 #[cfg(test)]
@@ -218,23 +297,23 @@ mod tests {
     fn standing_still_and_lifting_back_are_redundant() {
         let mut q = VecDeque::new();
         let down = sphere([0.0, 1.0, 0.0], [0.0, 0.1, 0.0]);
-        assert_eq!(push(&mut q, &[], false, down, 16), Push::Queued);
+        assert_eq!(push(&mut q, &[], false, down), Push::Queued);
         let still = Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([0.0, 0.1, 0.0]));
-        assert_eq!(push(&mut q, &[], false, still, 16), Push::Redundant);
+        assert_eq!(push(&mut q, &[], false, still), Push::Redundant);
         let up = sphere([0.0, 0.1, 0.0], [0.0, 1.0, 0.0]);
-        assert_eq!(push(&mut q, &[], false, up, 16), Push::Redundant);
+        assert_eq!(push(&mut q, &[], false, up), Push::Redundant);
         assert_eq!(q.len(), 1);
         // A different radius is a different shape.
         let big = Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([0.0, 0.1, 0.0]));
-        assert_eq!(push(&mut q, &[], false, big, 16), Push::Queued);
+        assert_eq!(push(&mut q, &[], false, big), Push::Queued);
     }
 
     #[test]
     fn applied_entries_are_skipped_only_without_snowfall() {
         let mut q = VecDeque::new();
         let still = Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([0.0, 0.1, 0.0]));
-        assert_eq!(push(&mut q, &[still], true, still, 16), Push::Redundant);
-        assert_eq!(push(&mut q, &[still], false, still, 16), Push::Queued);
+        assert_eq!(push(&mut q, &[still], true, still), Push::Redundant);
+        assert_eq!(push(&mut q, &[still], false, still), Push::Queued);
     }
 
     #[test]
@@ -247,41 +326,101 @@ mod tests {
                 &[],
                 false,
                 sphere([x, 0.1, 0.0], [x + 0.25, 0.1, 0.0]),
-                16,
             );
         }
         assert_eq!(q.len(), 1);
         assert_eq!(start(&q[0]).position, Vec3::new(0.0, 0.1, 0.0));
         assert_eq!(q[0].pose.position, Vec3::new(2.5, 0.1, 0.0));
         // A turn starts a new entry.
-        push(
-            &mut q,
-            &[],
-            false,
-            sphere([2.5, 0.1, 0.0], [2.5, 0.1, 0.5]),
-            16,
-        );
+        push(&mut q, &[], false, sphere([2.5, 0.1, 0.0], [2.5, 0.1, 0.5]));
         assert_eq!(q.len(), 2);
     }
 
+    /// Whether `p` lies in the capsule of a queue entry (a swept sphere) or of a resting sphere.
+    fn in_capsule(d: &Deformer, r: f32, p: Vec3) -> bool {
+        point_segment_distance(p, start(d).position, d.pose.position) <= r
+    }
+
     #[test]
-    fn a_full_queue_merges_a_continuation_then_drops_the_oldest() {
+    fn bounding_a_queue_merges_neighbours_into_covers_and_loses_nothing() {
         let mut q = VecDeque::new();
         let mut p = [0.0f32, 0.1, 0.0];
-        // A zig-zag: nothing extends, everything queues until the cap.
-        for k in 0..4 {
+        // A zig-zag: nothing extends, everything queues.
+        for k in 0..40 {
             let next = [p[0] + 0.2, 0.1, if k % 2 == 0 { 0.3 } else { 0.0 }];
-            assert_eq!(push(&mut q, &[], false, sphere(p, next), 4), Push::Queued);
+            assert_eq!(push(&mut q, &[], false, sphere(p, next)), Push::Queued);
             p = next;
         }
-        let next = [p[0] + 0.2, 0.1, 0.3];
-        assert_eq!(push(&mut q, &[], false, sphere(p, next), 4), Push::Merged);
-        assert_eq!(q.len(), 4);
-        assert_eq!(q[3].pose.position, Vec3::from(next));
-        let far = sphere([9.0, 0.1, 9.0], [9.5, 0.1, 9.3]);
-        assert_eq!(push(&mut q, &[], false, far, 4), Push::DroppedOldest);
-        assert_eq!(q.len(), 4);
-        assert_eq!(q[3], far);
+        let before: Vec<Deformer> = q.iter().copied().collect();
+        let radius = |s: &Shape| s.bounding_radius().unwrap();
+        let merges = bound(&mut q, 7, radius);
+        assert_eq!(q.len(), 7);
+        assert_eq!(merges, 33);
+        // Every point of every original capsule (sampled along it and around it) is inside a kept
+        // entry's capsule.
+        for d in &before {
+            for k in 0..=20 {
+                let t = k as f32 / 20.0;
+                let c = start(d).position.lerp(d.pose.position, t);
+                for off in [
+                    Vec3::X,
+                    -Vec3::X,
+                    Vec3::Y,
+                    -Vec3::Y,
+                    Vec3::Z,
+                    -Vec3::Z,
+                    Vec3::ZERO,
+                ] {
+                    let pt = c + off * 0.1;
+                    assert!(
+                        q.iter().any(|e| in_capsule(e, radius(&e.shape), pt)),
+                        "{pt} of {d:?} is not covered"
+                    );
+                }
+            }
+        }
+        // Within the cap, nothing changes.
+        let kept: Vec<Deformer> = q.iter().copied().collect();
+        assert_eq!(bound(&mut q, 7, radius), 0);
+        assert_eq!(q.iter().copied().collect::<Vec<_>>(), kept);
+    }
+
+    #[test]
+    fn a_cover_holds_two_capsules_computed_by_hand() {
+        // Two unit-radius resting balls 4 m apart: the cover runs between their centres, radius 1.
+        let (a, b, r) = cover(
+            (Vec3::ZERO, Vec3::ZERO, 1.0),
+            (Vec3::new(4.0, 0.0, 0.0), Vec3::new(4.0, 0.0, 0.0), 1.0),
+        );
+        assert_eq!((a, b), (Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0)));
+        assert!((r - 1.0).abs() < 1e-5, "{r}");
+        // A segment 0..4 along x (radius 0.5) and a ball of 0.2 at (2, 0, 1): the cover keeps the
+        // segment and grows to hold the ball, 1 + 0.2.
+        let (a, b, r) = cover(
+            (Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), 0.5),
+            (Vec3::new(2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0), 0.2),
+        );
+        assert_eq!((a, b), (Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0)));
+        assert!((r - 1.2).abs() < 1e-5, "{r}");
+    }
+
+    #[test]
+    fn a_mesh_entry_is_held_only_by_the_same_motion_or_at_its_end() {
+        let shape = Shape::Mesh(crate::mesh::MeshId(0));
+        let a = Deformer::moving(shape, Pose::at([0.0, 0.0, 0.0]), Pose::at([1.0, 0.0, 0.0]));
+        let b = Deformer::moving(shape, Pose::at([0.0, 0.0, 5.0]), Pose::at([1.0, 0.0, 0.0]));
+        // The same end pose by another path is a different imprint.
+        assert!(!contains(&a, &b));
+        assert!(contains(&a, &a));
+        assert!(contains(
+            &a,
+            &Deformer::new(shape, Pose::at([1.0, 0.0, 0.0]))
+        ));
+        // The start of a mesh's motion is not drawn by its entry.
+        assert!(!contains(
+            &a,
+            &Deformer::new(shape, Pose::at([0.0, 0.0, 0.0]))
+        ));
     }
 
     #[test]
@@ -291,14 +430,13 @@ mod tests {
         };
         let mut q = VecDeque::new();
         let a = Deformer::moving(shape, Pose::at([0.0, 0.1, 0.0]), Pose::at([0.3, 0.1, 0.0]));
-        push(&mut q, &[], false, a, 8);
+        push(&mut q, &[], false, a);
         assert_eq!(
             push(
                 &mut q,
                 &[],
                 false,
-                Deformer::new(shape, Pose::at([0.3, 0.1, 0.0])),
-                8
+                Deformer::new(shape, Pose::at([0.3, 0.1, 0.0]))
             ),
             Push::Redundant
         );
@@ -307,8 +445,7 @@ mod tests {
                 &mut q,
                 &[],
                 false,
-                Deformer::new(shape, Pose::at([0.2, 0.1, 0.0])),
-                8
+                Deformer::new(shape, Pose::at([0.2, 0.1, 0.0]))
             ),
             Push::Queued
         );

@@ -363,6 +363,30 @@ impl SlotAllocator {
         Some(Slot { offset, bytes })
     }
 
+    /// Reserve the slot of `bytes` bytes (rounded up to [`SLOT_ALIGN`]) that starts at `offset`,
+    /// or `None` when that range is not free (restoring a saved pool's exact placement).
+    pub fn alloc_at(&mut self, offset: u64, bytes: u64) -> Option<Slot> {
+        let bytes = bytes.max(1).div_ceil(SLOT_ALIGN) * SLOT_ALIGN;
+        if !offset.is_multiple_of(SLOT_ALIGN) {
+            return None;
+        }
+        let i = self.free.iter().position(|&(o, len)| {
+            o <= offset && offset.checked_add(bytes).is_some_and(|end| end <= o + len)
+        })?;
+        let (o, len) = self.free[i];
+        let mut pieces = Vec::with_capacity(2);
+        if offset > o {
+            pieces.push((o, offset - o));
+        }
+        if offset + bytes < o + len {
+            pieces.push((offset + bytes, o + len - offset - bytes));
+        }
+        self.free.splice(i..=i, pieces);
+        self.used += bytes;
+        self.high_water = self.high_water.max(self.used);
+        Some(Slot { offset, bytes })
+    }
+
     /// Return a slot to the pool, merging it with free neighbours.
     pub fn free(&mut self, slot: Slot) {
         let i = self.free.partition_point(|&(o, _)| o < slot.offset);
@@ -388,6 +412,24 @@ mod tests {
     #[test]
     fn record_is_64_bytes() {
         assert_eq!(std::mem::size_of::<SurfaceRecord>(), 64);
+    }
+
+    #[test]
+    fn a_slot_can_be_reserved_where_it_was() {
+        let mut a = SlotAllocator::new(10 * SLOT_ALIGN);
+        let s = a.alloc_at(3 * SLOT_ALIGN, 2 * SLOT_ALIGN).unwrap();
+        assert_eq!((s.offset, s.bytes), (3 * SLOT_ALIGN, 2 * SLOT_ALIGN));
+        assert_eq!(a.used(), 2 * SLOT_ALIGN);
+        // Overlapping, misaligned or past the end: refused, nothing changes.
+        assert!(a.alloc_at(4 * SLOT_ALIGN, SLOT_ALIGN).is_none());
+        assert!(a.alloc_at(SLOT_ALIGN + 1, SLOT_ALIGN).is_none());
+        assert!(a.alloc_at(9 * SLOT_ALIGN, 2 * SLOT_ALIGN).is_none());
+        assert!(a.alloc_at(u64::MAX - 255, SLOT_ALIGN).is_none());
+        // First fit now takes the hole before it, then after it.
+        assert_eq!(a.alloc(3 * SLOT_ALIGN).unwrap().offset, 0);
+        assert_eq!(a.alloc(SLOT_ALIGN).unwrap().offset, 5 * SLOT_ALIGN);
+        a.free(s);
+        assert_eq!(a.largest_free(), 4 * SLOT_ALIGN);
     }
 
     #[test]
