@@ -7,7 +7,7 @@ use crate::error::{Result, SnowError};
 use crate::mesh::MeshId;
 
 /// The geometry of a deformer, in its own frame (centred on its pose's position).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
     /// A ball.
     Sphere {
@@ -48,7 +48,7 @@ impl Shape {
 }
 
 /// Position and rotation of a deformer in the world.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pose {
     /// World position of the shape's origin, metres.
     pub position: Vec3,
@@ -75,7 +75,7 @@ impl Pose {
 }
 
 /// One deformer as seen in one frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Deformer {
     /// Its geometry.
     pub shape: Shape,

@@ -9,7 +9,7 @@ use glam::{Mat4, Vec3};
 use crate::error::{Result, SnowError};
 
 /// Handle of a mesh registered with a [`crate::SnowWorld`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct MeshId(pub(crate) u32);
 
 /// An indexed triangle list in the mesh's own frame.

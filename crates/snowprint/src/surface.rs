@@ -17,7 +17,7 @@ pub const MIN_TEXEL_SIZE: f32 = 0.04;
 pub const MAX_RESOLUTION: u32 = 512;
 
 /// Description of one snow surface.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SurfaceDesc {
     /// Unique name, used for output files.
     pub name: String,

@@ -39,6 +39,7 @@ pub mod planner;
 pub mod plot;
 pub mod quadtree;
 pub mod queue;
+pub mod save;
 
 use glam::{Vec3, Vec4};
 
@@ -389,8 +390,10 @@ pub struct SnowManager {
     pages: PageStore,
     /// Mesh deformers by the manager's [`MeshId`].
     meshes: Vec<ManagedMesh>,
-    /// World meshes of earlier posings that queued imprints may still name.
+    /// World meshes of earlier posings that queued imprints may still name, and their vertices
+    /// (for saves).
     retired: Vec<MeshId>,
+    retired_mesh: std::collections::HashMap<u32, Mesh>,
     /// Bytes paged out between ticks (zone unloads), reported by the next tick.
     paged_between: u64,
     stats: TickStats,
@@ -448,6 +451,7 @@ impl SnowManager {
             pages: PageStore::default(),
             meshes: Vec::new(),
             retired: Vec::new(),
+            retired_mesh: Default::default(),
             paged_between: 0,
             stats: TickStats::default(),
         }
@@ -562,6 +566,8 @@ impl SnowManager {
             let new = self.world.add_mesh(&name, &posed)?;
             self.planner.set_mesh_radius(new, r)?;
             self.retired.push(world);
+            let old = std::mem::replace(&mut self.meshes[id.0 as usize].mesh, posed.clone());
+            self.retired_mesh.insert(world.0, old);
             self.meshes[id.0 as usize].world = new;
         } else {
             self.world.pose_mesh(world, positions)?;
@@ -659,18 +665,39 @@ impl SnowManager {
                 }
             }
         }
-        let updates: Vec<SurfaceUpdate<'_>> = plan
-            .updates
-            .iter()
-            .filter_map(|u| {
-                self.world_ids[u.surface.0 as usize].map(|w| SurfaceUpdate {
-                    surface: w,
-                    elapsed: u.elapsed,
-                    deformers: &u.imprints,
+        // The queued imprints are captured frame by frame: layer `j` holds the `j`-th queued
+        // frame of every surface updated (the first also catches snowfall up), so a surface that
+        // waited goes through the same steps as one updated in every frame.
+        let mut runs: Vec<(SurfaceId, f32, Vec<&[crate::Deformer]>)> = Vec::new();
+        for u in &plan.updates {
+            let Some(w) = self.world_ids[u.surface.0 as usize] else {
+                continue;
+            };
+            let mut frames = Vec::new();
+            let mut start = 0;
+            for k in 1..=u.imprints.len() {
+                if k == u.imprints.len() || u.frames[k] != u.frames[start] {
+                    frames.push(&u.imprints[start..k]);
+                    start = k;
+                }
+            }
+            if frames.is_empty() {
+                frames.push(&u.imprints[..]);
+            }
+            runs.push((w, u.elapsed, frames));
+        }
+        let layers = runs.iter().map(|r| r.2.len()).max().unwrap_or(0);
+        for j in 0..layers {
+            let updates: Vec<SurfaceUpdate<'_>> = runs
+                .iter()
+                .filter_map(|(w, elapsed, frames)| {
+                    frames.get(j).map(|d| SurfaceUpdate {
+                        surface: *w,
+                        elapsed: if j == 0 { *elapsed } else { 0.0 },
+                        deformers: d,
+                    })
                 })
-            })
-            .collect();
-        if !updates.is_empty() {
+                .collect();
             self.world.update(&updates)?;
         }
         let mut stats = plan.stats.clone();
@@ -705,6 +732,7 @@ impl SnowManager {
                 k += 1;
             } else {
                 self.world.remove_mesh(m)?;
+                self.retired_mesh.remove(&m.0);
                 self.retired.swap_remove(k);
             }
         }

@@ -2,18 +2,19 @@
 //! surface updated only every few frames still receives every footprint (issue 4's "no imprint is
 //! lost").
 //!
-//! An entry is a [`Deformer`] as it was in one frame, with its `previous` pose: the swept shape of
-//! that frame. When the surface's turn comes the whole queue is captured in one pass: the capture
-//! keeps the lowest point of anything per texel, so capturing the union of the frames' shapes at
-//! once presses every texel at least as deep as capturing them frame by frame (exactly as deep
-//! where the frames' prints do not meet within the blur's reach; see `docs/MANAGER.md`).
+//! An entry ([`Imprint`]) is a [`Deformer`] as it was in one frame, with its `previous` pose (the
+//! swept shape of that frame) and the frame's number. When the surface's turn comes the queue is
+//! captured frame by frame, in order (one capture and update per frame that queued something), so
+//! the heightmap goes through the same steps as if the surface had been updated every frame.
 //!
-//! The queue is kept short without changing the union it captures:
+//! The queue is kept short without changing what it presses:
 //! - an entry whose swept shape lies inside one already queued (a foot standing still, or lifted
 //!   straight back up the way it came down), or inside one applied at the surface's last update
 //!   when no snow falls on it, is redundant and not queued;
-//! - an entry whose swept shape holds a queued one replaces it;
-//! - a sphere that keeps moving in a straight line extends its queued sweep.
+//! - an entry whose swept shape holds a queued one replaces it (in its own frame).
+//!
+//! Both are exact as long as prints of one frame that are not in the other do not come within the
+//! blur's reach (one texel) of each other, as footprints of one walker do not.
 //!
 //! Nothing is ever dropped. A surface updated in a frame takes its whole queue, however long.
 //! Only the queue of a surface that waits (for the budget or for memory) is bounded, by
@@ -34,6 +35,15 @@ pub const SCAN: usize = 8;
 /// tests (0.001 mm: far below a texel and below 1 unit of depression for any usable snow depth).
 pub const EPS: f32 = 1e-6;
 
+/// One queued entry: what pressed a surface in one frame.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Imprint {
+    /// The tick it was queued in (captured with the other imprints of that tick).
+    pub frame: u64,
+    /// The shape, its pose and its previous pose.
+    pub deformer: Deformer,
+}
+
 /// What a push did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Push {
@@ -41,7 +51,7 @@ pub enum Push {
     Queued,
     /// Already covered by a queued or just-applied entry: nothing to add.
     Redundant,
-    /// Replaced or extended a queued entry without changing the union of shapes.
+    /// Replaced a queued entry it holds.
     Absorbed,
 }
 
@@ -117,35 +127,15 @@ pub fn contains(outer: &Deformer, inner: &Deformer) -> bool {
     }
 }
 
-/// For a sphere continuing in a straight line (`next` starts where `prev` ends and heads the same
-/// way), the single sweep covering both.
-fn straight_extension(prev: &Deformer, next: &Deformer) -> Option<Deformer> {
-    let Shape::Sphere { .. } = prev.shape else {
-        return None;
-    };
-    if prev.shape != next.shape || prev.pose.position != start(next).position {
-        return None;
-    }
-    let (a, b, c) = (start(prev).position, prev.pose.position, next.pose.position);
-    let (ab, bc) = (b - a, c - b);
-    if ab.length_squared() == 0.0 || bc.length_squared() == 0.0 || ab.dot(bc) <= 0.0 {
-        return None;
-    }
-    // c within EPS of the line through a and b.
-    if ab.cross(c - a).length() > EPS * ab.length() {
-        return None;
-    }
-    Some(Deformer::moving(prev.shape, start(prev), next.pose))
-}
-
 /// Push one frame's deformer into a surface's queue. `applied` is what the surface's last update
 /// captured; it is consulted only when `skip_applied` (no snowfall on the surface, so pressing the
 /// same shape again cannot change the heightmap). Nothing is dropped: see [`bound`] for how a
 /// waiting surface's queue is kept short.
 pub fn push(
-    queue: &mut VecDeque<Deformer>,
+    queue: &mut VecDeque<Imprint>,
     applied: &[Deformer],
     skip_applied: bool,
+    frame: u64,
     d: Deformer,
 ) -> Push {
     let scan_from = queue.len().saturating_sub(SCAN);
@@ -155,7 +145,7 @@ pub fn push(
     if queue
         .range(scan_from..)
         .rev()
-        .any(|q| covers_exactly(q, &d, resting))
+        .any(|q| covers_exactly(&q.deformer, &d, resting))
         || (skip_applied
             && applied
                 .iter()
@@ -167,7 +157,7 @@ pub fn push(
     }
     // Newest first: a foot standing still matches its own last entry.
     for i in (scan_from..queue.len()).rev() {
-        let q = &queue[i];
+        let q = &queue[i].deformer;
         if q.shape != d.shape {
             continue;
         }
@@ -175,19 +165,16 @@ pub fn push(
             return Push::Redundant;
         }
         if contains(&d, q) {
-            // Whatever else the window holds, the union only grows by what `d` adds.
-            queue[i] = d;
-            return Push::Absorbed;
-        }
-        if let Some(longer) = straight_extension(q, &d) {
-            queue[i] = longer;
+            // It presses all the held entry did: the held one goes, `d` is queued in its frame.
+            queue.remove(i);
+            queue.push_back(Imprint { frame, deformer: d });
             return Push::Absorbed;
         }
     }
     if skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) {
         return Push::Redundant;
     }
-    queue.push_back(d);
+    queue.push_back(Imprint { frame, deformer: d });
     Push::Queued
 }
 
@@ -230,12 +217,14 @@ fn capsule_volume(c: (Vec3, Vec3, f32)) -> f32 {
 /// capsule volume). `radius` gives the radius of a ball holding a shape around its origin (for
 /// meshes, their registered bound). Returns the number of merges; every merged entry is held by
 /// what replaces it, so nothing it pressed is lost.
-pub fn bound(queue: &mut VecDeque<Deformer>, cap: usize, radius: impl Fn(&Shape) -> f32) -> usize {
+pub fn bound(queue: &mut VecDeque<Imprint>, cap: usize, radius: impl Fn(&Shape) -> f32) -> usize {
     let cap = cap.max(1);
     let mut merges = 0;
     while queue.len() > cap {
-        let caps: Vec<(Vec3, Vec3, f32)> =
-            queue.iter().map(|d| capsule(d, radius(&d.shape))).collect();
+        let caps: Vec<(Vec3, Vec3, f32)> = queue
+            .iter()
+            .map(|d| capsule(&d.deformer, radius(&d.deformer.shape)))
+            .collect();
         // The cost of merging each neighbour pair, cheapest first.
         let mut pairs: Vec<(f32, usize)> = (0..caps.len() - 1)
             .map(|i| {
@@ -263,22 +252,26 @@ pub fn bound(queue: &mut VecDeque<Deformer>, cap: usize, radius: impl Fn(&Shape)
             need -= 1;
             merges += 1;
         }
-        let old = std::mem::take(queue);
+        let old: Vec<Imprint> = std::mem::take(queue).into();
         let mut skip = false;
-        for (i, d) in old.into_iter().enumerate() {
+        for (i, d) in old.iter().enumerate() {
             if skip {
                 skip = false;
                 continue;
             }
             if let Some((a, b, r)) = merged[i] {
-                queue.push_back(Deformer::moving(
-                    Shape::Sphere { radius: r },
-                    Pose::at(a.to_array()),
-                    Pose::at(b.to_array()),
-                ));
+                // In the later frame: the queue stays in frame order.
+                queue.push_back(Imprint {
+                    frame: old[i + 1].frame,
+                    deformer: Deformer::moving(
+                        Shape::Sphere { radius: r },
+                        Pose::at(a.to_array()),
+                        Pose::at(b.to_array()),
+                    ),
+                });
                 skip = true;
             } else {
-                queue.push_back(d);
+                queue.push_back(*d);
             }
         }
     }
@@ -297,43 +290,47 @@ mod tests {
     fn standing_still_and_lifting_back_are_redundant() {
         let mut q = VecDeque::new();
         let down = sphere([0.0, 1.0, 0.0], [0.0, 0.1, 0.0]);
-        assert_eq!(push(&mut q, &[], false, down), Push::Queued);
+        assert_eq!(push(&mut q, &[], false, 0, down), Push::Queued);
         let still = Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([0.0, 0.1, 0.0]));
-        assert_eq!(push(&mut q, &[], false, still), Push::Redundant);
+        assert_eq!(push(&mut q, &[], false, 0, still), Push::Redundant);
         let up = sphere([0.0, 0.1, 0.0], [0.0, 1.0, 0.0]);
-        assert_eq!(push(&mut q, &[], false, up), Push::Redundant);
+        assert_eq!(push(&mut q, &[], false, 0, up), Push::Redundant);
         assert_eq!(q.len(), 1);
         // A different radius is a different shape.
         let big = Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([0.0, 0.1, 0.0]));
-        assert_eq!(push(&mut q, &[], false, big), Push::Queued);
+        assert_eq!(push(&mut q, &[], false, 0, big), Push::Queued);
     }
 
     #[test]
     fn applied_entries_are_skipped_only_without_snowfall() {
         let mut q = VecDeque::new();
         let still = Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([0.0, 0.1, 0.0]));
-        assert_eq!(push(&mut q, &[still], true, still), Push::Redundant);
-        assert_eq!(push(&mut q, &[still], false, still), Push::Queued);
+        assert_eq!(push(&mut q, &[still], true, 0, still), Push::Redundant);
+        assert_eq!(push(&mut q, &[still], false, 0, still), Push::Queued);
     }
 
     #[test]
-    fn straight_motion_extends_one_sweep() {
+    fn each_frame_of_a_motion_keeps_its_own_entry_and_a_held_entry_moves_to_its_holder() {
         let mut q = VecDeque::new();
-        for k in 0..10 {
+        for k in 0..10u64 {
             let x = k as f32 * 0.25;
-            push(
-                &mut q,
-                &[],
-                false,
-                sphere([x, 0.1, 0.0], [x + 0.25, 0.1, 0.0]),
-            );
+            let d = sphere([x, 0.1, 0.0], [x + 0.25, 0.1, 0.0]);
+            assert_eq!(push(&mut q, &[], false, k, d), Push::Queued);
         }
-        assert_eq!(q.len(), 1);
-        assert_eq!(start(&q[0]).position, Vec3::new(0.0, 0.1, 0.0));
-        assert_eq!(q[0].pose.position, Vec3::new(2.5, 0.1, 0.0));
-        // A turn starts a new entry.
-        push(&mut q, &[], false, sphere([2.5, 0.1, 0.0], [2.5, 0.1, 0.5]));
-        assert_eq!(q.len(), 2);
+        assert_eq!(q.len(), 10);
+        assert!(q.iter().enumerate().all(|(k, e)| e.frame == k as u64));
+        // A sweep over the last two frames' path holds their entries... only the newest one is
+        // compared first, and is replaced in the holder's frame (the queue stays in frame order).
+        let long = sphere([2.25, 0.1, 0.0], [2.5, 0.1, 0.0]);
+        assert_eq!(push(&mut q, &[], false, 10, long), Push::Redundant);
+        let longer = sphere([2.0, 0.1, 0.0], [3.0, 0.1, 0.0]);
+        assert_eq!(push(&mut q, &[], false, 11, longer), Push::Absorbed);
+        assert_eq!(q.back().unwrap().frame, 11);
+        assert!(
+            q.iter()
+                .zip(q.iter().skip(1))
+                .all(|(a, b)| a.frame <= b.frame)
+        );
     }
 
     /// Whether `p` lies in the capsule of a queue entry (a swept sphere) or of a resting sphere.
@@ -348,10 +345,10 @@ mod tests {
         // A zig-zag: nothing extends, everything queues.
         for k in 0..40 {
             let next = [p[0] + 0.2, 0.1, if k % 2 == 0 { 0.3 } else { 0.0 }];
-            assert_eq!(push(&mut q, &[], false, sphere(p, next)), Push::Queued);
+            assert_eq!(push(&mut q, &[], false, 0, sphere(p, next)), Push::Queued);
             p = next;
         }
-        let before: Vec<Deformer> = q.iter().copied().collect();
+        let before: Vec<Deformer> = q.iter().map(|e| e.deformer).collect();
         let radius = |s: &Shape| s.bounding_radius().unwrap();
         let merges = bound(&mut q, 7, radius);
         assert_eq!(q.len(), 7);
@@ -373,14 +370,15 @@ mod tests {
                 ] {
                     let pt = c + off * 0.1;
                     assert!(
-                        q.iter().any(|e| in_capsule(e, radius(&e.shape), pt)),
+                        q.iter()
+                            .any(|e| in_capsule(&e.deformer, radius(&e.deformer.shape), pt)),
                         "{pt} of {d:?} is not covered"
                     );
                 }
             }
         }
         // Within the cap, nothing changes.
-        let kept: Vec<Deformer> = q.iter().copied().collect();
+        let kept: Vec<Imprint> = q.iter().copied().collect();
         assert_eq!(bound(&mut q, 7, radius), 0);
         assert_eq!(q.iter().copied().collect::<Vec<_>>(), kept);
     }
@@ -430,12 +428,13 @@ mod tests {
         };
         let mut q = VecDeque::new();
         let a = Deformer::moving(shape, Pose::at([0.0, 0.1, 0.0]), Pose::at([0.3, 0.1, 0.0]));
-        push(&mut q, &[], false, a);
+        push(&mut q, &[], false, 0, a);
         assert_eq!(
             push(
                 &mut q,
                 &[],
                 false,
+                0,
                 Deformer::new(shape, Pose::at([0.3, 0.1, 0.0]))
             ),
             Push::Redundant
@@ -445,6 +444,7 @@ mod tests {
                 &mut q,
                 &[],
                 false,
+                0,
                 Deformer::new(shape, Pose::at([0.2, 0.1, 0.0]))
             ),
             Push::Queued
