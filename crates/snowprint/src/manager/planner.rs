@@ -1445,7 +1445,7 @@ impl Planner {
         }
         if (0..n).any(|i| {
             let st = &p.status[i];
-            (st.queue_len > 0 || st.has(WANTED)) && !st.has(REMOVED) && !st.has(LISTED)
+            st.queue_len > 0 && !st.has(REMOVED) && !st.has(LISTED)
         }) {
             return bad("a surface with queued imprints is missing from the queued list".into());
         }
