@@ -59,7 +59,7 @@ fn world(precision: Precision) -> (SnowManager, Vec<ManagedId>, MeshId) {
 /// Frame `f`: a sphere walks along the row of surfaces, the cube slides across surface 1 and is
 /// re-posed (stretched) every four frames.
 fn step(m: &mut SnowManager, mesh: MeshId, f: u32) {
-    if f % 4 == 0 {
+    if f.is_multiple_of(4) {
         let s = 1.0 + 0.2 * ((f / 4) % 3) as f32;
         let cube: Vec<Vec3> = [
             (-1., -1., -1.),
