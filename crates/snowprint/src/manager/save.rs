@@ -425,14 +425,21 @@ impl SnowManager {
 
     /// Build a manager from a parsed save.
     pub fn from_save(gpu: &GpuContext, file: SaveFile) -> Result<Self> {
-        let world = SnowWorld::new(gpu, Self::world_config(&file.config))?;
-        if world.memory().pool_budget < file.config.pool_bytes / 256 * 256 {
+        // A save continues exactly only with the pool it was made with: one this device cannot
+        // hold is refused before anything is allocated.
+        let max_pool = gpu
+            .caps
+            .max_storage_binding
+            .min(gpu.device.limits().max_buffer_size)
+            / 256
+            * 256;
+        if file.config.pool_bytes / 256 * 256 > max_pool {
             return Err(SnowError::Scene(format!(
-                "the save's pool of {} bytes is larger than this device allows ({} bytes)",
-                file.config.pool_bytes,
-                world.memory().pool_budget
+                "the save's pool of {} bytes is larger than this device allows ({max_pool} bytes)",
+                file.config.pool_bytes
             )));
         }
+        let world = SnowWorld::new(gpu, Self::world_config(&file.config))?;
         let mut m = SnowManager::with_parts(world, Planner::new(&file.config)?);
         // World meshes are numbered anew: map the saved numbers to the new ones.
         let mut map: std::collections::HashMap<u32, MeshId> = Default::default();
