@@ -723,7 +723,36 @@ fn pool_exhaustion_is_an_error_not_a_panic() {
             .iter()
             .all(|&v| v == 0)
     );
-    assert!(matches!(w.read_heightmap(a), Err(SnowError::StaleHandle { .. })) || a == c);
+    // `c` takes `a`'s freed slot, but `a` is stale: it names neither `c` nor anything else.
+    assert_eq!(c.index(), a.index());
+    assert_ne!(c, a);
+    assert_stale(w.read_heightmap(a).map(|_| ()));
+    assert_stale(w.surface(a).map(|_| ()));
+    assert_stale(w.layout(a).map(|_| ()));
+    assert_stale(w.gpu_offsets(a).map(|_| ()));
+    assert_stale(w.read_last_capture(a).map(|_| ()));
+    assert_stale(w.remove_surface(a));
+    let update = [snowprint::SurfaceUpdate {
+        surface: a,
+        elapsed: 0.0,
+        deformers: &[],
+    }];
+    assert_stale(w.update(&update).map(|_| ()));
+    // The stale calls changed nothing: `c` is still live, listed once, and removable.
+    assert_eq!(w.surfaces().filter(|(id, _)| *id == c).count(), 1);
+    assert!(w.surfaces().all(|(id, _)| id != a));
+    w.remove_surface(c).unwrap();
+    assert_stale(w.read_heightmap(c).map(|_| ()));
+}
+
+/// `r` must be [`SnowError::StaleHandle`] for a surface.
+fn assert_stale(r: snowprint::Result<()>) {
+    match r {
+        Err(SnowError::StaleHandle {
+            what: "surface", ..
+        }) => {}
+        other => panic!("expected a stale surface handle, got {other:?}"),
+    }
 }
 
 #[test]
