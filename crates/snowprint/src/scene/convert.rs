@@ -814,12 +814,59 @@ fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShap
             ),
         ));
     }
-    let mesh = Mesh::load_gltf(&resolved).map_err(|e| {
+    // A scene may come from an untrusted mod: it and its meshes read only under its own folder.
+    let root = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let inside = match (resolved.canonicalize(), root.canonicalize()) {
+        (Ok(file), Ok(root)) => file.starts_with(root),
+        _ => false,
+    };
+    if !inside {
+        return Err(src.error(
+            &span,
+            format!(
+                "{who} has path {}, which leads outside the scene file's folder ({folder})",
+                src.quote(&span)
+            ),
+            "a scene may read only files under its own folder, so copy the mesh there and give a path relative to the scene",
+        ));
+    }
+    let mesh = Mesh::load_gltf_within(&resolved, root).map_err(|e| {
+        if let SnowError::MeshUri {
+            what,
+            uri,
+            problem,
+            fix,
+            ..
+        } = &e
+        {
+            return src.error(
+                &span,
+                format!(
+                    "{who} has path {}, but in {} {what} has uri {uri:?}, which {problem}",
+                    src.quote(&span),
+                    resolved.display()
+                ),
+                fix.replace("the mesh's folder", "the scene's folder"),
+            );
+        }
         let reason = match e {
             SnowError::MeshFile { reason, .. } | SnowError::InvalidMesh { reason, .. } => reason,
             other => other.to_string(),
         };
         let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
+        // The loader's reasons end with what to do after "; ": make that the hint.
+        let (reason, fix) = match reason.split_once("; ") {
+            Some((reason, fix)) => (reason.to_owned(), fix.to_owned()),
+            None => (
+                reason,
+                "give it a valid glTF (.gltf) or GLB (.glb) file holding a closed triangle mesh"
+                    .to_owned(),
+            ),
+        };
         src.error(
             &span,
             format!(
@@ -827,7 +874,7 @@ fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShap
                 src.quote(&span),
                 resolved.display()
             ),
-            "give it a valid glTF (.gltf) or GLB (.glb) file holding a closed triangle mesh",
+            fix,
         )
     })?;
     Ok(SceneShape::Mesh {
