@@ -346,11 +346,15 @@ fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mes
         path: path.to_owned(),
         reason,
     };
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
+    let not_gltf = |e: &dyn std::fmt::Display| {
+        let e = e.to_string();
+        let e = e.split_whitespace().collect::<Vec<_>>().join(" ");
         err(format!(
             "is not a valid glTF or GLB file ({e}); export it again as glTF 2.0"
         ))
-    })?;
+    };
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| not_gltf(&e))?;
+    validate(gltf.document.as_json()).map_err(|e| not_gltf(&e))?;
     let doc = &gltf.document;
     let uri_err = |what: String, uri: &str, (problem, fix): UriRefusal| SnowError::MeshUri {
         path: path.to_owned(),
@@ -473,6 +477,34 @@ fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mes
     }
     mesh.validate(&path.display().to_string())?;
     Ok(mesh)
+}
+
+/// The `gltf` crate's validation, after the check its primitive hook skips: that hook indexes the
+/// accessors with the POSITION attribute unchecked, and panics on an index out of range.
+fn validate(root: &gltf::json::Root) -> std::result::Result<(), String> {
+    use gltf::json::validation::{Checked, Validate};
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = prim
+                .attributes
+                .get(&Checked::Valid(gltf::json::mesh::Semantic::Positions))
+                && a.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "mesh {m} primitive {p} names POSITION accessor {}, but there are {} accessors",
+                    a.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    let mut first = None;
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        if first.is_none() {
+            first = Some(format!("{}: {error}", path()));
+        }
+    });
+    first.map_or(Ok(()), Err)
 }
 
 /// Nodes form trees: no node is its own child or ancestor, none has two parents, none lies deeper
