@@ -53,6 +53,14 @@ impl Mesh {
         if let Some(p) = self.positions.iter().find(|p| !p.is_finite()) {
             return err(format!("vertex {:?} is not finite", p.to_array()));
         }
+        let limit = crate::deformer::MAX_DEFORMER_SIZE;
+        if let Some(p) = self.positions.iter().find(|p| p.length() > limit) {
+            return err(format!(
+                "vertex {:?} lies {} m from the mesh's origin, farther than the {limit} m (MAX_DEFORMER_SIZE) a deformer may reach; model the mesh around its origin and at most {limit} m across",
+                p.to_array(),
+                p.length()
+            ));
+        }
         Ok(())
     }
 

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 use toml::Spanned;
 
-use crate::deformer::{Deformer, Shape};
+use crate::deformer::{Deformer, MAX_DEFORMER_SIZE, Shape};
 use crate::error::{Result, SnowError};
 use crate::mesh::Mesh;
 use crate::surface::SurfaceDesc;
@@ -682,8 +682,10 @@ fn deformer(
             v,
             &who,
             "radius",
-            |x| x > 0.0,
-            "radii must be finite numbers of metres above 0",
+            |x| x > 0.0 && x <= MAX_DEFORMER_SIZE,
+            &format!(
+                "radii must be finite numbers of metres above 0 and at most {MAX_DEFORMER_SIZE} (the largest shape the capture places exactly)"
+            ),
         )
     };
     let shape = match kind {
@@ -705,8 +707,10 @@ fn deformer(
                 v,
                 &who,
                 "half_height",
-                |x| x >= 0.0,
-                "half_height must be a finite number of metres, 0 or more",
+                |x| (0.0..=MAX_DEFORMER_SIZE).contains(&x),
+                &format!(
+                    "half_height must be a finite number of metres, 0 or more and at most {MAX_DEFORMER_SIZE} (the largest shape the capture places exactly)"
+                ),
             )?;
             SceneShape::Capsule {
                 radius,
@@ -728,8 +732,10 @@ fn deformer(
                 &who,
                 "half_extents",
                 "[x, y, z] in metres",
-                |x| x > 0.0,
-                "half_extents must be three finite numbers of metres above 0",
+                |x| x > 0.0 && x <= MAX_DEFORMER_SIZE,
+                &format!(
+                    "half_extents must be three finite numbers of metres above 0 and at most {MAX_DEFORMER_SIZE} (the largest shape the capture places exactly)"
+                ),
             )?;
             SceneShape::Box {
                 half_extents: Vec3::from(h),
