@@ -547,7 +547,7 @@ fn check_node_trees(doc: &gltf::Document) -> std::result::Result<(), String> {
             }
             if on_path[at] {
                 return Err(format!(
-                    "node {at} is its own ancestor (its children lead back to it), a cycle; glTF nodes must form trees, so remove the child link that closes the loop"
+                    "node {at} is its own ancestor, a cycle of child links; glTF nodes must form trees, so remove the child link that closes the loop"
                 ));
             }
             if path.len() > MAX_GLTF_DEPTH {
