@@ -366,10 +366,11 @@ fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mes
 
     // Images are never decoded, but a URI that leads outside the folder is refused all the same:
     // a file from an untrusted mod that names /etc/passwd is not a mesh to use.
-    for image in doc.images() {
-        if let gltf::image::Source::Uri { uri, .. } = image.source() {
-            follow_uri(uri, files, false)
-                .map_err(|r| uri_err(format!("image {}", image.index()), uri, r))?;
+    // (Read from the JSON: `gltf::Image::source` unwraps, and panics on an image with neither a
+    // uri nor a bufferView, or a bufferView without a mimeType, which validation lets through.)
+    for (i, image) in doc.as_json().images.iter().enumerate() {
+        if let Some(uri) = &image.uri {
+            follow_uri(uri, files, false).map_err(|r| uri_err(format!("image {i}"), uri, r))?;
         }
     }
     let mut buffers: Vec<Vec<u8>> = Vec::new();
