@@ -1256,3 +1256,213 @@ fn huge_shapes_resting_on_the_snow_are_placed_exactly() {
         assert!(worst < 1e-6, "r {r}: height off by {worst} m");
     }
 }
+
+/// What a hand-derived case expects at a texel centre: the lowest height pressed there, nothing, or
+/// no claim (within 2 mm of the footprint's edge, where the texel centre's rounding decides).
+enum Expect {
+    Height(f64),
+    Nothing,
+    Edge,
+}
+
+/// Capture cases derived by hand on a yawed surface, independent of `capture::push_primitives` and
+/// of the CPU ray cast: the surface's frame, a box's orientation, a capsule's pose, a box swept
+/// within one frame, and culling at the surface's edges and above the frustum. World positions are
+/// written out with the yaw's sine and cosine; expectations are the shapes' closed forms in f64.
+#[test]
+fn capture_matches_hand_derived_cases_on_a_yawed_surface() {
+    let mut w = world(CaptureMode::Depth);
+    let yaw = 30.0f32;
+    let (center, size, snow) = (Vec3::new(2.0, 1.0, -3.0), [3.0f32, 2.0], 0.3f32);
+    let mut desc = SurfaceDesc::new("yawed", center.to_array(), size, snow);
+    desc.yaw_degrees = yaw;
+    let id = w.add_surface(desc).unwrap();
+    let l = w.layout(id).unwrap();
+    let frustum = f64::from(snow + ANKLE);
+    let th = yaw.to_radians();
+    let rot = Quat::from_rotation_y(th);
+    // Rotation about +Y by th takes local +X to (cos, 0, -sin) and local +Z to (sin, 0, cos).
+    let world = |x: f32, y: f32, z: f32| {
+        center
+            + x * Vec3::new(th.cos(), 0.0, -th.sin())
+            + Vec3::new(0.0, y, 0.0)
+            + z * Vec3::new(th.sin(), 0.0, th.cos())
+    };
+    // Texel centres by hand: local x from -1.5 to 1.5 over the width, z from -1 to 1 over the height.
+    let centre = |col: u32, row: u32| {
+        (
+            -1.5 + (f64::from(col) + 0.5) * 3.0 / f64::from(l.width),
+            -1.0 + (f64::from(row) + 0.5) * 2.0 / f64::from(l.height),
+        )
+    };
+    const EDGE: f64 = 2e-3;
+    // Inside a rectangle |u| <= a, |v| <= b, with the edge band left out.
+    let rect = |u: f64, v: f64, a: f64, b: f64, height: f64| {
+        let outside = (u.abs() - a).max(v.abs() - b);
+        if outside.abs() < EDGE {
+            Expect::Edge
+        } else if outside < 0.0 {
+            Expect::Height(height)
+        } else {
+            Expect::Nothing
+        }
+    };
+    // Lowest point of a ball of radius r centred at height c, at horizontal distance d.
+    let ball = move |d: f64, r: f64, c: f64| {
+        if (d - r).abs() < EDGE {
+            Expect::Edge
+        } else if d < r {
+            let low = c - (r * r - d * d).sqrt();
+            if low >= frustum {
+                Expect::Nothing
+            } else {
+                Expect::Height(low.max(0.0))
+            }
+        } else {
+            Expect::Nothing
+        }
+    };
+    let boxy = Shape::Box {
+        half_extents: Vec3::new(0.4, 0.1, 0.15),
+    };
+    let quarter = std::f64::consts::FRAC_PI_4;
+    type Case = (&'static str, Deformer, Box<dyn Fn(f64, f64) -> Expect>);
+    let cases: Vec<Case> = vec![
+        (
+            "box along the surface's axes",
+            Deformer::new(
+                boxy,
+                Pose {
+                    position: world(0.5, 0.2, -0.3),
+                    rotation: rot,
+                },
+            ),
+            Box::new(move |x, z| rect(x - 0.5, z + 0.3, 0.4, 0.15, 0.1)),
+        ),
+        (
+            "box turned a quarter about +Y: its long side along local z",
+            Deformer::new(
+                boxy,
+                Pose {
+                    position: world(0.5, 0.2, -0.3),
+                    rotation: Quat::from_rotation_y(th + std::f32::consts::FRAC_PI_2),
+                },
+            ),
+            Box::new(move |x, z| rect(x - 0.5, z + 0.3, 0.15, 0.4, 0.1)),
+        ),
+        (
+            "box turned 45 degrees: box x = (cos, -sin), box z = (sin, cos) in local (x, z)",
+            Deformer::new(
+                boxy,
+                Pose {
+                    position: world(0.5, 0.2, -0.3),
+                    rotation: Quat::from_rotation_y(th + std::f32::consts::FRAC_PI_4),
+                },
+            ),
+            Box::new(move |x, z| {
+                let (px, pz) = (x - 0.5, z + 0.3);
+                let u = px * quarter.cos() - pz * quarter.sin();
+                let v = px * quarter.sin() + pz * quarter.cos();
+                rect(u, v, 0.4, 0.15, 0.1)
+            }),
+        ),
+        (
+            "capsule laid along local x (a quarter about +Z, then the yaw)",
+            Deformer::new(
+                Shape::Capsule {
+                    radius: 0.1,
+                    half_height: 0.3,
+                },
+                Pose {
+                    position: world(-0.6, 0.15, 0.4),
+                    rotation: rot * Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
+                },
+            ),
+            Box::new(move |x, z| {
+                let along = (x + 0.6).clamp(-0.3, 0.3);
+                let d = ((x + 0.6 - along).powi(2) + (z - 0.4).powi(2)).sqrt();
+                ball(d, 0.1, 0.15)
+            }),
+        ),
+        (
+            "box swept 2.1 m along local x within one frame: one continuous trench",
+            Deformer::moving(
+                Shape::Box {
+                    half_extents: Vec3::new(0.05, 0.1, 0.08),
+                },
+                Pose {
+                    position: world(-1.2, 0.15, 0.6),
+                    rotation: rot,
+                },
+                Pose {
+                    position: world(0.9, 0.15, 0.6),
+                    rotation: rot,
+                },
+            ),
+            Box::new(move |x, z| rect(x + 0.15, z - 0.6, 1.1, 0.08, 0.05)),
+        ),
+        (
+            "ball centred 20 cm past the surface's +x edge, reaching 10 cm over it",
+            Deformer::new(
+                Shape::Sphere { radius: 0.3 },
+                Pose::at(world(1.7, 0.25, 0.0).to_array()),
+            ),
+            Box::new(move |x, z| ball(((x - 1.7).powi(2) + z * z).sqrt(), 0.3, 0.25)),
+        ),
+    ];
+    for (what, deformer, expect) in &cases {
+        w.step(0.0, std::slice::from_ref(deformer)).unwrap();
+        let capture = w.read_last_capture(id).unwrap().expect("captured");
+        let (mut pressed, mut empty) = (0, 0);
+        for row in 0..l.height {
+            for col in 0..l.width {
+                let (x, z) = centre(col, row);
+                let got = f64::from(capture[(row * l.width + col) as usize]);
+                match expect(x, z) {
+                    Expect::Edge => {}
+                    Expect::Nothing => {
+                        assert_eq!(got, 1.0, "{what}: texel ({col}, {row}) at ({x}, {z})");
+                        empty += 1;
+                    }
+                    Expect::Height(h) => {
+                        let dh = (got * frustum - h).abs();
+                        assert!(
+                            dh <= f64::from(CAPTURE_HEIGHT_TOLERANCE),
+                            "{what}: texel ({col}, {row}) at ({x}, {z}): height {} for {h}",
+                            got * frustum
+                        );
+                        pressed += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            pressed >= 10 && empty >= 100,
+            "{what}: {pressed} pressed, {empty} empty"
+        );
+    }
+    // Culled: wholly past the -z edge, wholly above the frustum: no primitive reaches the GPU.
+    // (Counted from the frame's statistics: `read_last_capture` keeps answering an earlier step's
+    // capture after a step in which no surface was updated.)
+    for (what, at, kept) in [
+        ("past the -z edge", world(0.0, 0.1, -1.25), 0),
+        ("over the -z edge", world(0.0, 0.1, -1.15), 1),
+        ("above the frustum", world(0.0, snow + ANKLE + 0.21, 0.0), 0),
+        (
+            "touching the frustum's top",
+            world(0.0, snow + ANKLE + 0.19, 0.0),
+            1,
+        ),
+    ] {
+        let stats = w
+            .step(
+                0.0,
+                &[Deformer::new(
+                    Shape::Sphere { radius: 0.2 },
+                    Pose::at(at.to_array()),
+                )],
+            )
+            .unwrap();
+        assert_eq!(stats.primitives, kept, "{what}");
+    }
+}
