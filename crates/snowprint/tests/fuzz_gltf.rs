@@ -215,7 +215,7 @@ fn edge_value() -> impl Strategy<Value = Value> {
             Value::Array(vec![]),
             Value::Object(Default::default()),
         ]),
-        prop::collection::vec(0u64..8, 0..4).prop_map(|v| Value::from(v)),
+        prop::collection::vec(0u64..8, 0..4).prop_map(Value::from),
         (-1.0e30f64..1.0e30).prop_map(Value::from),
     ]
 }
@@ -235,9 +235,9 @@ enum JsonEdit {
 fn json_edit() -> impl Strategy<Value = JsonEdit> {
     let k = any::<usize>();
     prop_oneof![
-        4 => (k.clone(), edge_value()).prop_map(|(k, v)| JsonEdit::Replace(k, v)),
-        2 => k.clone().prop_map(JsonEdit::Remove),
-        1 => (k.clone(), any::<usize>()).prop_map(|(k, i)| JsonEdit::DuplicateIn(k, i)),
+        4 => (k, edge_value()).prop_map(|(k, v)| JsonEdit::Replace(k, v)),
+        2 => k.prop_map(JsonEdit::Remove),
+        1 => (k, any::<usize>()).prop_map(|(k, i)| JsonEdit::DuplicateIn(k, i)),
         2 => (k, prop::collection::vec(0u64..4, 0..4)).prop_map(|(k, c)| JsonEdit::Children(k, c)),
     ]
 }

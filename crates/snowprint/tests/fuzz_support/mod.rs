@@ -44,6 +44,7 @@ pub fn peak_rss() -> Option<u64> {
 }
 
 type Job<I, O> = (I, Sender<Result<O, String>>);
+type JobChannel<I, O> = (Sender<Job<I, O>>, Receiver<Job<I, O>>);
 
 /// Runs a function on a worker thread, one input at a time, and fails an input that panics or runs
 /// longer than the limit. After a timeout the stuck worker is abandoned and a new one started, so
@@ -65,7 +66,7 @@ impl<I: Send + 'static, O: Send + 'static> Watchdog<I, O> {
     }
 
     fn spawn(f: fn(I) -> O) -> Sender<Job<I, O>> {
-        let (tx, rx): (Sender<Job<I, O>>, Receiver<Job<I, O>>) = channel();
+        let (tx, rx): JobChannel<I, O> = channel();
         std::thread::spawn(move || {
             while let Ok((input, reply)) = rx.recv() {
                 let out = catch_unwind(AssertUnwindSafe(|| f(input))).map_err(|p| {
@@ -130,13 +131,13 @@ pub enum Edit {
 pub fn edit(tokens: usize) -> impl Strategy<Value = Edit> {
     let pos = any::<usize>();
     prop_oneof![
-        (pos.clone(), 0u8..8).prop_map(|(at, bit)| Edit::FlipBit { at, bit }),
-        (pos.clone(), any::<u8>()).prop_map(|(at, byte)| Edit::SetByte { at, byte }),
-        (pos.clone(), prop::collection::vec(any::<u8>(), 1..16))
+        (pos, 0u8..8).prop_map(|(at, bit)| Edit::FlipBit { at, bit }),
+        (pos, any::<u8>()).prop_map(|(at, byte)| Edit::SetByte { at, byte }),
+        (pos, prop::collection::vec(any::<u8>(), 1..16))
             .prop_map(|(at, bytes)| Edit::Insert { at, bytes }),
-        (pos.clone(), 0..tokens).prop_map(|(at, token)| Edit::Token { at, token }),
-        (pos.clone(), 1usize..64).prop_map(|(at, len)| Edit::Delete { at, len }),
-        (pos.clone(), 1usize..256, pos.clone(), 1usize..64).prop_map(|(from, len, at, times)| {
+        (pos, 0..tokens).prop_map(|(at, token)| Edit::Token { at, token }),
+        (pos, 1usize..64).prop_map(|(at, len)| Edit::Delete { at, len }),
+        (pos, 1usize..256, pos, 1usize..64).prop_map(|(from, len, at, times)| {
             Edit::Duplicate {
                 from,
                 len,
@@ -144,9 +145,9 @@ pub fn edit(tokens: usize) -> impl Strategy<Value = Edit> {
                 times,
             }
         }),
-        (pos.clone(), pos.clone()).prop_map(|(line, at)| Edit::SpliceLine { line, at }),
-        pos.clone().prop_map(|line| Edit::DeleteLine { line }),
-        (pos.clone(), pos).prop_map(|(a, b)| Edit::SwapLines { a, b }),
+        (pos, pos).prop_map(|(line, at)| Edit::SpliceLine { line, at }),
+        pos.prop_map(|line| Edit::DeleteLine { line }),
+        (pos, pos).prop_map(|(a, b)| Edit::SwapLines { a, b }),
     ]
 }
 
@@ -330,11 +331,11 @@ pub fn tetrahedron_gltf() -> String {
 /// A GLB container: the JSON chunk (padded with spaces) and the binary chunk (padded with zeros).
 pub fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let total = 12 + 8 + j.len() + 8 + b.len();
