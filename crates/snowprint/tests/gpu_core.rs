@@ -1212,8 +1212,8 @@ fn huge_shapes_cover_the_surface_up_to_the_bound_and_are_refused_beyond() {
 
 /// A sphere of radius R resting `gap` above the ground, R up to the bound: the capture's height at
 /// each texel centre (x, z) is `c - sqrt(R^2 - x^2 - z^2)`, evaluated here in f64 from the f32
-/// inputs. The naive `c - sqrt(R^2 - d^2)` in f32 is off by up to ulp(R^2) / 4R (15 um at
-/// R = 1000, 1.2 mm at 1e4); the capture's form is exact to well under a micrometre.
+/// inputs. The naive `c - sqrt(R^2 - d^2)` in f32 is off by up to ulp(R^2) / 2R (31 um at
+/// R = 1000, 0.4 mm at 1e4); the capture's form is exact to well under a micrometre.
 #[test]
 fn huge_shapes_resting_on_the_snow_are_placed_exactly() {
     let mut w = world(CaptureMode::Depth);
