@@ -6,6 +6,12 @@ use glam::{Quat, Vec3};
 use crate::error::{Result, SnowError};
 use crate::mesh::MeshId;
 
+/// Largest size of a deformer, metres: a radius, a capsule's half height, a box's half extent, or a
+/// mesh vertex's distance from the mesh's origin. Up to it the capture places a shape to within
+/// 50 um of its exact surface (`tests/gpu_core.rs`, `huge_shapes_*`); beyond it, the spacing of
+/// 32-bit floats near the shape's size would move the imprint, so larger shapes are refused.
+pub const MAX_DEFORMER_SIZE: f32 = 1000.0;
+
 /// The geometry of a deformer, in its own frame (centred on its pose's position).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
@@ -116,13 +122,13 @@ impl Deformer {
                 expected,
             })
         };
-        let positive = |v: f32| v.is_finite() && v > 0.0;
+        let positive = |v: f32| v.is_finite() && v > 0.0 && v <= MAX_DEFORMER_SIZE;
         match self.shape {
             Shape::Sphere { radius } if !positive(radius) => {
                 return bad(
                     "radius",
                     radius.to_string(),
-                    "a finite number of metres above 0",
+                    "a finite number of metres above 0 and at most MAX_DEFORMER_SIZE (1000)",
                 );
             }
             Shape::Capsule {
@@ -133,24 +139,26 @@ impl Deformer {
                     return bad(
                         "radius",
                         radius.to_string(),
-                        "a finite number of metres above 0",
+                        "a finite number of metres above 0 and at most MAX_DEFORMER_SIZE (1000)",
                     );
                 }
-                if !(half_height.is_finite() && half_height >= 0.0) {
+                if !(half_height.is_finite() && (0.0..=MAX_DEFORMER_SIZE).contains(&half_height)) {
                     return bad(
                         "half_height",
                         half_height.to_string(),
-                        "a finite number of metres, 0 or more",
+                        "a finite number of metres, 0 or more and at most MAX_DEFORMER_SIZE (1000)",
                     );
                 }
             }
             Shape::Box { half_extents }
-                if !(half_extents.is_finite() && half_extents.min_element() > 0.0) =>
+                if !(half_extents.is_finite()
+                    && half_extents.min_element() > 0.0
+                    && half_extents.max_element() <= MAX_DEFORMER_SIZE) =>
             {
                 return bad(
                     "half_extents",
                     format!("{:?}", half_extents.to_array()),
-                    "three finite numbers of metres above 0",
+                    "three finite numbers of metres above 0 and at most MAX_DEFORMER_SIZE (1000)",
                 );
             }
             _ => {}

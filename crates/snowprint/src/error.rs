@@ -76,6 +76,21 @@ pub enum SnowError {
         /// Why it could not be used.
         reason: String,
     },
+    /// A mesh file names a buffer or image it may not read: outside the folder it may read from,
+    /// an absolute path, a URI with a scheme other than `data:`, or a malformed `data:` URI.
+    #[error("mesh file {}: {what} has uri {uri:?}, which {problem}; {fix}", path.display())]
+    MeshUri {
+        /// The mesh file.
+        path: PathBuf,
+        /// Which reference (`buffer 0`, `image 2`).
+        what: String,
+        /// The URI as written (shortened when long).
+        uri: String,
+        /// What is wrong with it.
+        problem: String,
+        /// What to do.
+        fix: String,
+    },
     /// A handle does not name a live object of this world.
     #[error(
         "{what} handle {index} does not belong to this world (it was removed or never existed)"

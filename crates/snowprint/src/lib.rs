@@ -37,7 +37,7 @@ pub mod surface;
 pub mod view;
 pub mod world;
 
-pub use deformer::{Deformer, Pose, Shape};
+pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};
 pub use error::{Result, SnowError};
 pub use gpu::{Capabilities, GpuContext, GpuOptions};
 pub use heightmap::Heightmap;

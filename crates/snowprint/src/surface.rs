@@ -148,14 +148,24 @@ impl SurfaceLayout {
     }
 }
 
-/// Handle of a surface in a [`crate::SnowWorld`].
+/// Handle of a surface in a [`crate::SnowWorld`]: a slot index and the generation of that slot.
+///
+/// A removed surface's index is reused by a later [`crate::SnowWorld::add_surface`], but with the
+/// next generation, so a handle kept past its surface's removal never names the new surface: every
+/// call with it answers [`crate::SnowError::StaleHandle`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct SurfaceId(pub(crate) u32);
+pub struct SurfaceId(pub(crate) u32, pub(crate) u32);
 
 impl SurfaceId {
-    /// Index of the surface, in order of creation.
+    /// Index of the surface's slot in its world; two live surfaces never share one, but a removed
+    /// surface's index is given to a later one (compare whole handles to tell them apart).
     pub fn index(self) -> u32 {
         self.0
+    }
+
+    /// Generation of the slot: how many surfaces held this index before this one.
+    pub fn generation(self) -> u32 {
+        self.1
     }
 }
 

@@ -290,6 +290,9 @@ pub struct SnowWorld {
     pool: wgpu::Buffer,
     alloc: SlotAllocator,
     surfaces: Vec<Option<SurfaceState>>,
+    /// Generation of each slot of `surfaces`: bumped when its surface is removed, so that old
+    /// handles to the slot are refused (see [`SurfaceId`]).
+    generations: Vec<u32>,
     meshes: Vec<Option<MeshGpu>>,
     atlases: Vec<(u32, wgpu::Texture, wgpu::TextureView)>,
     records: Growable,
@@ -442,6 +445,7 @@ impl SnowWorld {
             pool,
             alloc,
             surfaces: Vec::new(),
+            generations: Vec::new(),
             meshes: Vec::new(),
             atlases: Vec::new(),
             last: LastFrame::default(),
@@ -493,29 +497,29 @@ impl SnowWorld {
     }
 
     fn insert_state(&mut self, state: SurfaceState) -> SurfaceId {
-        let index = match self.surfaces.iter().position(Option::is_none) {
+        // A free slot whose generation is spent (u32::MAX removals) is retired, never reused.
+        let free = (0..self.surfaces.len())
+            .find(|&i| self.surfaces[i].is_none() && self.generations[i] != u32::MAX);
+        let index = match free {
             Some(i) => {
                 self.surfaces[i] = Some(state);
                 i
             }
             None => {
                 self.surfaces.push(Some(state));
+                self.generations.push(0);
                 self.surfaces.len() - 1
             }
         };
-        SurfaceId(index as u32)
+        SurfaceId(index as u32, self.generations[index])
     }
 
     /// Remove a surface and give its pool bytes back.
     pub fn remove_surface(&mut self, id: SurfaceId) -> Result<()> {
-        let state = self
-            .surfaces
-            .get_mut(id.0 as usize)
-            .and_then(Option::take)
-            .ok_or(SnowError::StaleHandle {
-                what: "surface",
-                index: id.0,
-            })?;
+        self.state(id)?;
+        let index = id.0 as usize;
+        let state = self.surfaces[index].take().expect("checked live above");
+        self.generations[index] = self.generations[index].saturating_add(1);
         self.alloc.free(state.slot);
         Ok(())
     }
@@ -665,16 +669,18 @@ impl SnowWorld {
 
     /// Every live surface.
     pub fn surfaces(&self) -> impl Iterator<Item = (SurfaceId, &SurfaceDesc)> {
-        self.surfaces
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| s.as_ref().map(|s| (SurfaceId(i as u32), &s.desc)))
+        self.surfaces.iter().enumerate().filter_map(|(i, s)| {
+            s.as_ref()
+                .map(|s| (SurfaceId(i as u32, self.generations[i]), &s.desc))
+        })
     }
 
     fn state(&self, id: SurfaceId) -> Result<&SurfaceState> {
+        let index = id.0 as usize;
         self.surfaces
-            .get(id.0 as usize)
+            .get(index)
             .and_then(Option::as_ref)
+            .filter(|_| self.generations[index] == id.1)
             .ok_or(SnowError::StaleHandle {
                 what: "surface",
                 index: id.0,
@@ -1435,6 +1441,7 @@ impl SnowWorld {
     /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing), when
     /// it was captured in that step; `None` otherwise.
     pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        self.state(id)?;
         let Some(&(_, r, _)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
             return Ok(None);
         };
@@ -1469,6 +1476,7 @@ impl SnowWorld {
     /// was captured in that step by separate stages ([`PassMode::Separate`]; the fused pass keeps
     /// stage 1's output in registers).
     pub fn read_last_blurred(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        self.state(id)?;
         if self.config.passes == PassMode::Fused {
             return Ok(None);
         }

@@ -310,13 +310,34 @@ fn mesh_capture_matches_cpu_and_clamps_to_the_ground() {
         &[],
         &tris,
     );
+    // Only texels whose centre lies on a triangle edge may differ, and by no more than the edge
+    // can move a value: the GPU's value must be one the ray cast finds within a texel of it (the
+    // range of the CPU values of the 3x3 texels around it), never an arbitrary one.
     let mut mismatch = 0;
-    for (g, c) in gpu_cap.iter().zip(&cpu_cap) {
-        if (*g < 1.0) != (*c < 1.0) || (g - c).abs() > 1e-4 {
+    for row in 0..l.height {
+        for col in 0..l.width {
+            let i = (row * l.width + col) as usize;
+            let (g, c) = (gpu_cap[i], cpu_cap[i]);
+            if (g < 1.0) == (c < 1.0) && (g - c).abs() <= 1e-4 {
+                continue;
+            }
             mismatch += 1;
+            let mut range = (f32::MAX, f32::MIN);
+            for dr in -1i32..=1 {
+                for dc in -1i32..=1 {
+                    let (r, q) = (row as i32 + dr, col as i32 + dc);
+                    if r >= 0 && q >= 0 && (r as u32) < l.height && (q as u32) < l.width {
+                        let v = cpu_cap[(r as u32 * l.width + q as u32) as usize];
+                        range = (range.0.min(v), range.1.max(v));
+                    }
+                }
+            }
+            assert!(
+                g >= range.0 - 1e-4 && g <= range.1 + 1e-4,
+                "texel ({col}, {row}): GPU {g}, ray cast {c}, and its neighbours span {range:?}"
+            );
         }
     }
-    // Only texels whose centre lies on a triangle edge may differ.
     assert!(
         mismatch * 100 <= gpu_cap.len(),
         "{mismatch} of {} texels differ",
@@ -723,7 +744,36 @@ fn pool_exhaustion_is_an_error_not_a_panic() {
             .iter()
             .all(|&v| v == 0)
     );
-    assert!(matches!(w.read_heightmap(a), Err(SnowError::StaleHandle { .. })) || a == c);
+    // `c` takes `a`'s freed slot, but `a` is stale: it names neither `c` nor anything else.
+    assert_eq!(c.index(), a.index());
+    assert_ne!(c, a);
+    assert_stale(w.read_heightmap(a).map(|_| ()));
+    assert_stale(w.surface(a).map(|_| ()));
+    assert_stale(w.layout(a).map(|_| ()));
+    assert_stale(w.gpu_offsets(a).map(|_| ()));
+    assert_stale(w.read_last_capture(a).map(|_| ()));
+    assert_stale(w.remove_surface(a));
+    let update = [snowprint::SurfaceUpdate {
+        surface: a,
+        elapsed: 0.0,
+        deformers: &[],
+    }];
+    assert_stale(w.update(&update).map(|_| ()));
+    // The stale calls changed nothing: `c` is still live, listed once, and removable.
+    assert_eq!(w.surfaces().filter(|(id, _)| *id == c).count(), 1);
+    assert!(w.surfaces().all(|(id, _)| id != a));
+    w.remove_surface(c).unwrap();
+    assert_stale(w.read_heightmap(c).map(|_| ()));
+}
+
+/// `r` must be [`SnowError::StaleHandle`] for a surface.
+fn assert_stale(r: snowprint::Result<()>) {
+    match r {
+        Err(SnowError::StaleHandle {
+            what: "surface", ..
+        }) => {}
+        other => panic!("expected a stale surface handle, got {other:?}"),
+    }
 }
 
 #[test]
@@ -1112,5 +1162,307 @@ fn moving_mesh_is_swept_within_a_frame() {
             65535,
             "column {col}"
         );
+    }
+}
+
+/// Shapes up to `MAX_DEFORMER_SIZE` that hold the whole 2 x 2 m surface press every texel to the
+/// ground (before the bound was stated and the footprint clamped to the surface, a sphere of radius
+/// 1e8 pressed only the -X half and one of 3e38 nothing); larger ones are refused with a sentence.
+#[test]
+fn huge_shapes_cover_the_surface_up_to_the_bound_and_are_refused_beyond() {
+    let mut w = world(CaptureMode::Depth);
+    let id = w
+        .add_surface(SurfaceDesc::new("yard", [0.0; 3], [2.0, 2.0], 0.3))
+        .unwrap();
+    let texels = w.layout(id).unwrap().texels() as usize;
+    let max = snowprint::MAX_DEFORMER_SIZE;
+    for shape in [
+        Shape::Sphere { radius: 1.5 },
+        Shape::Sphere { radius: max },
+        Shape::Capsule {
+            radius: max,
+            half_height: max,
+        },
+        Shape::Box {
+            half_extents: Vec3::splat(max),
+        },
+    ] {
+        w.step(0.0, &[Deformer::new(shape, Pose::at([0.0; 3]))])
+            .unwrap();
+        let capture = w.read_last_capture(id).unwrap().expect("captured");
+        assert_eq!(capture.len(), texels);
+        let pressed = capture.iter().filter(|&&d| d == 0.0).count();
+        assert_eq!(pressed, texels, "{shape:?} pressed {pressed} of {texels}");
+    }
+    for radius in [max * 1.001, 1e8, 1e36, 3e38] {
+        let e = w
+            .step(
+                0.0,
+                &[Deformer::new(Shape::Sphere { radius }, Pose::at([0.0; 3]))],
+            )
+            .unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(e, SnowError::InvalidDeformer { what: "radius", .. })
+                && msg.contains("at most MAX_DEFORMER_SIZE (1000)"),
+            "{msg}"
+        );
+    }
+}
+
+/// A sphere of radius R resting `gap` above the ground, R up to the bound: the capture's height at
+/// each texel centre (x, z) is `c - sqrt(R^2 - x^2 - z^2)`, evaluated here in f64 from the f32
+/// inputs. The naive `c - sqrt(R^2 - d^2)` in f32 is off by up to ulp(R^2) / 2R (31 um at
+/// R = 1000, 0.4 mm at 1e4); the capture's form is exact to well under a micrometre.
+#[test]
+fn huge_shapes_resting_on_the_snow_are_placed_exactly() {
+    let mut w = world(CaptureMode::Depth);
+    let desc = SurfaceDesc::new("yard", [0.0; 3], [2.0, 2.0], 0.3);
+    let id = w.add_surface(desc.clone()).unwrap();
+    let l = w.layout(id).unwrap();
+    let frustum = 0.3 + ANKLE;
+    let gap = 0.1f32;
+    for radius in [1.0f32, 30.0, 1000.0] {
+        let cy = radius + gap;
+        w.step(
+            0.0,
+            &[Deformer::new(
+                Shape::Sphere { radius },
+                Pose::at([0.0, cy, 0.0]),
+            )],
+        )
+        .unwrap();
+        let capture = w.read_last_capture(id).unwrap().expect("captured");
+        let (r, cy) = (f64::from(radius), f64::from(cy));
+        let mut worst = 0.0f64;
+        let mut covered = 0;
+        for row in 0..l.height {
+            for col in 0..l.width {
+                // Texel centres by hand: the surface spans -1..1 m on both axes.
+                let x = -1.0 + (f64::from(col) + 0.5) * 2.0 / f64::from(l.width);
+                let z = -1.0 + (f64::from(row) + 0.5) * 2.0 / f64::from(l.height);
+                let d2 = x * x + z * z;
+                let got = f64::from(capture[(row * l.width + col) as usize]);
+                if d2 >= r * r || cy - (r * r - d2).sqrt() >= f64::from(frustum) {
+                    assert_eq!(got, 1.0, "r {r} texel ({col}, {row}): nothing there");
+                    continue;
+                }
+                covered += 1;
+                let want = cy - (r * r - d2).sqrt();
+                worst = worst.max((got * f64::from(frustum) - want).abs());
+            }
+        }
+        assert!(covered > 100, "r {r}: {covered} texels");
+        assert!(worst < 1e-6, "r {r}: height off by {worst} m");
+    }
+}
+
+/// What a hand-derived case expects at a texel centre: the lowest height pressed there, nothing, or
+/// no claim (within 2 mm of the footprint's edge, where the texel centre's rounding decides).
+enum Expect {
+    Height(f64),
+    Nothing,
+    Edge,
+}
+
+/// Capture cases derived by hand on a yawed surface, independent of `capture::push_primitives` and
+/// of the CPU ray cast: the surface's frame, a box's orientation, a capsule's pose, a box swept
+/// within one frame, and culling at the surface's edges and above the frustum. World positions are
+/// written out with the yaw's sine and cosine; expectations are the shapes' closed forms in f64.
+#[test]
+fn capture_matches_hand_derived_cases_on_a_yawed_surface() {
+    let mut w = world(CaptureMode::Depth);
+    let yaw = 30.0f32;
+    let (center, size, snow) = (Vec3::new(2.0, 1.0, -3.0), [3.0f32, 2.0], 0.3f32);
+    let mut desc = SurfaceDesc::new("yawed", center.to_array(), size, snow);
+    desc.yaw_degrees = yaw;
+    let id = w.add_surface(desc).unwrap();
+    let l = w.layout(id).unwrap();
+    let frustum = f64::from(snow + ANKLE);
+    let th = yaw.to_radians();
+    let rot = Quat::from_rotation_y(th);
+    // Rotation about +Y by th takes local +X to (cos, 0, -sin) and local +Z to (sin, 0, cos).
+    let world = |x: f32, y: f32, z: f32| {
+        center
+            + x * Vec3::new(th.cos(), 0.0, -th.sin())
+            + Vec3::new(0.0, y, 0.0)
+            + z * Vec3::new(th.sin(), 0.0, th.cos())
+    };
+    // Texel centres by hand: local x from -1.5 to 1.5 over the width, z from -1 to 1 over the height.
+    let centre = |col: u32, row: u32| {
+        (
+            -1.5 + (f64::from(col) + 0.5) * 3.0 / f64::from(l.width),
+            -1.0 + (f64::from(row) + 0.5) * 2.0 / f64::from(l.height),
+        )
+    };
+    const EDGE: f64 = 2e-3;
+    // Inside a rectangle |u| <= a, |v| <= b, with the edge band left out.
+    let rect = |u: f64, v: f64, a: f64, b: f64, height: f64| {
+        let outside = (u.abs() - a).max(v.abs() - b);
+        if outside.abs() < EDGE {
+            Expect::Edge
+        } else if outside < 0.0 {
+            Expect::Height(height)
+        } else {
+            Expect::Nothing
+        }
+    };
+    // Lowest point of a ball of radius r centred at height c, at horizontal distance d.
+    let ball = move |d: f64, r: f64, c: f64| {
+        if (d - r).abs() < EDGE {
+            Expect::Edge
+        } else if d < r {
+            let low = c - (r * r - d * d).sqrt();
+            if low >= frustum {
+                Expect::Nothing
+            } else {
+                Expect::Height(low.max(0.0))
+            }
+        } else {
+            Expect::Nothing
+        }
+    };
+    let boxy = Shape::Box {
+        half_extents: Vec3::new(0.4, 0.1, 0.15),
+    };
+    let quarter = std::f64::consts::FRAC_PI_4;
+    type Case = (&'static str, Deformer, Box<dyn Fn(f64, f64) -> Expect>);
+    let cases: Vec<Case> = vec![
+        (
+            "box along the surface's axes",
+            Deformer::new(
+                boxy,
+                Pose {
+                    position: world(0.5, 0.2, -0.3),
+                    rotation: rot,
+                },
+            ),
+            Box::new(move |x, z| rect(x - 0.5, z + 0.3, 0.4, 0.15, 0.1)),
+        ),
+        (
+            "box turned a quarter about +Y: its long side along local z",
+            Deformer::new(
+                boxy,
+                Pose {
+                    position: world(0.5, 0.2, -0.3),
+                    rotation: Quat::from_rotation_y(th + std::f32::consts::FRAC_PI_2),
+                },
+            ),
+            Box::new(move |x, z| rect(x - 0.5, z + 0.3, 0.15, 0.4, 0.1)),
+        ),
+        (
+            "box turned 45 degrees: box x = (cos, -sin), box z = (sin, cos) in local (x, z)",
+            Deformer::new(
+                boxy,
+                Pose {
+                    position: world(0.5, 0.2, -0.3),
+                    rotation: Quat::from_rotation_y(th + std::f32::consts::FRAC_PI_4),
+                },
+            ),
+            Box::new(move |x, z| {
+                let (px, pz) = (x - 0.5, z + 0.3);
+                let u = px * quarter.cos() - pz * quarter.sin();
+                let v = px * quarter.sin() + pz * quarter.cos();
+                rect(u, v, 0.4, 0.15, 0.1)
+            }),
+        ),
+        (
+            "capsule laid along local x (a quarter about +Z, then the yaw)",
+            Deformer::new(
+                Shape::Capsule {
+                    radius: 0.1,
+                    half_height: 0.3,
+                },
+                Pose {
+                    position: world(-0.6, 0.15, 0.4),
+                    rotation: rot * Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
+                },
+            ),
+            Box::new(move |x, z| {
+                let along = (x + 0.6).clamp(-0.3, 0.3);
+                let d = ((x + 0.6 - along).powi(2) + (z - 0.4).powi(2)).sqrt();
+                ball(d, 0.1, 0.15)
+            }),
+        ),
+        (
+            "box swept 2.1 m along local x within one frame: one continuous trench",
+            Deformer::moving(
+                Shape::Box {
+                    half_extents: Vec3::new(0.05, 0.1, 0.08),
+                },
+                Pose {
+                    position: world(-1.2, 0.15, 0.6),
+                    rotation: rot,
+                },
+                Pose {
+                    position: world(0.9, 0.15, 0.6),
+                    rotation: rot,
+                },
+            ),
+            Box::new(move |x, z| rect(x + 0.15, z - 0.6, 1.1, 0.08, 0.05)),
+        ),
+        (
+            "ball centred 20 cm past the surface's +x edge, reaching 10 cm over it",
+            Deformer::new(
+                Shape::Sphere { radius: 0.3 },
+                Pose::at(world(1.7, 0.25, 0.0).to_array()),
+            ),
+            Box::new(move |x, z| ball(((x - 1.7).powi(2) + z * z).sqrt(), 0.3, 0.25)),
+        ),
+    ];
+    for (what, deformer, expect) in &cases {
+        w.step(0.0, std::slice::from_ref(deformer)).unwrap();
+        let capture = w.read_last_capture(id).unwrap().expect("captured");
+        let (mut pressed, mut empty) = (0, 0);
+        for row in 0..l.height {
+            for col in 0..l.width {
+                let (x, z) = centre(col, row);
+                let got = f64::from(capture[(row * l.width + col) as usize]);
+                match expect(x, z) {
+                    Expect::Edge => {}
+                    Expect::Nothing => {
+                        assert_eq!(got, 1.0, "{what}: texel ({col}, {row}) at ({x}, {z})");
+                        empty += 1;
+                    }
+                    Expect::Height(h) => {
+                        let dh = (got * frustum - h).abs();
+                        assert!(
+                            dh <= f64::from(CAPTURE_HEIGHT_TOLERANCE),
+                            "{what}: texel ({col}, {row}) at ({x}, {z}): height {} for {h}",
+                            got * frustum
+                        );
+                        pressed += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            pressed >= 10 && empty >= 100,
+            "{what}: {pressed} pressed, {empty} empty"
+        );
+    }
+    // Culled: wholly past the -z edge, wholly above the frustum: no primitive reaches the GPU.
+    // (Counted from the frame's statistics: `read_last_capture` keeps answering an earlier step's
+    // capture after a step in which no surface was updated.)
+    for (what, at, kept) in [
+        ("past the -z edge", world(0.0, 0.1, -1.25), 0),
+        ("over the -z edge", world(0.0, 0.1, -1.15), 1),
+        ("above the frustum", world(0.0, snow + ANKLE + 0.21, 0.0), 0),
+        (
+            "touching the frustum's top",
+            world(0.0, snow + ANKLE + 0.19, 0.0),
+            1,
+        ),
+    ] {
+        let stats = w
+            .step(
+                0.0,
+                &[Deformer::new(
+                    Shape::Sphere { radius: 0.2 },
+                    Pose::at(at.to_array()),
+                )],
+            )
+            .unwrap();
+        assert_eq!(stats.primitives, kept, "{what}");
     }
 }

@@ -14,14 +14,17 @@ pub fn texel_center(column: u32, row: u32, width: u32, height: u32, half_size: V
     -half_size + cell / Vec2::new(width as f32, height as f32) * 2.0 * half_size
 }
 
+/// Same stable form as `sphere_interval` in capture.wgsl: `(c.y -+ r) +- d^2 / (r + s)`.
 fn sphere_interval(c: Vec3, r: f32, x: f32, z: f32) -> (f32, f32) {
     let (dx, dz) = (x - c.x, z - c.z);
-    let s2 = r * r - dx * dx - dz * dz;
-    if s2 < 0.0 {
+    let d2 = dx * dx + dz * dz;
+    let d = d2.sqrt();
+    if d > r {
         return (BIG, -BIG);
     }
-    let s = s2.sqrt();
-    (c.y - s, c.y + s)
+    let s = ((r - d) * (r + d)).sqrt();
+    let sag = d2 / (r + s);
+    ((c.y - r) + sag, (c.y + r) - sag)
 }
 
 /// Heights where the vertical line through `(x, z)` is inside the capsule; empty when `lo > hi`.

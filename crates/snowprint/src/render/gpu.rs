@@ -96,7 +96,7 @@ pub struct SurfaceUniform {
     pub search: [f32; 4],
     /// Look: ground from, ground full, AO strength, POM self-shadow taps.
     pub look: [f32; 4],
-    /// Pattern offset (xy), reserved.
+    /// Pattern offset (xy), switched-off terms (z, `SnowLook::switch_bits`), macro wave strength (w).
     pub pattern: [f32; 4],
 }
 

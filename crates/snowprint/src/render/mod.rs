@@ -309,6 +309,12 @@ pub struct SnowLook {
     pub ground_full: f32,
     /// Strength of the heightmap's ambient occlusion (0 to 1).
     pub occlusion: f32,
+    /// The sky's tint of the walls and rims of prints (on by default; off only to see what it
+    /// adds, as the image tests do).
+    pub sky_tint: bool,
+    /// Reoriented normal mapping of detail onto the heightmap's normal (on by default; off, the
+    /// detail is blended linearly, which flattens it).
+    pub rnm: bool,
 }
 
 impl Default for SnowLook {
@@ -317,7 +323,16 @@ impl Default for SnowLook {
             ground_from: 0.66,
             ground_full: 0.9,
             occlusion: 0.85,
+            sky_tint: true,
+            rnm: true,
         }
+    }
+}
+
+impl SnowLook {
+    /// The switched-off terms as `snow.wgsl` reads them (`SNOW_NO_SKY_TINT`, `SNOW_NO_RNM`).
+    fn switch_bits(&self) -> u32 {
+        u32::from(!self.sky_tint) | (u32::from(!self.rnm) << 1)
     }
 }
 
@@ -1419,6 +1434,20 @@ impl Renderer {
         self.config.debug_view = view;
     }
 
+    /// Change how snow and ground meet, or switch a term of the material off (as the image tests
+    /// do to show they see it); checked as [`Renderer::new`] checks its configuration.
+    ///
+    /// # Errors
+    ///
+    /// [`RenderError`] naming the look's value that is out of range; the look in use is kept.
+    pub fn set_look(&mut self, look: SnowLook) -> RenderResult<()> {
+        let mut config = self.config;
+        config.look = look;
+        config.validate(&self.device)?;
+        self.config = config;
+        Ok(())
+    }
+
     /// How a surface is drawn in the tessellated tier: its mesh, whether it is tessellated at all,
     /// its banks and macro waves. Checked against the surface (a mesh must lie within its
     /// rectangle); surfaces never given one get [`SurfaceGeometry::default`].
@@ -2430,7 +2459,7 @@ impl Renderer {
                 pattern: [
                     desc.center.x,
                     desc.center.z,
-                    0.0,
+                    look.switch_bits() as f32,
                     self.geometry
                         .get(id)
                         .map_or(1.0, |g: &SurfaceGeometry| g.macro_waves),

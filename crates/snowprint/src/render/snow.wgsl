@@ -42,7 +42,7 @@ struct SnowSurface {
     index: u32,             // the surface's slot in the renderer's per-surface tables
     search: vec4<f32>,      // x: linear taps per texel crossed, y: min taps, z: max taps, w: binary refinement taps
     look: vec4<f32>,        // x: depression where the ground starts to show, y: where it shows fully, z: AO strength, w: POM self-shadow taps
-    pattern: vec4<f32>,     // xy: offset of the procedural patterns (metres), z: snow sparkle (unused: 0), w: reserved
+    pattern: vec4<f32>,     // xy: offset of the procedural patterns (metres), z: switches (SNOW_NO_*), w: macro wave strength
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
@@ -437,6 +437,32 @@ fn snow_sss_tint(albedo: vec3<f32>, transition: f32, sky: vec3<f32>) -> vec3<f32
     return mix(albedo, albedo * sky, clamp(transition, 0.0, 1.0));
 }
 
+// Switches that turn one term of the material off (`s.pattern.z`, a sum of these bits), so that a
+// test can show the images see the term. Must match `SnowLook::switch_bits` in mod.rs.
+const SNOW_NO_SKY_TINT: u32 = 1u;
+const SNOW_NO_RNM: u32 = 2u;
+
+fn snow_switched_off(s: SnowSurface, bit: u32) -> bool {
+    return (u32(s.pattern.z) & bit) != 0u;
+}
+
+// The sky tint of walls and rims, unless switched off.
+fn snow_tint(s: SnowSurface, albedo: vec3<f32>, transition: f32, sky: vec3<f32>) -> vec3<f32> {
+    if snow_switched_off(s, SNOW_NO_SKY_TINT) {
+        return albedo;
+    }
+    return snow_sss_tint(albedo, transition, sky);
+}
+
+// Detail on a base normal: RNM, or (switched off) the linear blend RNM replaces, which flattens
+// the detail.
+fn snow_combine(s: SnowSurface, base: vec3<f32>, detail: vec3<f32>) -> vec3<f32> {
+    if snow_switched_off(s, SNOW_NO_RNM) {
+        return normalize(vec3<f32>(base.xy + detail.xy, base.z * detail.z));
+    }
+    return snow_rnm(base, detail);
+}
+
 // The basic snow material: fresh, untouched snow, no heightmap at all (the talk's cheaper material
 // for surfaces nothing has pressed). `face` is the box face's local normal, `pixel` the pixel's
 // footprint on the surface in metres (detail finer than a few pixels fades out).
@@ -448,7 +474,7 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>, pix
     m.f0 = 0.02;
     m.wrap = 0.35;
     if face.y > 0.5 {
-        let n = snow_rnm(snow_macro_normal(q), snow_detail_normal(q, 1.0, pixel));
+        let n = snow_combine(s, snow_macro_normal(q), snow_detail_normal(q, 1.0, pixel));
         m.normal = snow_ts_to_local(n);
         m.albedo = SNOW_FRESH;
         m.roughness = 0.62;
@@ -463,7 +489,7 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>, pix
         m.transition = 0.45;
         m.ao = mix(0.6, 1.0, clamp(p.y / max(s.snow_depth, 1e-3), 0.0, 1.0));
     }
-    m.albedo = snow_sss_tint(m.albedo, m.transition, sky);
+    m.albedo = snow_tint(s, m.albedo, m.transition, sky);
     return m;
 }
 
@@ -491,7 +517,7 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     let hn = vec3<f32>(hf.y, hf.z, sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)));
     let flatten = 1.0 - smoothstep(0.0, 0.5, dep);
     let wave = normalize(mix(vec3<f32>(0.0, 0.0, 1.0), snow_macro_normal(q), flatten));
-    let snow_n = snow_rnm(wave, snow_detail_normal(q, mix(1.0, 0.45, dep), pixel));
+    let snow_n = snow_combine(s, wave, snow_detail_normal(q, mix(1.0, 0.45, dep), pixel));
     var ground_layer: SnowLayer;
     if ground > 0.0 {
         ground_layer = snow_ground_layer(s, q, pixel);
@@ -504,14 +530,14 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     // Detail normals of the two stages are mixed as perturbations of the same surface, then
     // reoriented onto the heightmap's normal.
     let detail = normalize(mix(snow_n, ground_layer.normal, ground));
-    let n = snow_rnm(hn, detail);
+    let n = snow_combine(s, hn, detail);
 
     // Diffuse and specular: a simple lerp between the stages, as in the talk. The ground is wet
     // where the snow was pressed onto it.
     let snow_albedo = mix(SNOW_FRESH, SNOW_PACKED, smoothstep(0.05, 0.8, dep));
     let wet_ground = ground_layer.albedo * 0.8;
     var m: SnowSample;
-    m.albedo = snow_sss_tint(mix(snow_albedo, wet_ground, ground), transition, sky);
+    m.albedo = snow_tint(s, mix(snow_albedo, wet_ground, ground), transition, sky);
     m.roughness = mix(mix(0.62, 0.5, dep), ground_layer.roughness * 0.55, ground);
     m.f0 = mix(0.02, 0.05, ground);
     m.normal = snow_ts_to_local(n);

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 use toml::Spanned;
 
-use crate::deformer::{Deformer, Shape};
+use crate::deformer::{Deformer, MAX_DEFORMER_SIZE, Shape};
 use crate::error::{Result, SnowError};
 use crate::mesh::Mesh;
 use crate::surface::SurfaceDesc;
@@ -682,8 +682,10 @@ fn deformer(
             v,
             &who,
             "radius",
-            |x| x > 0.0,
-            "radii must be finite numbers of metres above 0",
+            |x| x > 0.0 && x <= MAX_DEFORMER_SIZE,
+            &format!(
+                "radii must be finite numbers of metres above 0 and at most {MAX_DEFORMER_SIZE} (the largest shape the capture places exactly)"
+            ),
         )
     };
     let shape = match kind {
@@ -705,8 +707,10 @@ fn deformer(
                 v,
                 &who,
                 "half_height",
-                |x| x >= 0.0,
-                "half_height must be a finite number of metres, 0 or more",
+                |x| (0.0..=MAX_DEFORMER_SIZE).contains(&x),
+                &format!(
+                    "half_height must be a finite number of metres, 0 or more and at most {MAX_DEFORMER_SIZE} (the largest shape the capture places exactly)"
+                ),
             )?;
             SceneShape::Capsule {
                 radius,
@@ -728,8 +732,10 @@ fn deformer(
                 &who,
                 "half_extents",
                 "[x, y, z] in metres",
-                |x| x > 0.0,
-                "half_extents must be three finite numbers of metres above 0",
+                |x| x > 0.0 && x <= MAX_DEFORMER_SIZE,
+                &format!(
+                    "half_extents must be three finite numbers of metres above 0 and at most {MAX_DEFORMER_SIZE} (the largest shape the capture places exactly)"
+                ),
             )?;
             SceneShape::Box {
                 half_extents: Vec3::from(h),
@@ -814,12 +820,59 @@ fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShap
             ),
         ));
     }
-    let mesh = Mesh::load_gltf(&resolved).map_err(|e| {
+    // A scene may come from an untrusted mod: it and its meshes read only under its own folder.
+    let root = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let inside = match (resolved.canonicalize(), root.canonicalize()) {
+        (Ok(file), Ok(root)) => file.starts_with(root),
+        _ => false,
+    };
+    if !inside {
+        return Err(src.error(
+            &span,
+            format!(
+                "{who} has path {}, which leads outside the scene file's folder ({folder})",
+                src.quote(&span)
+            ),
+            "a scene may read only files under its own folder, so copy the mesh there and give a path relative to the scene",
+        ));
+    }
+    let mesh = Mesh::load_gltf_within(&resolved, root).map_err(|e| {
+        if let SnowError::MeshUri {
+            what,
+            uri,
+            problem,
+            fix,
+            ..
+        } = &e
+        {
+            return src.error(
+                &span,
+                format!(
+                    "{who} has path {}, but in {} {what} has uri {uri:?}, which {problem}",
+                    src.quote(&span),
+                    resolved.display()
+                ),
+                fix.replace("the mesh's folder", "the scene's folder"),
+            );
+        }
         let reason = match e {
             SnowError::MeshFile { reason, .. } | SnowError::InvalidMesh { reason, .. } => reason,
             other => other.to_string(),
         };
         let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
+        // The loader's reasons end with what to do after "; ": make that the hint.
+        let (reason, fix) = match reason.split_once("; ") {
+            Some((reason, fix)) => (reason.to_owned(), fix.to_owned()),
+            None => (
+                reason,
+                "give it a valid glTF (.gltf) or GLB (.glb) file holding a closed triangle mesh"
+                    .to_owned(),
+            ),
+        };
         src.error(
             &span,
             format!(
@@ -827,7 +880,7 @@ fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShap
                 src.quote(&span),
                 resolved.display()
             ),
-            "give it a valid glTF (.gltf) or GLB (.glb) file holding a closed triangle mesh",
+            fix,
         )
     })?;
     Ok(SceneShape::Mesh {

@@ -2,11 +2,15 @@
 //! convention). The capture relies on that winding to fill what lies below the ground (see
 //! `capture/capture.wgsl`).
 
-use std::path::Path;
+mod gltf_file;
 
 use glam::{Mat4, Vec3};
 
 use crate::error::{Result, SnowError};
+
+pub use gltf_file::{
+    MAX_GLTF_DEPTH, MAX_GLTF_FILE_BYTES, MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_GLTF_VERTICES,
+};
 
 /// Handle of a mesh registered with a [`crate::SnowWorld`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -48,6 +52,14 @@ impl Mesh {
         }
         if let Some(p) = self.positions.iter().find(|p| !p.is_finite()) {
             return err(format!("vertex {:?} is not finite", p.to_array()));
+        }
+        let limit = crate::deformer::MAX_DEFORMER_SIZE;
+        if let Some(p) = self.positions.iter().find(|p| p.length() > limit) {
+            return err(format!(
+                "vertex {:?} lies {} m from the mesh's origin, farther than the {limit} m (MAX_DEFORMER_SIZE) a deformer may reach; model the mesh around its origin and at most {limit} m across",
+                p.to_array(),
+                p.length()
+            ));
         }
         Ok(())
     }
@@ -171,58 +183,6 @@ impl Mesh {
             indices.extend_from_slice(&[a, b, c, a, c, d]);
         }
         Mesh { positions, indices }
-    }
-
-    /// Load every triangle primitive of a glTF or GLB file, with node transforms applied, into one
-    /// mesh in the file's frame (metres, +Y up as glTF defines).
-    pub fn load_gltf(path: &Path) -> Result<Mesh> {
-        let err = |reason: String| SnowError::MeshFile {
-            path: path.to_owned(),
-            reason,
-        };
-        let (doc, buffers, _) = gltf::import(path).map_err(|e| err(e.to_string()))?;
-        let mut mesh = Mesh::default();
-        let scene = doc
-            .default_scene()
-            .or_else(|| doc.scenes().next())
-            .ok_or_else(|| err("has no scene".into()))?;
-        let mut stack: Vec<(gltf::Node, Mat4)> =
-            scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-        while let Some((node, parent)) = stack.pop() {
-            let m = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-            if let Some(gm) = node.mesh() {
-                for prim in gm.primitives() {
-                    if prim.mode() != gltf::mesh::Mode::Triangles {
-                        continue;
-                    }
-                    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-                    let Some(pos) = reader.read_positions() else {
-                        continue;
-                    };
-                    let base = mesh.positions.len() as u32;
-                    let first_index = mesh.indices.len();
-                    let pos: Vec<Vec3> = pos.map(|p| m.transform_point3(Vec3::from(p))).collect();
-                    let n = pos.len() as u32;
-                    mesh.positions.extend(pos);
-                    match reader.read_indices() {
-                        Some(ix) => mesh.indices.extend(ix.into_u32().map(|i| base + i)),
-                        None => mesh.indices.extend(base..base + n),
-                    }
-                    // A mirroring transform flips the winding; keep triangles outward-facing.
-                    if m.determinant() < 0.0 {
-                        for tri in mesh.indices[first_index..].chunks_exact_mut(3) {
-                            tri.swap(1, 2);
-                        }
-                    }
-                }
-            }
-            stack.extend(node.children().map(|c| (c, m)));
-        }
-        if mesh.indices.is_empty() {
-            return Err(err("holds no triangles".into()));
-        }
-        mesh.validate(&path.display().to_string())?;
-        Ok(mesh)
     }
 }
 

@@ -1,0 +1,787 @@
+//! glTF and GLB loading for mesh deformers, for files that may come from an untrusted mod.
+//!
+//! Only the triangles' positions are read. The loader never follows a buffer or image URI out of
+//! the folder it was given (`root`): a relative URI is resolved against the file's folder, made
+//! canonical (which follows `..` and symbolic links) and must still lie under the canonical root;
+//! absolute paths and URIs with a scheme other than `data:` are refused. Node hierarchies are
+//! checked to be trees before they are walked (a cycle would otherwise never end), and the sizes of
+//! everything read are bounded ([`MAX_GLTF_NODES`] and the other limits below), so that a hostile
+//! file gets one sentence, never a hang, a panic or unbounded memory.
+//!
+//! Accessors are read here, with checked arithmetic, rather than through the `gltf` crate's
+//! reader, whose offset arithmetic assumes valid counts and strides.
+
+use std::io::Read;
+use std::path::{Component, Path, PathBuf};
+
+use glam::{Mat4, Vec3};
+
+use super::Mesh;
+use crate::error::{Result, SnowError};
+
+/// Most nodes a glTF file may have.
+pub const MAX_GLTF_NODES: usize = 65_536;
+/// Deepest node hierarchy accepted: a root node has depth 1.
+pub const MAX_GLTF_DEPTH: usize = 128;
+/// Most vertices a loaded mesh may have, counting each node that instances a mesh once more.
+pub const MAX_GLTF_VERTICES: usize = 1 << 22;
+/// Most triangles a loaded mesh may have, counting each node that instances a mesh once more.
+pub const MAX_GLTF_TRIANGLES: usize = 1 << 22;
+/// Largest glTF or GLB file, and largest external buffer file, that is read, bytes.
+pub const MAX_GLTF_FILE_BYTES: u64 = 256 << 20;
+
+/// The longest URI quoted in a message, characters (a data: URI can be megabytes).
+const QUOTE_CHARS: usize = 60;
+
+impl Mesh {
+    /// Load every triangle primitive of a glTF or GLB file, with node transforms applied, into one
+    /// mesh in the file's frame (metres, +Y up as glTF defines). External buffers are read only
+    /// from the file's own folder and below; `data:` URIs and a GLB's binary chunk are always fine.
+    ///
+    /// # Errors
+    ///
+    /// [`SnowError::MeshFile`] when the file cannot be read or is not a usable glTF (nodes that do
+    /// not form trees, sizes beyond [`MAX_GLTF_NODES`] and the other limits, accessors that do not
+    /// fit their buffers), [`SnowError::MeshUri`] for a URI that leads outside the folder,
+    /// [`SnowError::InvalidMesh`] for out-of-range indices or non-finite positions.
+    pub fn load_gltf(path: &Path) -> Result<Mesh> {
+        let folder = parent_folder(path);
+        Self::load_gltf_within(path, &folder)
+    }
+
+    /// As [`Mesh::load_gltf`], but the file and every external file it names must lie under
+    /// `root` (for a scene: the scene file's folder), after `..` and symbolic links are followed.
+    ///
+    /// # Errors
+    ///
+    /// As [`Mesh::load_gltf`]; also [`SnowError::MeshFile`] when `path` itself is outside `root`.
+    pub fn load_gltf_within(path: &Path, root: &Path) -> Result<Mesh> {
+        let err = |reason: String| SnowError::MeshFile {
+            path: path.to_owned(),
+            reason,
+        };
+        let canonical_root = canonical_folder(root).map_err(|e| {
+            err(format!(
+                "its allowed folder {} cannot be opened ({e}); check that the folder exists",
+                root.display()
+            ))
+        })?;
+        let canonical = path.canonicalize().map_err(|e| {
+            err(format!(
+                "cannot be opened ({e}); check the path and that the file exists"
+            ))
+        })?;
+        if !canonical.starts_with(&canonical_root) {
+            return Err(err(format!(
+                "lies outside {}, the only folder meshes may be read from here; move the file into that folder",
+                canonical_root.display()
+            )));
+        }
+        let bytes = read_bounded(&canonical).map_err(err)?;
+        let folder = parent_folder(&canonical);
+        parse(&bytes, path, Some((&folder, &canonical_root)))
+    }
+
+    /// Load a glTF or GLB file given as bytes. `name` names it in messages. `files` is `None` to read
+    /// no file at all (only `data:` URIs and a GLB's binary chunk), or `(folder, root)`: relative
+    /// URIs are resolved against `folder` and must lead to files under `root`.
+    ///
+    /// # Errors
+    ///
+    /// As [`Mesh::load_gltf`].
+    pub fn from_gltf_slice(
+        bytes: &[u8],
+        name: &Path,
+        files: Option<(&Path, &Path)>,
+    ) -> Result<Mesh> {
+        match files {
+            None => parse(bytes, name, None),
+            Some((folder, root)) => {
+                let root = canonical_folder(root).map_err(|e| SnowError::MeshFile {
+                    path: name.to_owned(),
+                    reason: format!(
+                        "its allowed folder {} cannot be opened ({e}); check that the folder exists",
+                        root.display()
+                    ),
+                })?;
+                parse(bytes, name, Some((folder, &root)))
+            }
+        }
+    }
+}
+
+/// The folder of a file, `.` for a bare file name.
+fn parent_folder(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    }
+}
+
+fn canonical_folder(root: &Path) -> std::io::Result<PathBuf> {
+    if root.as_os_str().is_empty() {
+        Path::new(".").canonicalize()
+    } else {
+        root.canonicalize()
+    }
+}
+
+/// A whole file, refused beyond [`MAX_GLTF_FILE_BYTES`].
+fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, String> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| format!("cannot be opened ({e}); check the path and its permissions"))?;
+    let meta = file
+        .metadata()
+        .map_err(|e| format!("cannot be read ({e}); check the path and its permissions"))?;
+    if !meta.is_file() {
+        return Err("is not a file; give the path of a glTF (.gltf) or GLB (.glb) file".into());
+    }
+    if meta.len() > MAX_GLTF_FILE_BYTES {
+        return Err(format!(
+            "is {} bytes, more than the {MAX_GLTF_FILE_BYTES} bytes a mesh file may have; simplify the mesh",
+            meta.len()
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(MAX_GLTF_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot be read ({e}); check the file"))?;
+    if bytes.len() as u64 > MAX_GLTF_FILE_BYTES {
+        return Err(format!(
+            "is more than the {MAX_GLTF_FILE_BYTES} bytes a mesh file may have; simplify the mesh"
+        ));
+    }
+    Ok(bytes)
+}
+
+/// A URI shortened for a message.
+fn quote_uri(uri: &str) -> String {
+    if uri.chars().count() > QUOTE_CHARS {
+        let cut: String = uri.chars().take(QUOTE_CHARS - 3).collect();
+        format!("{cut}...")
+    } else {
+        uri.to_owned()
+    }
+}
+
+/// Why a URI cannot be followed: (what is wrong, what to do).
+type UriRefusal = (String, String);
+
+const EMBED_OR_BESIDE: &str =
+    "embed the data as a data: URI, or put the file in the mesh's folder and give a relative uri";
+
+/// Bytes of a `data:` URI (base64 only, as glTF writes them).
+fn data_uri(uri: &str) -> std::result::Result<Vec<u8>, UriRefusal> {
+    let rest = &uri["data:".len()..];
+    let Some(comma) = rest.find(',') else {
+        return Err((
+            "is a data: URI without a comma before its data".into(),
+            "write it as data:application/octet-stream;base64,<data>".into(),
+        ));
+    };
+    if !rest[..comma].ends_with(";base64") {
+        return Err((
+            "is a data: URI that is not base64".into(),
+            "write it as data:application/octet-stream;base64,<data>".into(),
+        ));
+    }
+    decode_base64(&rest[comma + 1..]).ok_or_else(|| {
+        (
+            "is a data: URI whose base64 data is not valid".into(),
+            "re-export the file, or check that the data was not cut or altered".into(),
+        )
+    })
+}
+
+/// Standard base64 with optional padding; ASCII whitespace is skipped.
+fn decode_base64(text: &str) -> Option<Vec<u8>> {
+    let mut out = Vec::with_capacity(text.len() / 4 * 3);
+    let (mut acc, mut bits) = (0u32, 0u32);
+    let mut padding = 0;
+    for b in text.bytes() {
+        let v = match b {
+            b'A'..=b'Z' => b - b'A',
+            b'a'..=b'z' => b - b'a' + 26,
+            b'0'..=b'9' => b - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            b'=' => {
+                padding += 1;
+                continue;
+            }
+            b if b.is_ascii_whitespace() => continue,
+            _ => return None,
+        };
+        if padding > 0 {
+            return None;
+        }
+        acc = (acc << 6) | u32::from(v);
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    (padding <= 2).then_some(out)
+}
+
+/// `%XX` escapes decoded (glTF URIs are URI references).
+fn percent_decode(uri: &str) -> Option<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// The file a relative URI names, checked to lie under `root` (canonical).
+fn resolve_file(uri: &str, folder: &Path, root: &Path) -> std::result::Result<PathBuf, UriRefusal> {
+    let decoded = percent_decode(uri).ok_or_else(|| {
+        (
+            "has a malformed %-escape or is not UTF-8".to_owned(),
+            "write it as a relative path with %XX escapes".to_owned(),
+        )
+    })?;
+    if decoded.is_empty() || decoded.contains('\0') {
+        return Err((
+            "is empty or holds a NUL character".into(),
+            EMBED_OR_BESIDE.into(),
+        ));
+    }
+    let as_path = Path::new(&decoded);
+    let absolute = decoded.starts_with('/')
+        || decoded.starts_with('\\')
+        || as_path.is_absolute()
+        || as_path
+            .components()
+            .any(|c| matches!(c, Component::Prefix(_) | Component::RootDir));
+    if absolute {
+        return Err((
+            "is an absolute path, and a mesh may read only files under its allowed folder".into(),
+            EMBED_OR_BESIDE.into(),
+        ));
+    }
+    let joined = folder.join(as_path);
+    let canonical = joined.canonicalize().map_err(|e| {
+        (
+            format!("names {}, which cannot be opened ({e})", joined.display()),
+            "put the file there or fix the uri".to_owned(),
+        )
+    })?;
+    if !canonical.starts_with(root) {
+        return Err((
+            format!(
+                "leads to {}, outside {}, the only folder this mesh may read from",
+                canonical.display(),
+                root.display()
+            ),
+            EMBED_OR_BESIDE.into(),
+        ));
+    }
+    Ok(canonical)
+}
+
+/// A URI that has a scheme (`file:`, `http:`), as opposed to a relative reference.
+fn scheme(uri: &str) -> Option<&str> {
+    let colon = uri.find(':')?;
+    let head = &uri[..colon];
+    let is_scheme = head.len() > 1
+        && head.starts_with(|c: char| c.is_ascii_alphabetic())
+        && head
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'));
+    is_scheme.then_some(head)
+}
+
+/// Check (and for buffers, read) one URI.
+fn follow_uri(
+    uri: &str,
+    files: Option<(&Path, &Path)>,
+    read: bool,
+) -> std::result::Result<Option<Vec<u8>>, UriRefusal> {
+    if uri.starts_with("data:") {
+        return if read {
+            data_uri(uri).map(Some)
+        } else {
+            Ok(None)
+        };
+    }
+    if let Some(s) = scheme(uri) {
+        return Err((
+            format!("has the scheme {s}:, and only relative paths and data: URIs are read"),
+            EMBED_OR_BESIDE.into(),
+        ));
+    }
+    let Some((folder, root)) = files else {
+        return Err((
+            "names a file, and this mesh was given as bytes with no folder to read files from"
+                .into(),
+            "embed the data as a data: URI or a GLB binary chunk".into(),
+        ));
+    };
+    let file = resolve_file(uri, folder, root)?;
+    if !read {
+        return Ok(None);
+    }
+    read_bounded(&file).map(Some).map_err(|reason| {
+        (
+            format!("names {}, which {reason}", file.display()),
+            "fix the file or the uri".to_owned(),
+        )
+    })
+}
+
+fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mesh> {
+    let err = |reason: String| SnowError::MeshFile {
+        path: path.to_owned(),
+        reason,
+    };
+    let not_gltf = |e: &dyn std::fmt::Display| {
+        let e = e.to_string();
+        let e = e.split_whitespace().collect::<Vec<_>>().join(" ");
+        err(format!(
+            "is not a valid glTF or GLB file ({e}); export it again as glTF 2.0"
+        ))
+    };
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| not_gltf(&e))?;
+    validate(gltf.document.as_json()).map_err(|e| not_gltf(&e))?;
+    let doc = &gltf.document;
+    let uri_err = |what: String, uri: &str, (problem, fix): UriRefusal| SnowError::MeshUri {
+        path: path.to_owned(),
+        what,
+        uri: quote_uri(uri),
+        problem,
+        fix,
+    };
+
+    // Images are never decoded, but a URI that leads outside the folder is refused all the same:
+    // a file from an untrusted mod that names /etc/passwd is not a mesh to use.
+    // (Read from the JSON: `gltf::Image::source` unwraps, and panics on an image with neither a
+    // uri nor a bufferView, or a bufferView without a mimeType, which validation lets through.)
+    for (i, image) in doc.as_json().images.iter().enumerate() {
+        if let Some(uri) = &image.uri {
+            follow_uri(uri, files, false).map_err(|r| uri_err(format!("image {i}"), uri, r))?;
+        }
+    }
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    let mut total: u64 = 0;
+    for buffer in doc.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
+                err(format!(
+                    "buffer {} has no uri and the file has no GLB binary chunk; give the buffer a uri or save the file as GLB",
+                    buffer.index()
+                ))
+            })?,
+            gltf::buffer::Source::Uri(uri) => follow_uri(uri, files, true)
+                .map_err(|r| uri_err(format!("buffer {}", buffer.index()), uri, r))?
+                .unwrap_or_default(),
+        };
+        if (data.len() as u64) < buffer.length() as u64 {
+            return Err(err(format!(
+                "buffer {} holds {} bytes, fewer than its byteLength {}; fix the byteLength or the data",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            )));
+        }
+        total += data.len() as u64;
+        if total > MAX_GLTF_FILE_BYTES {
+            return Err(err(format!(
+                "has more than {MAX_GLTF_FILE_BYTES} bytes of buffers; simplify the mesh"
+            )));
+        }
+        buffers.push(data);
+    }
+
+    let scene = doc
+        .default_scene()
+        .or_else(|| doc.scenes().next())
+        .ok_or_else(|| err("has no scene; add a scene listing the mesh's nodes".into()))?;
+    check_node_trees(doc).map_err(err)?;
+
+    let mut mesh = Mesh::default();
+    let mut visited = vec![false; doc.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        // Trees were checked, so a node is met twice only when a scene lists it twice or lists a
+        // node and one of its ancestors.
+        let seen = &mut visited[node.index()];
+        if *seen {
+            return Err(err(format!(
+                "scene {} reaches node {} twice (it lists the node, or one of its ancestors, more than once); list each node tree once",
+                scene.index(),
+                node.index()
+            )));
+        }
+        *seen = true;
+        let m = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(gm) = node.mesh() {
+            for prim in gm.primitives() {
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    continue;
+                }
+                let Some(positions) = prim.get(&gltf::Semantic::Positions) else {
+                    continue;
+                };
+                let what = format!("mesh {} primitive {}", gm.index(), prim.index());
+                let pos = read_positions(&positions, &buffers)
+                    .map_err(|e| err(format!("{what}: its POSITION accessor {e}")))?;
+                let n = pos.len();
+                let indices = match prim.indices() {
+                    Some(a) => read_indices(&a, &buffers)
+                        .map_err(|e| err(format!("{what}: its index accessor {e}")))?,
+                    None => (0..n as u32).collect(),
+                };
+                if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
+                    return Err(err(format!(
+                        "{what} has index {i}, out of range for its {n} vertices; fix the indices"
+                    )));
+                }
+                let base = mesh.positions.len();
+                if base + n > MAX_GLTF_VERTICES
+                    || (mesh.indices.len() + indices.len()) / 3 > MAX_GLTF_TRIANGLES
+                {
+                    return Err(err(format!(
+                        "holds more than {MAX_GLTF_VERTICES} vertices or {MAX_GLTF_TRIANGLES} triangles (counting every node that instances a mesh); simplify the mesh"
+                    )));
+                }
+                mesh.positions
+                    .extend(pos.into_iter().map(|p| m.transform_point3(p)));
+                let first = mesh.indices.len();
+                mesh.indices
+                    .extend(indices.into_iter().map(|i| base as u32 + i));
+                // A mirroring transform flips the winding; keep triangles outward-facing.
+                if m.determinant() < 0.0 {
+                    for tri in mesh.indices[first..].chunks_exact_mut(3) {
+                        tri.swap(1, 2);
+                    }
+                }
+            }
+        }
+        stack.extend(node.children().map(|c| (c, m)));
+    }
+    if mesh.indices.is_empty() {
+        return Err(err(
+            "holds no triangles; give it a mesh with a triangle primitive".into(),
+        ));
+    }
+    mesh.validate(&path.display().to_string())?;
+    Ok(mesh)
+}
+
+/// The `gltf` crate's validation, after the check its primitive hook skips: that hook indexes the
+/// accessors with the POSITION attribute unchecked, and panics on an index out of range.
+fn validate(root: &gltf::json::Root) -> std::result::Result<(), String> {
+    use gltf::json::validation::{Checked, Validate};
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = prim
+                .attributes
+                .get(&Checked::Valid(gltf::json::mesh::Semantic::Positions))
+                && a.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "mesh {m} primitive {p} names POSITION accessor {}, but there are {} accessors",
+                    a.value(),
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
+    let mut first = None;
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        if first.is_none() {
+            first = Some(format!("{}: {error}", path()));
+        }
+    });
+    first.map_or(Ok(()), Err)
+}
+
+/// Nodes form trees: no node is its own child or ancestor, none has two parents, none lies deeper
+/// than [`MAX_GLTF_DEPTH`], and there are at most [`MAX_GLTF_NODES`].
+fn check_node_trees(doc: &gltf::Document) -> std::result::Result<(), String> {
+    let n = doc.nodes().len();
+    if n > MAX_GLTF_NODES {
+        return Err(format!(
+            "has {n} nodes, more than the {MAX_GLTF_NODES} a mesh file may have; merge nodes or simplify the file"
+        ));
+    }
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for node in doc.nodes() {
+        let p = node.index();
+        for child in node.children() {
+            let c = child.index();
+            if c == p {
+                return Err(format!(
+                    "node {p} lists itself as its child, a cycle; glTF nodes must form trees, so remove that child"
+                ));
+            }
+            if let Some(q) = parent[c] {
+                return Err(format!(
+                    "node {c} is a child of both node {q} and node {p}; glTF nodes must form trees, so give each node one parent"
+                ));
+            }
+            parent[c] = Some(p);
+        }
+    }
+    // Depth of every node, from its parent chain; `depth[i] == 0` is not yet known.
+    let mut depth = vec![0usize; n];
+    let mut on_path = vec![false; n];
+    let mut path = Vec::new();
+    for start in 0..n {
+        let mut at = start;
+        // Walk up to a node of known depth or a root, stopping at a cycle or too deep a chain.
+        let known = loop {
+            if depth[at] != 0 {
+                break depth[at];
+            }
+            if on_path[at] {
+                return Err(format!(
+                    "node {at} is its own ancestor, a cycle of child links; glTF nodes must form trees, so remove the child link that closes the loop"
+                ));
+            }
+            if path.len() > MAX_GLTF_DEPTH {
+                return Err(format!(
+                    "node {start} lies more than {MAX_GLTF_DEPTH} levels deep; flatten the node hierarchy"
+                ));
+            }
+            on_path[at] = true;
+            path.push(at);
+            match parent[at] {
+                Some(p) => at = p,
+                None => break 0,
+            }
+        };
+        for (k, &node) in path.iter().rev().enumerate() {
+            depth[node] = known + k + 1;
+            on_path[node] = false;
+        }
+        if depth[start] > MAX_GLTF_DEPTH {
+            return Err(format!(
+                "node {start} lies {} levels deep, more than {MAX_GLTF_DEPTH}; flatten the node hierarchy",
+                depth[start]
+            ));
+        }
+        path.clear();
+    }
+    Ok(())
+}
+
+/// Where an accessor's elements lie: the buffer's bytes from the first element, the stride, the
+/// count and the element size.
+struct Elements<'a> {
+    bytes: &'a [u8],
+    stride: usize,
+    count: usize,
+    size: usize,
+}
+
+impl Elements<'_> {
+    fn get(&self, i: usize) -> &[u8] {
+        &self.bytes[i * self.stride..i * self.stride + self.size]
+    }
+}
+
+/// Locate an accessor's elements in its buffer, with every offset checked.
+fn elements<'a>(
+    accessor: &gltf::Accessor<'_>,
+    buffers: &'a [Vec<u8>],
+    size: usize,
+) -> std::result::Result<Elements<'a>, String> {
+    if accessor.sparse().is_some() {
+        return Err(
+            "is sparse, which snowprint does not read; export without sparse accessors".into(),
+        );
+    }
+    let count = accessor.count();
+    if count == 0 {
+        return Err("has count 0; an accessor needs at least one element".into());
+    }
+    let Some(view) = accessor.view() else {
+        return Err("has no bufferView; give it one".into());
+    };
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or("names a buffer that does not exist")?;
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(format!(
+            "has a byteStride of {stride}, less than its element's {size} bytes; fix the byteStride"
+        ));
+    }
+    let view_end = view
+        .offset()
+        .checked_add(view.length())
+        .filter(|&e| e <= buffer.len())
+        .ok_or_else(|| {
+            format!(
+                "has a bufferView (bytes {} to {} of buffer {}) that does not fit its {} bytes; fix the bufferView",
+                view.offset(),
+                view.offset().saturating_add(view.length()),
+                view.buffer().index(),
+                buffer.len()
+            )
+        })?;
+    let start = view.offset().checked_add(accessor.offset());
+    let end = (count - 1)
+        .checked_mul(stride)
+        .and_then(|x| x.checked_add(size))
+        .and_then(|x| x.checked_add(start?));
+    match (start, end) {
+        (Some(start), Some(end)) if end <= view_end => Ok(Elements {
+            bytes: &buffer[start..end],
+            stride,
+            count,
+            size,
+        }),
+        _ => Err(format!(
+            "has {count} elements of {size} bytes at offset {} and stride {stride}, which do not fit its bufferView of {} bytes; fix the count or the offsets",
+            accessor.offset(),
+            view.length()
+        )),
+    }
+}
+
+fn read_positions(
+    accessor: &gltf::Accessor<'_>,
+    buffers: &[Vec<u8>],
+) -> std::result::Result<Vec<Vec3>, String> {
+    use gltf::accessor::{DataType, Dimensions};
+    if accessor.data_type() != DataType::F32 || accessor.dimensions() != Dimensions::Vec3 {
+        return Err(format!(
+            "holds {:?} {:?}, but positions must be VEC3 of FLOAT; export positions as floats",
+            accessor.dimensions(),
+            accessor.data_type()
+        ));
+    }
+    if accessor.count() > MAX_GLTF_VERTICES {
+        return Err(format!(
+            "has {} vertices, more than {MAX_GLTF_VERTICES}; simplify the mesh",
+            accessor.count()
+        ));
+    }
+    let e = elements(accessor, buffers, 12)?;
+    Ok((0..e.count)
+        .map(|i| {
+            let b = e.get(i);
+            let f = |k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
+            Vec3::new(f(0), f(4), f(8))
+        })
+        .collect())
+}
+
+fn read_indices(
+    accessor: &gltf::Accessor<'_>,
+    buffers: &[Vec<u8>],
+) -> std::result::Result<Vec<u32>, String> {
+    use gltf::accessor::{DataType, Dimensions};
+    let size = match accessor.data_type() {
+        DataType::U8 => 1,
+        DataType::U16 => 2,
+        DataType::U32 => 4,
+        other => {
+            return Err(format!(
+                "holds {other:?}, but indices must be unsigned integers; fix the componentType"
+            ));
+        }
+    };
+    if accessor.dimensions() != Dimensions::Scalar {
+        return Err(format!(
+            "holds {:?}, but indices must be SCALAR; fix the type",
+            accessor.dimensions()
+        ));
+    }
+    if accessor.count() / 3 > MAX_GLTF_TRIANGLES {
+        return Err(format!(
+            "has {} indices, more than {} triangles; simplify the mesh",
+            accessor.count(),
+            MAX_GLTF_TRIANGLES
+        ));
+    }
+    if !accessor.count().is_multiple_of(3) {
+        return Err(format!(
+            "has {} indices, not a multiple of 3 as a triangle list needs; fix the count",
+            accessor.count()
+        ));
+    }
+    let e = elements(accessor, buffers, size)?;
+    Ok((0..e.count)
+        .map(|i| {
+            let b = e.get(i);
+            match size {
+                1 => u32::from(b[0]),
+                2 => u32::from(u16::from_le_bytes([b[0], b[1]])),
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            }
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_decodes_known_values() {
+        assert_eq!(decode_base64("TWFu").unwrap(), b"Man");
+        assert_eq!(decode_base64("TWE=").unwrap(), b"Ma");
+        assert_eq!(decode_base64("TQ==").unwrap(), b"M");
+        assert_eq!(decode_base64("").unwrap(), b"");
+        assert!(decode_base64("TQ=a").is_none());
+        assert!(decode_base64("T*==").is_none());
+    }
+
+    #[test]
+    fn uris_with_a_scheme_are_told_from_relative_paths() {
+        assert_eq!(scheme("file:///etc/passwd"), Some("file"));
+        assert_eq!(scheme("http://x/y.bin"), Some("http"));
+        assert_eq!(scheme("mesh.bin"), None);
+        assert_eq!(scheme("a b/c:d.bin"), None);
+        assert_eq!(percent_decode("a%20b.bin").unwrap(), "a b.bin");
+        assert!(percent_decode("a%2").is_none());
+    }
+
+    #[test]
+    fn node_cycles_and_shared_children_are_refused() {
+        let doc = |nodes: &str| {
+            let text = format!(
+                r#"{{"asset":{{"version":"2.0"}},"scenes":[{{"nodes":[0]}}],"nodes":{nodes}}}"#
+            );
+            gltf::Gltf::from_slice(text.as_bytes()).unwrap().document
+        };
+        let e = check_node_trees(&doc(r#"[{"children":[1]},{"children":[0]}]"#)).unwrap_err();
+        assert!(e.contains("own ancestor") && e.contains("cycle"), "{e}");
+        let e = check_node_trees(&doc(r#"[{"children":[0]}]"#)).unwrap_err();
+        assert!(e.contains("node 0 lists itself"), "{e}");
+        let e = check_node_trees(&doc(r#"[{"children":[1,2]},{"children":[2]},{}]"#)).unwrap_err();
+        assert!(e.contains("node 2 is a child of both"), "{e}");
+        assert!(check_node_trees(&doc(r#"[{"children":[1,2]},{"children":[3]},{},{}]"#)).is_ok());
+        // A chain exactly MAX_GLTF_DEPTH deep is fine; one more level is not.
+        let chain = |len: usize| {
+            let nodes: Vec<String> = (0..len)
+                .map(|i| {
+                    if i + 1 < len {
+                        format!(r#"{{"children":[{}]}}"#, i + 1)
+                    } else {
+                        "{}".to_owned()
+                    }
+                })
+                .collect();
+            doc(&format!("[{}]", nodes.join(",")))
+        };
+        assert!(check_node_trees(&chain(MAX_GLTF_DEPTH)).is_ok());
+        let e = check_node_trees(&chain(MAX_GLTF_DEPTH + 1)).unwrap_err();
+        assert!(e.contains("levels deep"), "{e}");
+    }
+}
