@@ -125,7 +125,11 @@ fn bad_scene_is_one_sentence_and_leaves_no_output() {
         .output()
         .expect("run snowprint");
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--dt -1"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--dt") && err.contains("-1 is not above 0"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
