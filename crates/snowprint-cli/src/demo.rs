@@ -251,7 +251,12 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     );
     if t1 > end {
         return Err(format!(
-            "--to {t1}: the action of this demo ends at {end} s; give --to at most {end}"
+            "--to {}: the action of this demo ends at {end} s; give --to at most {end}",
+            if t1 >= 1e6 {
+                format!("{t1:e}")
+            } else {
+                t1.to_string()
+            }
         ));
     }
     if !(t0.is_finite() && t1.is_finite() && t0 >= 0.0 && t1 >= t0) {
