@@ -46,6 +46,7 @@ fn main() -> ExitCode {
                 .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
         )
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .init();
     let cli = Cli::parse();
     let gpu = snowprint::GpuOptions {
@@ -101,10 +102,19 @@ fn quiet_device_select_probe() {
     }
 }
 
-/// Resident memory every 10,000 frames, at `info` level (`SNOWPRINT_LOG=info`): how the soak in
+/// Resident memory every 10,000 frames (or `SNOWPRINT_MEMORY_EVERY`), at `info` level (`SNOWPRINT_LOG=info`): how the soak in
 /// docs/RELIABILITY.md samples a long run.
 pub fn log_memory(frame: u64) {
-    if frame % 10_000 == 0
+    // SNOWPRINT_MEMORY_EVERY changes the interval (the tests sample short runs).
+    static EVERY: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    let every = *EVERY.get_or_init(|| {
+        std::env::var("SNOWPRINT_MEMORY_EVERY")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .filter(|&n| n > 0)
+            .unwrap_or(10_000)
+    });
+    if frame % every == 0
         && let Some(kib) = resident_kib()
     {
         tracing::info!("frame {frame}: resident memory {kib} KiB");

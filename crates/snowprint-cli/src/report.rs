@@ -30,6 +30,7 @@ impl Summary {
     pub fn push(&mut self, s: &TickStats) {
         if self.width == 0 {
             self.width = 1;
+            self.buckets.reserve_exact(MAX_BUCKETS + 1);
         }
         match self.buckets.last_mut() {
             Some(last) if self.last_count < self.width => {
@@ -44,18 +45,20 @@ impl Summary {
             }
         }
         if self.buckets.len() > MAX_BUCKETS {
-            let old = std::mem::take(&mut self.buckets);
-            let full = old.len();
-            for pair in old.chunks(2) {
-                let mut b = pair[0].clone();
-                if let Some(second) = pair.get(1) {
+            // Merge neighbours in place: the vector keeps its capacity, so memory stays put.
+            let n = self.buckets.len();
+            let half = n.div_ceil(2);
+            for i in 0..half {
+                let mut b = std::mem::take(&mut self.buckets[2 * i]);
+                if let Some(second) = self.buckets.get(2 * i + 1) {
                     merge(&mut b, second);
                 }
-                self.buckets.push(b);
+                self.buckets[i] = b;
             }
+            self.buckets.truncate(half);
             // The last bucket was possibly partial; after merging it holds its frames plus a full
             // bucket's, or only its own when it had no partner.
-            self.last_count = if full % 2 == 0 {
+            self.last_count = if n % 2 == 0 {
                 self.width + self.last_count
             } else {
                 self.last_count
