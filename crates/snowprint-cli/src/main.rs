@@ -114,7 +114,7 @@ pub fn log_memory(frame: u64) {
             .filter(|&n| n > 0)
             .unwrap_or(10_000)
     });
-    if frame % every == 0
+    if frame.is_multiple_of(every)
         && let Some(kib) = resident_kib()
     {
         tracing::info!("frame {frame}: resident memory {kib} KiB");

@@ -58,7 +58,7 @@ impl Summary {
             self.buckets.truncate(half);
             // The last bucket was possibly partial; after merging it holds its frames plus a full
             // bucket's, or only its own when it had no partner.
-            self.last_count = if n % 2 == 0 {
+            self.last_count = if n.is_multiple_of(2) {
                 self.width + self.last_count
             } else {
                 self.last_count

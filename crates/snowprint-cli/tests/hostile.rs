@@ -37,8 +37,7 @@ fn answer(cwd: &Path, args: &[String]) -> (bool, String, String) {
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     let line = err
         .lines()
-        .filter(|l| l.starts_with("snowprint:") || l.starts_with("error:"))
-        .last()
+        .rfind(|l| l.starts_with("snowprint:") || l.starts_with("error:"))
         .unwrap_or("")
         .to_owned();
     (out.status.success(), line, err)
