@@ -6,12 +6,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use snowprint::{
     Deformer, GpuContext, GpuOptions, PassMode, PoolFormat, Pose, Precision, Shape, SnowWorld,
     StageTimes, SurfaceDesc, SurfaceUpdate, WorldConfig,
 };
+
+use crate::output::OutputSet;
+use crate::progress::Progress;
 
 /// Arguments of `snowprint bench`.
 #[derive(clap::Args, Debug)]
@@ -19,11 +21,11 @@ pub struct Args {
     /// Folder for `bench.json` and the SVG plots.
     #[arg(long, default_value = "out/bench")]
     pub out: PathBuf,
-    /// Frames measured per configuration (after the warm-up).
-    #[arg(long, default_value_t = 60)]
+    /// Frames measured per configuration (after the warm-up), 1 or more.
+    #[arg(long, default_value_t = 60, allow_negative_numbers = true, value_parser = crate::args::frames)]
     pub frames: u32,
     /// Frames run before measuring.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
     pub warmup: u32,
     /// Small sweeps only (what a software adapter can run in seconds).
     #[arg(long)]
@@ -344,6 +346,18 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
 
 /// Run the sweeps and write the report.
 pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
+    // The output folder is checked (and created) before anything is measured.
+    let mut outputs =
+        OutputSet::prepare(&args.out, "bench", &format!("--out {}", args.out.display()))?;
+    let files = [
+        "bench.json",
+        "bench_surfaces.svg",
+        "bench_resolution.svg",
+        "bench_deformers.svg",
+    ];
+    for name in files {
+        outputs.check_name(name)?;
+    }
     let gpu = GpuContext::new(gpu_options).map_err(|e| e.to_string())?;
     let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
     let quick = args.quick || software;
@@ -416,22 +430,17 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             cfg("many_512", 1024, 512, 1, fused),
         )));
     }
-    let bar = ProgressBar::new(configs.len() as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} bench [{bar:30}] {pos}/{len} {msg}")
-            .map_err(|e| e.to_string())?
-            .progress_chars("=> "),
-    );
+    let mut bar = Progress::new(configs.len() as u64, "bench", "configurations")?;
     let mut rows = Vec::new();
     for c in &configs {
-        bar.set_message(format!(
+        bar.set_message(&format!(
             "{} x {}^2, {} deformers",
             c.surfaces, c.resolution, c.deformers
         ));
         rows.push(measure(&gpu, c, args)?);
         bar.inc(1);
     }
-    bar.finish_and_clear();
+    bar.finish();
 
     println!(
         "adapter: {}\ntimestamps: {}\n",
@@ -484,8 +493,6 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             r.ratio_to_copy
         );
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     // The talk's memory: how many 512^2 surfaces a real 2 MiB pool holds at each precision, and
     // what each precision costs in accuracy against 32 bits on the talk's frame.
     let fits = Precision::ALL
@@ -532,7 +539,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         "rows": rows,
     });
     write(
-        &args.out.join("bench.json"),
+        &outputs.path("bench.json"),
         &serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
     )?;
     for sweep in ["surfaces", "resolution", "deformers"] {
@@ -553,8 +560,9 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
                 ),
             ],
         );
-        write(&args.out.join(format!("bench_{sweep}.svg")), &svg)?;
+        write(&outputs.path(&format!("bench_{sweep}.svg")), &svg)?;
     }
+    outputs.publish()?;
     eprintln!("snowprint: wrote {}", args.out.display());
     Ok(())
 }
@@ -733,10 +741,9 @@ fn precision_errors(gpu: &GpuContext, frames: u32) -> Result<Vec<PrecisionError>
     Ok(out)
 }
 
+/// Write a file of the output set (in its staging folder: the set is published as a whole).
 fn write(path: &Path, text: &str) -> Result<(), String> {
-    let tmp = path.with_extension("partial");
-    std::fs::write(&tmp, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// A log-log line plot as SVG.

@@ -6,8 +6,12 @@ use std::path::Path;
 
 use glam::Vec3;
 use snowprint::manager::city::{self, SurfaceKind};
-use snowprint::manager::{CameraView, ManagerConfig, SnowManager, TickStats, plot};
+use snowprint::manager::{CameraView, ManagerConfig, SnowManager};
 use snowprint::{GpuContext, GpuOptions};
+
+use crate::output::OutputSet;
+use crate::progress::Progress;
+use crate::report::StatsStream;
 
 /// Surfaces and walkers of the city demo.
 pub const SURFACES: usize = 400;
@@ -21,6 +25,10 @@ const MAP_METRES_PER_PIXEL: f32 = 0.1;
 /// Run the city for `frames` frames (default 10 s at 60 Hz) and write `city_report.json`,
 /// `city_pool.svg` and `city_map.png` into `out`.
 pub fn run(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), String> {
+    let mut set = OutputSet::prepare(out, "city", &format!("--out {}", out.display()))?;
+    for name in ["city_report.json", "city_pool.svg", "city_map.png"] {
+        set.check_name(name)?;
+    }
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let frames = frames.unwrap_or(600);
     let dt = 1.0 / 60.0;
@@ -35,44 +43,41 @@ pub fn run(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), Stri
                 .map_err(|e| e.to_string())?,
         );
     }
-    let bar = crate::simulate::frame_bar(frames, "city")?;
-    let mut stats: Vec<TickStats> = Vec::new();
+    let mut stream = StatsStream::create(set.path("city_report.json"), set.path("city_pool.svg"))?;
+    let mut progress = Progress::new(frames as u64, "city", "frames")?;
+    let (mut evictions, mut longest_wait, mut resident) = (0, 0, 0);
     for f in 0..frames {
         let t = f as f32 * dt;
         let camera = CameraView::new(&city.player_camera(t), 16.0 / 9.0);
         let deformers = city.deformers(f as u64, dt);
-        stats.push(
-            snow.tick(dt, Some(&camera), &deformers)
-                .map_err(|e| e.to_string())?,
-        );
-        bar.inc(1);
+        let stats = snow
+            .tick(dt, Some(&camera), &deformers)
+            .map_err(|e| format!("city: frame {f} failed: {e}"))?;
+        evictions += stats.evicted.len();
+        longest_wait = longest_wait.max(stats.max_wait_frames);
+        resident = stats.resident;
+        stream.push(&stats)?;
+        crate::log_memory(f as u64 + 1);
+        progress.inc(1);
     }
-    bar.finish_and_clear();
-
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
-    write_atomic(&out.join("city_report.json"), (json + "\n").as_bytes())?;
-    plot::write_svg(
-        &out.join("city_pool.svg"),
-        &stats,
+    progress.finish();
+    stream.finish(
         &format!(
             "city: {} surfaces, {} walkers, {budget} updates a frame, 2 MiB pool",
             city.surfaces.len(),
             city.walkers.len()
         ),
         Some(budget),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     let map = city_map(&snow, &city, &ids)?;
-    write_atomic(&out.join("city_map.png"), &map)?;
-    let last = stats.last();
+    let map_path = set.path("city_map.png");
+    std::fs::write(&map_path, map)
+        .map_err(|e| format!("cannot write {}: {e}", map_path.display()))?;
+    set.publish()?;
     eprintln!(
-        "snowprint: city of {} surfaces and {} walkers, {frames} frames: {} surfaces hold a heightmap at the end, {} evictions, longest wait {} frames; wrote city_report.json, city_pool.svg and city_map.png to {}",
+        "snowprint: city of {} surfaces and {} walkers, {frames} frames: {resident} surfaces hold a heightmap at the end, {evictions} evictions, longest wait {longest_wait} frames; wrote city_report.json, city_pool.svg and city_map.png to {}",
         city.surfaces.len(),
         city.walkers.len(),
-        last.map_or(0, |s| s.resident),
-        stats.iter().map(|s| s.evicted.len()).sum::<usize>(),
-        stats.iter().map(|s| s.max_wait_frames).max().unwrap_or(0),
         out.display()
     );
     Ok(())
@@ -164,10 +169,4 @@ fn city_map(
         w.write_image_data(&rgb).map_err(|e| e.to_string())?;
     }
     Ok(bytes)
-}
-
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let tmp = path.with_extension("partial");
-    std::fs::write(&tmp, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }

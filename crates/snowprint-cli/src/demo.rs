@@ -10,16 +10,18 @@
 //! The world comes from one function, [`build_scene`], returning a [`DemoScene`]: swap it for
 //! another world (the library's `snowprint::demo` once it lands) without touching the rest.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use snowprint::render::{
     DebugView, Environment, Instance, PointLight, RenderConfig, RenderFrame, Renderer, Tier,
 };
 use snowprint::{
     Camera, GpuContext, GpuOptions, GroundMaterial, SnowWorld, SurfaceId, WorldConfig,
 };
+
+use crate::output::OutputSet;
+use crate::progress::Progress;
 
 #[path = "contact_sheet.rs"]
 mod contact_sheet;
@@ -95,12 +97,13 @@ pub struct Args {
     pub out: PathBuf,
     /// Frames to render (default: 240 on a GPU, 60 on a software adapter). One frame shows the end
     /// of the camera's clip.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::frames)]
     pub frames: Option<u32>,
     /// Frame size, WIDTHxHEIGHT (default: 1280x720 on a GPU, 800x450 on a software adapter).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Camera: flythrough, closeup, overview, street, angel, fall or slide.
+    /// Camera: flythrough, overview, closeup, run, fall, angel, slide or fight (the stand-in
+    /// scene has flythrough, closeup, overview, street, angel, fall and slide).
     #[arg(long, default_value = "flythrough")]
     pub camera: String,
     /// Snow tier: relief (the talk's relief mapping), pom (parallax occlusion mapping) or
@@ -108,7 +111,7 @@ pub struct Args {
     #[arg(long, default_value = "relief")]
     pub tier: Tier,
     /// Samples per pixel along each axis, 1 to 4 (default: 2 on a GPU, 1 on a software adapter).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub supersample: Option<u32>,
     /// What the frames show: shaded, materials, depression, occlusion, normals or taps.
     #[arg(long, default_value = "shaded")]
@@ -116,15 +119,16 @@ pub struct Args {
     /// No falling snow.
     #[arg(long)]
     pub no_snowfall: bool,
-    /// Start of the clip, seconds of action (default: the camera's).
-    #[arg(long)]
+    /// Start of the clip, seconds of action (default: the camera's); within the scene's action.
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::moment)]
     pub from: Option<f32>,
-    /// End of the clip, seconds of action (default: the camera's).
-    #[arg(long)]
+    /// End of the clip, seconds of action (default: the camera's); at most the end of the
+    /// scene's action (the simulation runs up to it, so a later end would only cost time).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::moment)]
     pub to: Option<f32>,
     /// Simulation steps per second, whatever the frame count (default: 60 on a GPU, 30 on a
     /// software adapter; deformers are swept between steps, so trails stay continuous).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub sim_hz: Option<u32>,
     /// Which demo: `rooftops` (the library's demo world, rendered), `standin` (the renderer's
     /// small stand-in world, rendered) or `city` (several hundred surfaces under the surface
@@ -159,68 +163,17 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Files written by a run, in the scratch folder until published.
-struct Staging {
-    dir: PathBuf,
-    out: PathBuf,
-    files: Vec<String>,
-}
-
-impl Staging {
-    fn new(out: &Path) -> Result<Self, String> {
-        std::fs::create_dir_all(out)
-            .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-        let dir = out.join(format!(".snowprint-demo-partial-{}", std::process::id()));
-        if dir.exists() {
-            std::fs::remove_dir_all(&dir)
-                .map_err(|e| format!("cannot clear {}: {e}", dir.display()))?;
-        }
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-        Ok(Self {
-            dir,
-            out: out.to_owned(),
-            files: Vec::new(),
-        })
-    }
-
-    fn path(&mut self, name: &str) -> PathBuf {
-        self.files.push(name.to_owned());
-        self.dir.join(name)
-    }
-
-    /// Move everything into the output folder, replacing the outputs of an earlier run; the report
-    /// goes last so that its presence means the run finished.
-    fn publish(mut self) -> Result<Vec<String>, String> {
-        let stale = std::fs::read_dir(&self.out)
-            .map_err(|e| format!("cannot list {}: {e}", self.out.display()))?
-            .filter_map(|e| e.ok())
-            .map(|e| e.file_name().to_string_lossy().into_owned())
-            .filter(|n| {
-                (n.starts_with("frame_") && n.ends_with(".png"))
-                    || ["demo.gif", "demo.mp4", "contact_sheet.png", "report.json"]
-                        .contains(&n.as_str())
-            });
-        for name in stale {
-            let p = self.out.join(&name);
-            std::fs::remove_file(&p).map_err(|e| format!("cannot replace {}: {e}", p.display()))?;
-        }
-        self.files.sort_by_key(|n| n == "report.json");
-        for name in &self.files {
-            let (from, to) = (self.dir.join(name), self.out.join(name));
-            std::fs::rename(&from, &to)
-                .map_err(|e| format!("cannot move {} to {}: {e}", from.display(), to.display()))?;
-        }
-        let _ = std::fs::remove_dir_all(&self.dir);
-        Ok(std::mem::take(&mut self.files))
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        // After a failure (or after publishing) the scratch folder goes.
-        let _ = std::fs::remove_dir_all(&self.dir);
-    }
+/// Outputs of an earlier version that wrote plain files: replaced as a whole by a new set.
+fn legacy_output(name: &str) -> bool {
+    (name.starts_with("frame_") && name.ends_with(".png"))
+        || [
+            "demo.gif",
+            "demo.mp4",
+            "contact_sheet.png",
+            "compare_tiers.png",
+            "report.json",
+        ]
+        .contains(&name)
 }
 
 /// Run the demo and write its outputs.
@@ -229,6 +182,13 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         return crate::city::run(gpu, &args.out, args.frames);
     }
     let wall = Instant::now();
+    // The output folder is checked (and created) before anything runs.
+    let mut staging =
+        OutputSet::prepare(&args.out, "demo", &format!("--out {}", args.out.display()))?
+            .with_legacy(legacy_output);
+    for name in ["demo.gif", "report.json", "contact_sheet.png"] {
+        staging.check_name(name)?;
+    }
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
     let (default_frames, default_size, default_ss) = if software {
@@ -237,9 +197,6 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         (240, (1280, 720), 2)
     };
     let frames = args.frames.unwrap_or(default_frames);
-    if frames == 0 {
-        return Err("--frames 0 renders nothing; give at least 1".into());
-    }
     let (width, height) = args.size.unwrap_or(default_size);
     let supersample = args.supersample.unwrap_or(default_ss);
     let sim_hz = args.sim_hz.unwrap_or(if software { 30 } else { 60 });
@@ -284,6 +241,24 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     if let Some(t) = args.to {
         t1 = t;
     }
+    let (_, end) = scene.span(&args.camera);
+    let end = end.max(
+        scene
+            .cameras()
+            .iter()
+            .map(|c| scene.span(c).1)
+            .fold(0.0, f32::max),
+    );
+    if t1 > end {
+        return Err(format!(
+            "--to {}: the action of this demo ends at {end} s; give --to at most {end}",
+            if t1 >= 1e6 {
+                format!("{t1:e}")
+            } else {
+                t1.to_string()
+            }
+        ));
+    }
     if !(t0.is_finite() && t1.is_finite() && t0 >= 0.0 && t1 >= t0) {
         return Err(format!(
             "--from {t0} / --to {t1}: give 0 <= from <= to seconds"
@@ -299,7 +274,6 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         })
         .collect();
 
-    let mut staging = Staging::new(&args.out)?;
     let sheet_frames = contact_sheet::pick(frames as usize, 6);
     let mut sheet_images = Vec::new();
     let gif_path = staging.path("demo.gif");
@@ -313,14 +287,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let mut gif =
         contact_sheet::GifWriter::create(&gif_path, width, height, delay_ms * gif_every as u32)?;
 
-    let bar = ProgressBar::new(frames as u64);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} {msg:12} [{bar:30}] {pos}/{len} frames, {elapsed} elapsed, about {eta} left",
-        )
-        .map_err(|e| e.to_string())?
-        .progress_chars("=> "),
-    );
+    let mut bar = Progress::new(frames as u64, "demo", "frames")?;
     bar.set_message("simulating");
 
     let mut sim_t = 0.0f32;
@@ -412,19 +379,19 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         .save(&sheet_path)
         .map_err(|e| format!("cannot write {}: {e}", sheet_path.display()))?;
     let mp4 = if frames > 1 {
-        let mp4_path = staging.dir.join("demo.mp4");
         let fps = (1000.0 / delay_ms as f32).round().max(1.0);
-        let made = contact_sheet::encode_mp4(&staging.dir, &mp4_path, fps);
-        if made {
-            staging.files.push("demo.mp4".into());
-        } else {
+        let dir = staging.staging().to_owned();
+        let made = contact_sheet::encode_mp4(&dir, &staging.path("demo.mp4"), fps);
+        if !made {
+            let _ = std::fs::remove_file(dir.join("demo.mp4"));
+            staging.forget("demo.mp4");
             notes.push("ffmpeg is not on the PATH (or failed): no demo.mp4".into());
         }
         made
     } else {
         false
     };
-    bar.finish_and_clear();
+    bar.finish();
 
     let surfaces_json: Vec<serde_json::Value> = scene
         .surfaces()
@@ -472,7 +439,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             ctx.info.name
         ))
     };
-    let mut outputs: Vec<String> = staging.files.clone();
+    let mut outputs: Vec<String> = staging.names().to_vec();
     outputs.push("report.json".into());
     let report = serde_json::json!({
         "adapter": {
@@ -513,7 +480,8 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let report_path = staging.path("report.json");
     std::fs::write(&report_path, text)
         .map_err(|e| format!("cannot write {}: {e}", report_path.display()))?;
-    let files = staging.publish()?;
+    let files = staging.names().len();
+    staging.publish()?;
     eprintln!(
         "snowprint: {} frames of {width}x{height} ({}, camera {}) in {:.0} s on {}: {} files in {}",
         frames,
@@ -521,7 +489,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         args.camera,
         wall.elapsed().as_secs_f64(),
         ctx.info.name,
-        files.len(),
+        files,
         args.out.display()
     );
     Ok(())
@@ -530,6 +498,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
 
     fn args(out: &Path) -> Args {
         Args {
@@ -603,7 +572,8 @@ mod tests {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
         names.sort();
-        names.retain(|n| n != "demo.mp4");
+        // The set's own entries (its generation and the link to it) are hidden.
+        names.retain(|n| n != "demo.mp4" && !n.starts_with(".snowprint-demo-"));
         assert_eq!(
             names,
             [

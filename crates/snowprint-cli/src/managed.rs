@@ -1,11 +1,12 @@
 //! `snowprint simulate --report`: a scene run through the surface manager (budget, pool and
 //! priorities), with its per-frame statistics and a plot.
 
-use std::path::Path;
-
-use snowprint::manager::{CameraView, ManagedDeformer, ManagerConfig, SnowManager, ZoneId, plot};
+use snowprint::manager::{CameraView, ManagedDeformer, ManagerConfig, SnowManager, ZoneId};
 use snowprint::scene::Scene;
-use snowprint::{Deformer, GpuContext, GpuOptions};
+use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap};
+
+use crate::progress::Progress;
+use crate::simulate::{Done, Outputs};
 
 /// Aspect ratio the manager's visibility test assumes for a scene camera.
 const ASPECT: f32 = 16.0 / 9.0;
@@ -33,16 +34,17 @@ pub fn manager_config(scene: &Scene) -> ManagerConfig {
     config
 }
 
-/// Run the scene through a [`SnowManager`] and dump what each surface holds at the end; write the
-/// statistics of every frame to `report` (JSON) and a plot beside it (SVG).
+/// Run the scene through a [`SnowManager`] and dump what each surface holds at the end; stream
+/// the statistics of every frame to the report (JSON) as they come and plot them at the end (SVG).
+/// Nothing is kept per frame: memory stays flat however long the run.
 pub fn simulate(
     gpu: &GpuOptions,
     scene: &Scene,
     frames: u32,
     dt: f32,
-    dump: &Path,
-    report: Option<&Path>,
+    outputs: Outputs,
 ) -> Result<(), String> {
+    let Outputs { dump, mut report } = outputs;
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let config = manager_config(scene);
     let budget = config.updates_per_frame;
@@ -55,67 +57,105 @@ pub fn simulate(
         );
     }
     let shapes = crate::simulate::scene_shapes(scene, |name, mesh| snow.add_mesh(name, mesh))?;
-    let mut stats = Vec::new();
-    let bar = crate::simulate::frame_bar(frames, "simulate (managed)")?;
+    let mut progress = Progress::new(frames as u64, "simulate (managed)", "frames")?;
+    let mut failure = None;
+    let mut frames_done = 0;
+    let mut deformers: Vec<ManagedDeformer> = Vec::with_capacity(scene.deformers.len());
     for f in 1..=frames {
         let t = f as f32 * dt;
-        let deformers: Vec<ManagedDeformer> = scene
-            .deformers
-            .iter()
-            .zip(&shapes)
-            .map(|(d, &shape)| {
-                let deformer = Deformer::moving(shape, d.pose_at(t - dt), d.pose_at(t));
-                if d.player {
-                    ManagedDeformer::player(deformer)
-                } else {
-                    ManagedDeformer::new(deformer)
-                }
-            })
-            .collect();
+        deformers.clear();
+        deformers.extend(scene.deformers.iter().zip(&shapes).map(|(d, &shape)| {
+            let deformer = Deformer::moving(shape, d.pose_at(t - dt), d.pose_at(t));
+            if d.player {
+                ManagedDeformer::player(deformer)
+            } else {
+                ManagedDeformer::new(deformer)
+            }
+        }));
         let camera = scene
             .camera
             .as_ref()
             .map(|c| CameraView::new(&c.at(t), ASPECT));
-        stats.push(
-            snow.tick(dt, camera.as_ref(), &deformers)
-                .map_err(|e| e.to_string())?,
-        );
-        bar.inc(1);
+        match snow.tick(dt, camera.as_ref(), &deformers) {
+            Ok(stats) => {
+                if let Some((_, stream)) = &mut report {
+                    stream.push(&stats)?;
+                }
+            }
+            Err(e) => {
+                failure = Some(crate::simulate::frame_error(scene, f, dt, &e));
+                break;
+            }
+        }
+        frames_done = f;
+        crate::log_memory(f as u64);
+        progress.inc(1);
     }
-    bar.finish_and_clear();
-    // Let the imprints still queued land before reading the heightmaps.
-    snow.flush().map_err(|e| e.to_string())?;
+    progress.finish();
+    if failure.is_none() {
+        // Let the imprints still queued land before reading the heightmaps.
+        if let Err(e) = snow.flush() {
+            failure = Some(format!(
+                "{}: after frame {frames}, landing the imprints still queued failed: {e}",
+                scene.path.display()
+            ));
+        }
+    }
     let merged = snow.planner().imprints_merged();
     if merged > 0 {
         eprintln!(
-            "snowprint: {merged} queued imprints were merged into covering sweeps because a waiting \
-             surface's queue passed queue_cap: those trails are pressed at least as deep as made, \
-             and a little wider"
+            "snowprint: {merged} queued imprints were merged into covering sweeps because a \
+             waiting surface's queue passed queue_cap: those trails are pressed at least as deep as \
+             made, and a little wider"
         );
     }
-    let maps = ids
-        .iter()
-        .map(|&id| snow.read_heightmap(id).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, String>>()?;
-    crate::simulate::write_dump(scene, &maps, frames, dt, dump)?;
-    if let Some(path) = report {
-        let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
-        write_atomic(path, &(json + "\n"))?;
-        let svg = path.with_extension("svg");
-        plot::write_svg(
-            &svg,
-            &stats,
-            &format!("{}: pool use and updates per frame", scene.path.display()),
-            Some(budget),
-        )
-        .map_err(|e| e.to_string())?;
-        eprintln!("snowprint: wrote {} and {}", path.display(), svg.display());
+    let done = Done {
+        frames,
+        frames_done,
+        dt,
+    };
+    let dump_dir = dump.dir().to_owned();
+    let mut written = read_maps(&snow, &ids)
+        .and_then(|maps| crate::simulate::write_dump(scene, &maps, &done, dump));
+    if let Some((set, stream)) = report {
+        let partial = if frames_done < frames {
+            format!(" (partial: {frames_done} of {frames} frames)")
+        } else {
+            String::new()
+        };
+        let title = format!(
+            "{}: pool use and updates per frame{partial}",
+            scene.path.display()
+        );
+        let (json, svg) = (
+            set.dir().join(&set.names()[0]),
+            set.dir().join(&set.names()[1]),
+        );
+        let result = stream
+            .finish(&title, Some(budget))
+            .and_then(|()| set.publish());
+        match (&result, failure.is_none()) {
+            (Ok(()), true) => {
+                eprintln!("snowprint: wrote {} and {}", json.display(), svg.display());
+            }
+            (Ok(()), false) => eprintln!(
+                "snowprint: wrote {} and {} for the {frames_done} frames done (partial)",
+                json.display(),
+                svg.display()
+            ),
+            _ => {}
+        }
+        written = written.and(result);
     }
-    Ok(())
+    match failure {
+        None => written,
+        Some(f) => Err(f + &crate::simulate::partial_note(&done, &dump_dir, written)),
+    }
 }
 
-fn write_atomic(path: &Path, text: &str) -> Result<(), String> {
-    let tmp = path.with_extension("partial");
-    std::fs::write(&tmp, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write {}: {e}", path.display()))
+/// What each surface holds now (resident, paged out, or untouched snow).
+fn read_maps(snow: &SnowManager, ids: &[snowprint::ManagedId]) -> Result<Vec<Heightmap>, String> {
+    ids.iter()
+        .map(|&id| snow.read_heightmap(id).map_err(|e| e.to_string()))
+        .collect()
 }

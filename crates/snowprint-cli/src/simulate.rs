@@ -2,9 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use indicatif::{ProgressBar, ProgressStyle};
 use snowprint::scene::{Scene, SceneShape};
 use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap, Shape, SnowWorld, WorldConfig};
+
+use crate::output::OutputSet;
+use crate::progress::Progress;
 
 /// Arguments of `snowprint simulate`.
 #[derive(clap::Args, Debug)]
@@ -12,13 +14,14 @@ pub struct Args {
     /// Scene file (TOML, see docs/SCENES.md).
     #[arg(long)]
     pub scene: PathBuf,
-    /// Frames to run.
-    #[arg(long)]
+    /// Frames to run (1 or more).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::frames)]
     pub frames: u32,
-    /// Seconds per frame.
-    #[arg(long, default_value_t = 1.0 / 60.0)]
+    /// Seconds per frame (a finite number above 0).
+    #[arg(long, default_value_t = 1.0 / 60.0, allow_negative_numbers = true, value_parser = crate::args::seconds)]
     pub dt: f32,
-    /// Folder for `<surface>.png` (16-bit depression) and `<surface>.json`.
+    /// Folder for `<surface>.png` (16-bit depression) and `<surface>.json`, created with its
+    /// parents; published as a whole when the run ends (see docs/RELIABILITY.md).
     #[arg(long)]
     pub dump: PathBuf,
     /// Run the surface manager (budget, pool, priorities: the scene's `[budget]`, or the talk's
@@ -29,26 +32,124 @@ pub struct Args {
 }
 
 /// Run the scene for the frames asked and write `<surface>.png` and `<surface>.json` into the dump
-/// folder. Files appear only when the whole run succeeded.
+/// folder. Every output path is checked and created before the first frame; the files appear as
+/// one set when the run ends, or, when a frame fails, as the set of the frames done, marked
+/// partial.
 pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
-    if !(args.dt.is_finite() && args.dt > 0.0) {
-        return Err(format!(
-            "--dt {} is not usable; give a finite number of seconds above 0, such as 0.0166",
-            args.dt
-        ));
-    }
     let scene = Scene::load(&args.scene).map_err(|e| e.to_string())?;
-    if args.report.is_some() || scene.budget.is_some() {
-        return crate::managed::simulate(
-            gpu,
-            &scene,
-            args.frames,
-            args.dt,
-            &args.dump,
-            args.report.as_deref(),
+    let managed = args.report.is_some() || scene.budget.is_some();
+    if !managed && let Some(camera) = &scene.camera {
+        eprintln!(
+            "snowprint: note: {}:{}: [camera] only decides what the surface manager counts as visible, and without [budget] or --report every surface is updated every frame, so this run does not use it; add a [budget] table or --report to run under the manager",
+            scene.path.display(),
+            camera.line
         );
     }
-    simulate(gpu, &scene, args.frames, args.dt, &args.dump)
+    let outputs = Outputs::prepare(&scene, &args.dump, args.report.as_deref())?;
+    if managed {
+        return crate::managed::simulate(gpu, &scene, args.frames, args.dt, outputs);
+    }
+    simulate(gpu, &scene, args.frames, args.dt, outputs)
+}
+
+/// The output sets of a run, checked and opened before its first frame.
+pub struct Outputs {
+    /// The dump folder's set.
+    pub dump: OutputSet,
+    /// The report's set (its JSON and plot) and its streamed statistics.
+    pub report: Option<(OutputSet, crate::report::StatsStream)>,
+}
+
+impl Outputs {
+    /// Check and create the dump folder and the report's folder, and start the report file.
+    pub fn prepare(scene: &Scene, dump: &Path, report: Option<&Path>) -> Result<Self, String> {
+        let set = OutputSet::prepare(dump, "dump", &format!("--dump {}", dump.display()))?;
+        for s in &scene.surfaces {
+            for ext in ["png", "json"] {
+                set.check_name(&format!("{}.{ext}", s.name))?;
+            }
+        }
+        let report = match report {
+            None => None,
+            Some(path) => {
+                let what = format!("--report {}", path.display());
+                if path.is_dir() {
+                    return Err(format!(
+                        "{what} is a folder; give a file path such as {}",
+                        path.join("report.json").display()
+                    ));
+                }
+                let (json, svg) = crate::report::file_names(path)?;
+                let dir = path.parent().unwrap_or(Path::new(""));
+                let mut rset = OutputSet::prepare(dir, &crate::output::report_key(path), &what)?;
+                rset.check_name(&svg)?;
+                let same_dir = dir.canonicalize().ok() == set.dir().canonicalize().ok();
+                if same_dir
+                    && let Some(s) = scene.surfaces.iter().find(|s| {
+                        [format!("{}.json", s.name), format!("{}.png", s.name)]
+                            .iter()
+                            .any(|n| *n == json || *n == svg)
+                    })
+                {
+                    return Err(format!(
+                        "{what}: the dump writes a file of that name for surface {:?}; give the report another name",
+                        s.name
+                    ));
+                }
+                let stream = crate::report::StatsStream::create(rset.path(&json), rset.path(&svg))?;
+                Some((rset, stream))
+            }
+        };
+        Ok(Self { dump: set, report })
+    }
+}
+
+/// How far a run got.
+pub struct Done {
+    /// Frames asked for.
+    pub frames: u32,
+    /// Frames run to the end.
+    pub frames_done: u32,
+    /// Seconds per frame.
+    pub dt: f32,
+}
+
+/// One sentence for a frame that failed: the frame, the time, what went wrong and, where it can be
+/// told, the scene line of the deformer or camera at fault.
+pub fn frame_error(scene: &Scene, frame: u32, dt: f32, e: &snowprint::SnowError) -> String {
+    let file = scene.path.display();
+    let culprit = match e {
+        snowprint::SnowError::InvalidDeformer { name, .. } => name
+            .strip_prefix('#')
+            .and_then(|i| i.parse::<usize>().ok())
+            .and_then(|i| scene.deformers.get(i))
+            .or_else(|| scene.deformers.iter().find(|d| &d.name == name))
+            .map(|d| format!(" (deformer {:?}, {file}:{})", d.name, d.line)),
+        snowprint::SnowError::Scene(m) if m.starts_with("camera") => scene
+            .camera
+            .as_ref()
+            .map(|c| format!(" ([camera], {file}:{})", c.line)),
+        _ => None,
+    };
+    let e = e.to_string().replace('#', "deformer #");
+    format!(
+        "{file}: frame {frame} (t = {:.4} s) failed{}: {e}",
+        frame as f32 * dt,
+        culprit.unwrap_or_default()
+    )
+}
+
+/// What to add to a frame's error once the outputs of the frames before it are written.
+pub fn partial_note(done: &Done, dump: &Path, written: Result<(), String>) -> String {
+    match written {
+        Ok(()) => format!(
+            "; the {} frames before it are written to {} and marked partial (\"partial\": true, \"frames_done\": {})",
+            done.frames_done,
+            dump.display(),
+            done.frames_done
+        ),
+        Err(e) => format!("; the frames before it could not be written either ({e})"),
+    }
 }
 
 /// The library shape of each scene deformer, registering meshes through `add_mesh`.
@@ -80,26 +181,13 @@ pub fn scene_shapes(
         .collect()
 }
 
-/// A progress bar over frames.
-pub fn frame_bar(frames: u32, what: &str) -> Result<ProgressBar, String> {
-    let bar = ProgressBar::new(frames as u64);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} frames {{elapsed}}"
-        ))
-        .map_err(|e| e.to_string())?
-        .progress_chars("=> "),
-    );
-    Ok(bar)
-}
-
 /// Run a loaded scene, every surface every frame, and dump its heightmaps.
 pub fn simulate(
     gpu: &GpuOptions,
     scene: &Scene,
     frames: u32,
     dt: f32,
-    dump: &Path,
+    outputs: Outputs,
 ) -> Result<(), String> {
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let pool: u64 = scene
@@ -124,7 +212,9 @@ pub fn simulate(
         ids.push(world.add_surface(s.clone()).map_err(|e| e.to_string())?);
     }
     let shapes = scene_shapes(scene, |name, mesh| world.add_mesh(name, mesh))?;
-    let bar = frame_bar(frames, "simulate")?;
+    let mut progress = Progress::new(frames as u64, "simulate", "frames")?;
+    let mut failure = None;
+    let mut frames_done = 0;
     for f in 1..=frames {
         let t = f as f32 * dt;
         let deformers: Vec<Deformer> = scene
@@ -133,48 +223,41 @@ pub fn simulate(
             .zip(&shapes)
             .map(|(d, &shape)| Deformer::moving(shape, d.pose_at(t - dt), d.pose_at(t)))
             .collect();
-        world.step(dt, &deformers).map_err(|e| e.to_string())?;
-        bar.inc(1);
+        if let Err(e) = world.step(dt, &deformers) {
+            failure = Some(frame_error(scene, f, dt, &e));
+            break;
+        }
+        frames_done = f;
+        crate::log_memory(f as u64);
+        progress.inc(1);
     }
-    bar.finish_and_clear();
-
-    let maps = ids
+    progress.finish();
+    let done = Done {
+        frames,
+        frames_done,
+        dt,
+    };
+    let dump_dir = outputs.dump.dir().to_owned();
+    let written = ids
         .iter()
         .map(|&id| world.read_heightmap(id).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()?;
-    write_dump(scene, &maps, frames, dt, dump)
+        .collect::<Result<Vec<_>, _>>()
+        .and_then(|maps| write_dump(scene, &maps, &done, outputs.dump));
+    match failure {
+        None => written,
+        Some(f) => Err(f + &partial_note(&done, &dump_dir, written)),
+    }
 }
 
-/// Write each surface's heightmap and description into `dump`, through a staging folder so that an
-/// error leaves no output that looks complete.
+/// Write each surface's heightmap and description into the dump's set and publish it.
 pub fn write_dump(
     scene: &Scene,
     maps: &[Heightmap],
-    frames: u32,
-    dt: f32,
-    dump: &Path,
+    done: &Done,
+    mut set: OutputSet,
 ) -> Result<(), String> {
-    std::fs::create_dir_all(dump)
-        .map_err(|e| format!("cannot create the dump folder {}: {e}", dump.display()))?;
-    let staging = dump.join(format!(".snowprint-partial-{}", std::process::id()));
-    let result = write_staged(scene, maps, frames, dt, &staging, dump);
-    let _ = std::fs::remove_dir_all(&staging);
-    result
-}
-
-fn write_staged(
-    scene: &Scene,
-    maps: &[Heightmap],
-    frames: u32,
-    dt: f32,
-    staging: &Path,
-    dump: &Path,
-) -> Result<(), String> {
-    std::fs::create_dir_all(staging)
-        .map_err(|e| format!("cannot write into {}: {e}", dump.display()))?;
-    let mut files: Vec<PathBuf> = Vec::new();
     for (desc, map) in scene.surfaces.iter().zip(maps) {
-        let png = staging.join(format!("{}.png", desc.name));
+        let png = set.path(&format!("{}.png", desc.name));
         map.save_png(&png).map_err(|e| e.to_string())?;
         let layout = desc.layout();
         let meta = serde_json::json!({
@@ -186,24 +269,16 @@ fn write_staged(
             "yaw_degrees": desc.yaw_degrees,
             "snow_depth": desc.snow_depth,
             "replenish_rate": desc.replenish_rate,
-            "frames": frames,
-            "dt": dt,
+            "frames": done.frames,
+            "frames_done": done.frames_done,
+            "partial": done.frames_done < done.frames,
+            "dt": done.dt,
             "png": "16-bit greyscale depression: 0 = untouched, 65535 = pressed to the ground; column 0 = smallest x, row 0 = smallest z, before yaw",
         });
-        let json = staging.join(format!("{}.json", desc.name));
+        let json = set.path(&format!("{}.json", desc.name));
         let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
         std::fs::write(&json, text + "\n")
             .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
-        files.push(png);
-        files.push(json);
     }
-    for f in files {
-        let name = f
-            .file_name()
-            .ok_or("internal: staged file without a name")?;
-        let dest = dump.join(name);
-        std::fs::rename(&f, &dest)
-            .map_err(|e| format!("cannot move {} into place: {e}", dest.display()))?;
-    }
-    Ok(())
+    set.publish()
 }

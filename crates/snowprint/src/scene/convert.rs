@@ -49,6 +49,7 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
     };
 
     let mut names = HashMap::new();
+    let surface_spans: Vec<Range<usize>> = raw.surface.iter().map(Spanned::span).collect();
     let (surfaces, zones): (Vec<SurfaceDesc>, Vec<u32>) = raw
         .surface
         .into_iter()
@@ -90,10 +91,24 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
         }
     }
 
+    let budget_span = raw.budget.as_ref().map(Spanned::span);
+    let pool_span = raw
+        .budget
+        .as_ref()
+        .and_then(|b| b.get_ref().pool_bytes.as_ref().map(Spanned::span));
     let budget = raw
         .budget
         .map(|b| budget(src, b.into_inner()))
         .transpose()?;
+    if let (Some(b), Some(table)) = (&budget, budget_span) {
+        pool_holds_every_surface(
+            src,
+            b,
+            &surfaces,
+            &surface_spans,
+            pool_span.unwrap_or(table),
+        )?;
+    }
     let camera = raw
         .camera
         .map(|c| camera(src, c.span(), c.into_inner()))
@@ -186,6 +201,56 @@ fn budget(src: &Source<'_>, b: RawBudget) -> Result<SceneBudget> {
     })
 }
 
+/// The surface manager's pool must hold the largest surface on its own, or that surface could
+/// never be updated: known from the file alone, so refused here rather than at some frame.
+fn pool_holds_every_surface(
+    src: &Source<'_>,
+    b: &SceneBudget,
+    surfaces: &[SurfaceDesc],
+    spans: &[Range<usize>],
+    at: Range<usize>,
+) -> Result<()> {
+    let defaults = crate::manager::ManagerConfig::default();
+    let mut format = defaults.format;
+    if let Some(p) = b.precision {
+        format.precision = p;
+    }
+    let pool = b.pool_bytes.unwrap_or(defaults.pool_bytes);
+    let largest = surfaces
+        .iter()
+        .zip(spans)
+        .map(|(s, span)| {
+            let l = s.layout();
+            (format.slot_bytes(l.width, l.height), s, span)
+        })
+        .max_by_key(|(bytes, _, _)| *bytes);
+    if let Some((needed, s, span)) = largest
+        && needed > pool
+    {
+        let l = s.layout();
+        let written = if b.pool_bytes.is_some() {
+            format!("pool_bytes = {pool}")
+        } else {
+            format!("the default pool of {pool} bytes")
+        };
+        return Err(src.error(
+            &at,
+            format!(
+                "[budget] has {written}, but surface {:?} (line {}, {} x {} texels) needs {needed} bytes of the pool at {} bits",
+                s.name,
+                src.line(span.start),
+                l.width,
+                l.height,
+                format.precision.bits()
+            ),
+            format!(
+                "set pool_bytes to at least {needed}, use fewer precision_bits, or make the surface smaller"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn camera(src: &Source<'_>, table: Range<usize>, c: RawCamera) -> Result<SceneCamera> {
     let target = required(
         src,
@@ -270,7 +335,32 @@ fn camera(src: &Source<'_>, table: Range<usize>, c: RawCamera) -> Result<SceneCa
                 "list the camera keys in strictly increasing time",
             ));
         }
-        out.push((t, Vec3::from(eye)));
+        let eye = Vec3::from(eye);
+        let target = Vec3::from(target);
+        if (eye - target).length() <= EYE_CLEARANCE {
+            return Err(src.error(
+                &span,
+                format!(
+                    "the camera key at t = {t} has its eye at {:?}, on the target {:?}, so it looks nowhere",
+                    eye.to_array(),
+                    target.to_array()
+                ),
+                "move the eye away from the target (or the target away from the eye)",
+            ));
+        }
+        if let Some(&(prev_t, prev_eye)) = out.last()
+            && segment_distance(prev_eye, eye, target) <= EYE_CLEARANCE
+        {
+            return Err(src.error(
+                &span,
+                format!(
+                    "the camera's eye passes through its target {:?} between the keys at t = {prev_t} and t = {t}, where it looks nowhere",
+                    target.to_array()
+                ),
+                "add a key that takes the eye around the target, or move the target",
+            ));
+        }
+        out.push((t, eye));
     }
     if out.is_empty() {
         return Err(src.error(
@@ -283,7 +373,23 @@ fn camera(src: &Source<'_>, table: Range<usize>, c: RawCamera) -> Result<SceneCa
         keys: out,
         target: Vec3::from(target),
         fov_y_degrees,
+        line: src.line(table.start),
     })
+}
+
+/// How close the eye may come to the target, metres: nearer, the view direction is lost.
+const EYE_CLEARANCE: f32 = 1e-3;
+
+/// Distance from `p` to the segment `a`-`b`.
+fn segment_distance(a: Vec3, b: Vec3, p: Vec3) -> f32 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let f = if len2 > 0.0 {
+        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * f - p).length()
 }
 
 /// The value as an `f32`, if it stays finite.
@@ -417,6 +523,9 @@ fn capture(src: &Source<'_>, c: RawCapture) -> Result<CaptureConfig> {
     Ok(out)
 }
 
+/// Longest surface name, bytes: `<name>.json` must fit the 255 bytes of a file name.
+const MAX_NAME_BYTES: usize = 250;
+
 /// Why a surface name cannot be a file name, if it cannot.
 fn file_name_problem(name: &str) -> Option<String> {
     if name.is_empty() {
@@ -430,6 +539,13 @@ fn file_name_problem(name: &str) -> Option<String> {
     }
     if name.chars().all(|c| c == '.') {
         return Some("it is only dots".into());
+    }
+    // Outputs are `<name>.json` and `<name>.png`, and most file systems stop at 255 bytes.
+    if name.len() > MAX_NAME_BYTES {
+        return Some(format!(
+            "it has {} characters, and a file name of at most 255 leaves {MAX_NAME_BYTES} for it before \".json\"",
+            name.len()
+        ));
     }
     None
 }
@@ -456,7 +572,7 @@ fn surface(
                 "surface name {} cannot be used as a file name ({problem})",
                 src.quote(&name.span())
             ),
-            "use only letters, digits, \"_\", \"-\" and \".\"",
+            "use at most 250 letters, digits, \"_\", \"-\" and \".\"",
         ));
     }
     unique(src, names, &name, "surface")?;
@@ -590,6 +706,7 @@ fn deformer(
     names: &mut HashMap<String, usize>,
 ) -> Result<SceneDeformer> {
     let table = d.span();
+    let line = src.line(table.start);
     let d = d.into_inner();
     let name = required(
         src,
@@ -782,6 +899,7 @@ fn deformer(
         shape,
         keys,
         player: d.player.is_some_and(|p| *p.get_ref()),
+        line,
     })
 }
 

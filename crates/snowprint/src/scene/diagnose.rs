@@ -134,6 +134,23 @@ fn expectation(key: &str) -> Option<(&'static str, &'static str)> {
             "a list of [[deformer]] tables",
             "[[deformer]] (two brackets) above the keys of each deformer",
         ),
+        "budget" => (
+            "a table",
+            "a line [budget] followed by lines such as updates_per_frame = 2",
+        ),
+        "camera" => (
+            "a table",
+            "a line [camera] followed by target = [x, y, z] and keys = [{ t = 0.0, eye = [x, y, z] }]",
+        ),
+        "updates_per_frame" => ("a whole number of surfaces", "updates_per_frame = 2"),
+        "pool_bytes" => ("a whole number of bytes", "pool_bytes = 2097152"),
+        "active_distance" => ("a number of metres", "active_distance = 40.0"),
+        "precision_bits" => ("the whole number 8, 16 or 32", "precision_bits = 16"),
+        "zone" => ("a whole number", "zone = 1"),
+        "player" => ("true or false", "player = true"),
+        "target" => ("an array of 3 numbers", "target = [0.0, 6.0, 0.0]"),
+        "fov_y_degrees" => ("a number of degrees", "fov_y_degrees = 50.0"),
+        "eye" => ("an array of 3 numbers", "eye = [-12.0, 14.0, -12.0]"),
         "mode" => ("a string", "mode = \"depth\" or mode = \"mask\""),
         "ankle_height" => ("a number of metres", "ankle_height = 0.25"),
         "mask_depth" => ("a number", "mask_depth = 1.0"),
@@ -300,6 +317,25 @@ pub(super) fn toml_error(src: &Source<'_>, e: &toml::de::Error) -> SnowError {
             format!("the table here has no \"{key}\""),
             format!("add {key} = ... (see docs/SCENES.md)"),
         );
+    }
+
+    if msg.starts_with("invalid length") {
+        // A table written as an array (`budget = []`): serde speaks of "struct RawBudget with 4
+        // elements", which means nothing to the user.
+        if let Some(at) = src.key_before(span.start)
+            && let Some((want, example)) = expectation(&at.key)
+            && want == "a table"
+        {
+            let key = &at.key;
+            return src.error_at_line(
+                line,
+                format!(
+                    "{key} = {} is not {want} (found an array)",
+                    src.quote(&span)
+                ),
+                format!("write it as {example}"),
+            );
+        }
     }
 
     if msg.starts_with("invalid value") || msg.starts_with("invalid length") {

@@ -41,6 +41,11 @@ use crate::world::CaptureConfig;
 /// The only scene file version this library reads (the file's `version` key).
 pub const SCENE_VERSION: u32 = 1;
 
+/// The largest scene file read, bytes (4 MiB, about 90,000 deformer keys). Parsing keeps every
+/// value with its position for messages, some 2 KiB a key, so the limit keeps a hostile or
+/// runaway file from taking gigabytes; it is checked before parsing.
+pub const MAX_SCENE_BYTES: u64 = 4 << 20;
+
 /// A loaded scene: everything a simulation needs, checked and with meshes loaded.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
@@ -82,6 +87,8 @@ pub struct SceneCamera {
     pub target: Vec3,
     /// Vertical field of view, degrees.
     pub fov_y_degrees: f32,
+    /// Line of the `[camera]` table in the scene file (for messages; 0 when built by hand).
+    pub line: usize,
 }
 
 impl SceneCamera {
@@ -116,6 +123,8 @@ pub struct SceneDeformer {
     pub keys: Vec<Key>,
     /// Whether it is the player (`player = true`): the manager updates the player's surface first.
     pub player: bool,
+    /// Line of its `[[deformer]]` table in the scene file (for messages; 0 when built by hand).
+    pub line: usize,
 }
 
 /// The geometry of a scene deformer, in its own frame.
@@ -233,12 +242,31 @@ impl Scene {
     /// the file cannot be read, is not valid TOML, breaks a rule of the format, or names a mesh
     /// file that is missing or unusable.
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
+        use std::io::Read as _;
+        let unreadable = |e: std::io::Error| {
             SnowError::Scene(format!(
                 "{}: the scene file cannot be read ({e}); check the path and that it is a UTF-8 text file",
                 path.display()
             ))
-        })?;
+        };
+        let file = std::fs::File::open(path).map_err(unreadable)?;
+        if let Ok(meta) = file.metadata() {
+            if meta.is_dir() {
+                return Err(SnowError::Scene(format!(
+                    "{}: this is a folder, not a scene file; give the path of a .toml scene file",
+                    path.display()
+                )));
+            }
+            check_size(meta.len(), path)?;
+        }
+        // Read at most one byte past the limit, whatever the metadata said (a pipe, a growing file).
+        let mut bytes = Vec::new();
+        file.take(MAX_SCENE_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(unreadable)?;
+        check_size(bytes.len() as u64, path)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|e| unreadable(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
         Self::parse(&text, path)
     }
 
@@ -249,6 +277,7 @@ impl Scene {
     ///
     /// As [`Scene::load`], except for reading the scene file itself.
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
+        check_size(text.len() as u64, path)?;
         let src = diagnose::Source::new(text, path);
         let raw: raw::RawScene =
             toml::from_str(text).map_err(|e| diagnose::toml_error(&src, &e))?;
@@ -265,6 +294,18 @@ impl Scene {
             .map(SceneDeformer::end_time)
             .fold(0.0, f32::max)
     }
+}
+
+/// Refuse a scene file over [`MAX_SCENE_BYTES`].
+fn check_size(bytes: u64, path: &Path) -> Result<()> {
+    if bytes > MAX_SCENE_BYTES {
+        return Err(SnowError::Scene(format!(
+            "{}: the scene file is {} bytes or more, but a scene may have at most {MAX_SCENE_BYTES} bytes (4 MiB, about 90,000 deformer keys); use fewer keys (a key every few frames is enough, poses are interpolated)",
+            path.display(),
+            bytes
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -285,6 +326,7 @@ mod tests {
             shape: SceneShape::Sphere { radius: 0.1 },
             keys,
             player: false,
+            line: 0,
         }
     }
 

@@ -136,7 +136,12 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
     ("in a deformer key", &["t", "position", "rotation_degrees"]),
     (
         "in [budget]",
-        &["updates_per_frame", "pool_bytes", "active_distance"],
+        &[
+            "updates_per_frame",
+            "pool_bytes",
+            "active_distance",
+            "precision_bits",
+        ],
     ),
     ("in [camera]", &["target", "fov_y_degrees", "keys"]),
     ("in a camera key", &["t", "eye"]),
