@@ -7,6 +7,7 @@ mod args;
 mod bench;
 mod city;
 mod demo;
+mod inspect;
 mod managed;
 mod output;
 mod progress;
@@ -36,6 +37,8 @@ enum Command {
     Demo(demo::Args),
     /// Measure the deformation update per stage on the GPU, against a copy of the same bytes.
     Bench(bench::Args),
+    /// Print what a save file holds (settings, clock, sections, surfaces), checking it whole.
+    Inspect(inspect::Args),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&gpu, &args),
         Command::Demo(args) => demo::run(&gpu, &args),
         Command::Bench(args) => bench::run(&gpu, &args),
+        Command::Inspect(args) => inspect::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

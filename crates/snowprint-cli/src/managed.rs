@@ -1,7 +1,11 @@
 //! `snowprint simulate --report`: a scene run through the surface manager (budget, pool and
 //! priorities), with its per-frame statistics and a plot.
 
-use snowprint::manager::{CameraView, ManagedDeformer, ManagerConfig, SnowManager, ZoneId};
+use std::path::{Path, PathBuf};
+
+use snowprint::manager::{
+    CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, ZoneId,
+};
 use snowprint::scene::Scene;
 use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap};
 
@@ -34,6 +38,71 @@ pub fn manager_config(scene: &Scene) -> ManagerConfig {
     config
 }
 
+/// Where a managed run's state comes from and goes to.
+pub struct Persist {
+    /// Save the state after the last frame here.
+    pub save: Option<PathBuf>,
+    /// Start from this save instead of fresh snow.
+    pub load: Option<PathBuf>,
+}
+
+/// The manager for a run: loaded from a save (checked against the scene), or fresh with the
+/// scene's surfaces. Returns it with the handles of the scene's surfaces, in scene order.
+fn start(
+    ctx: &GpuContext,
+    scene: &Scene,
+    config: ManagerConfig,
+    load: Option<&Path>,
+) -> Result<(SnowManager, Vec<ManagedId>), String> {
+    let Some(path) = load else {
+        let mut snow = SnowManager::new(ctx, config).map_err(|e| e.to_string())?;
+        let mut ids = Vec::new();
+        for (desc, &zone) in scene.surfaces.iter().zip(&scene.zones) {
+            ids.push(
+                snow.add_surface(desc.clone(), ZoneId(zone))
+                    .map_err(|e| e.to_string())?,
+            );
+        }
+        return Ok((snow, ids));
+    };
+    let snow = SnowManager::load(ctx, path).map_err(|e| e.to_string())?;
+    let saved: Vec<(ManagedId, String)> = snow
+        .surface_names()
+        .map(|(id, name)| (id, name.to_owned()))
+        .collect();
+    let mut ids = Vec::new();
+    for desc in &scene.surfaces {
+        let found = saved.iter().find(|(_, n)| *n == desc.name).map(|s| s.0);
+        let Some(id) = found else {
+            return Err(format!(
+                "--load {}: the save has no surface {:?} of {}; load it with the scene it was saved from",
+                path.display(),
+                desc.name,
+                scene.path.display()
+            ));
+        };
+        if snow.surface(id).map_err(|e| e.to_string())? != desc {
+            return Err(format!(
+                "--load {}: surface {:?} differs between the save and {}; load it with the scene it was saved from",
+                path.display(),
+                desc.name,
+                scene.path.display()
+            ));
+        }
+        ids.push(id);
+    }
+    if saved.len() != ids.len() {
+        return Err(format!(
+            "--load {}: the save holds {} surfaces, {} has {}; load it with the scene it was saved from",
+            path.display(),
+            saved.len(),
+            scene.path.display(),
+            ids.len()
+        ));
+    }
+    Ok((snow, ids))
+}
+
 /// Run the scene through a [`SnowManager`] and dump what each surface holds at the end; stream
 /// the statistics of every frame to the report (JSON) as they come and plot them at the end (SVG).
 /// Nothing is kept per frame: memory stays flat however long the run.
@@ -43,26 +112,38 @@ pub fn simulate(
     frames: u32,
     dt: f32,
     outputs: Outputs,
+    persist: Persist,
 ) -> Result<(), String> {
     let Outputs { dump, mut report } = outputs;
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
-    let config = manager_config(scene);
-    let budget = config.updates_per_frame;
-    let mut snow = SnowManager::new(&ctx, config).map_err(|e| e.to_string())?;
-    let mut ids = Vec::new();
-    for (desc, &zone) in scene.surfaces.iter().zip(&scene.zones) {
-        ids.push(
-            snow.add_surface(desc.clone(), ZoneId(zone))
-                .map_err(|e| e.to_string())?,
-        );
+    let mut config = manager_config(scene);
+    if scene.budget.is_none() && report.is_none() {
+        // Saving or loading a scene without [budget]: every surface every frame, as a plain run.
+        config.updates_per_frame = snowprint::manager::UNLIMITED;
+        config.pool_bytes = scene
+            .surfaces
+            .iter()
+            .map(|s| {
+                let l = s.layout();
+                config.format.slot_bytes(l.width, l.height)
+            })
+            .sum::<u64>()
+            .max(1 << 20);
     }
-    let shapes = crate::simulate::scene_shapes(scene, |name, mesh| snow.add_mesh(name, mesh))?;
+    let budget = config.updates_per_frame;
+    let (mut snow, ids) = start(&ctx, scene, config, persist.load.as_deref())?;
+    // Frames continue from the save's clock.
+    let first = snow.planner().next_frame();
+    let shapes = crate::simulate::scene_shapes(scene, |name, mesh| match snow.mesh_named(name) {
+        Some(id) if persist.load.is_some() => Ok(id),
+        _ => snow.add_mesh(name, mesh),
+    })?;
     let mut progress = Progress::new(frames as u64, "simulate (managed)", "frames")?;
     let mut failure = None;
     let mut frames_done = 0;
     let mut deformers: Vec<ManagedDeformer> = Vec::with_capacity(scene.deformers.len());
     for f in 1..=frames {
-        let t = f as f32 * dt;
+        let t = (first + f as u64) as f32 * dt;
         deformers.clear();
         deformers.extend(scene.deformers.iter().zip(&shapes).map(|(d, &shape)| {
             let deformer = Deformer::moving(shape, d.pose_at(t - dt), d.pose_at(t));
@@ -92,6 +173,15 @@ pub fn simulate(
         progress.inc(1);
     }
     progress.finish();
+    if failure.is_none()
+        && let Some(path) = &persist.save
+    {
+        // The state after the last frame, queues and all: a run loaded from it continues exactly.
+        match snow.save(path) {
+            Ok(bytes) => eprintln!("snowprint: saved {} ({bytes} bytes)", path.display()),
+            Err(e) => failure = Some(format!("--save {}: {e}", path.display())),
+        }
+    }
     if failure.is_none() {
         // Let the imprints still queued land before reading the heightmaps.
         if let Err(e) = snow.flush() {

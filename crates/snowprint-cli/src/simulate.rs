@@ -29,6 +29,15 @@ pub struct Args {
     /// updates per frame beside it (same name, `.svg`).
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Save the whole snow state after the last frame to this file (imprints still queued
+    /// included; see docs/SAVES.md), written atomically. Runs the surface manager.
+    #[arg(long)]
+    pub save: Option<PathBuf>,
+    /// Continue a run from a save: the surfaces, heightmaps, queues and clock come from the file,
+    /// the deformers and camera from the scene (at the save's time onwards); `--frames` more
+    /// frames are run. The scene's surfaces must be the save's.
+    #[arg(long)]
+    pub load: Option<PathBuf>,
 }
 
 /// Run the scene for the frames asked and write `<surface>.png` and `<surface>.json` into the dump
@@ -37,7 +46,10 @@ pub struct Args {
 /// partial.
 pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let scene = Scene::load(&args.scene).map_err(|e| e.to_string())?;
-    let managed = args.report.is_some() || scene.budget.is_some();
+    let managed = args.report.is_some()
+        || scene.budget.is_some()
+        || args.save.is_some()
+        || args.load.is_some();
     if !managed && let Some(camera) = &scene.camera {
         eprintln!(
             "snowprint: note: {}:{}: [camera] only decides what the surface manager counts as visible, and without [budget] or --report every surface is updated every frame, so this run does not use it; add a [budget] table or --report to run under the manager",
@@ -46,8 +58,15 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         );
     }
     let outputs = Outputs::prepare(&scene, &args.dump, args.report.as_deref())?;
+    if let Some(save) = &args.save {
+        crate::output::check_file_target(save, "--save")?;
+    }
     if managed {
-        return crate::managed::simulate(gpu, &scene, args.frames, args.dt, outputs);
+        let persist = crate::managed::Persist {
+            save: args.save.clone(),
+            load: args.load.clone(),
+        };
+        return crate::managed::simulate(gpu, &scene, args.frames, args.dt, outputs, persist);
     }
     simulate(gpu, &scene, args.frames, args.dt, outputs)
 }
