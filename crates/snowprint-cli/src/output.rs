@@ -317,6 +317,53 @@ pub fn report_key(path: &Path) -> String {
     format!("report-{clean}")
 }
 
+/// Check before the first frame that a single output file (`--save`) can be written: it is not a
+/// folder, its folder exists or can be created, and a file can be made there. The file itself is
+/// written later, atomically (a temporary file beside it, then a rename).
+pub fn check_file_target(path: &Path, what: &str) -> Result<(), String> {
+    let what = format!("{what} {}", path.display());
+    if path.is_dir() {
+        return Err(format!(
+            "{what} is a folder; give a file path such as {}",
+            path.join("snow.save").display()
+        ));
+    }
+    if path.file_name().is_none() {
+        return Err(format!(
+            "{what} names no file; give a file path such as snow.save"
+        ));
+    }
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    for a in dir.ancestors() {
+        if let Ok(meta) = std::fs::metadata(a)
+            && !meta.is_dir()
+        {
+            return Err(format!(
+                "{what}: {} is a file, so the save cannot go inside it; give another path",
+                a.display()
+            ));
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(|e| {
+        format!(
+            "{what}: the folder {} cannot be created ({e}); give a path you can write to",
+            dir.display()
+        )
+    })?;
+    let probe = dir.join(format!("{PREFIX}probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| {
+        format!(
+            "{what}: cannot write into {} ({e}); give a folder you can write to",
+            dir.display()
+        )
+    })?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -417,51 +464,4 @@ mod tests {
         assert!(e.contains("is a file, so"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
-}
-
-/// Check before the first frame that a single output file (`--save`) can be written: it is not a
-/// folder, its folder exists or can be created, and a file can be made there. The file itself is
-/// written later, atomically (a temporary file beside it, then a rename).
-pub fn check_file_target(path: &Path, what: &str) -> Result<(), String> {
-    let what = format!("{what} {}", path.display());
-    if path.is_dir() {
-        return Err(format!(
-            "{what} is a folder; give a file path such as {}",
-            path.join("snow.save").display()
-        ));
-    }
-    if path.file_name().is_none() {
-        return Err(format!(
-            "{what} names no file; give a file path such as snow.save"
-        ));
-    }
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    for a in dir.ancestors() {
-        if let Ok(meta) = std::fs::metadata(a)
-            && !meta.is_dir()
-        {
-            return Err(format!(
-                "{what}: {} is a file, so the save cannot go inside it; give another path",
-                a.display()
-            ));
-        }
-    }
-    std::fs::create_dir_all(dir).map_err(|e| {
-        format!(
-            "{what}: the folder {} cannot be created ({e}); give a path you can write to",
-            dir.display()
-        )
-    })?;
-    let probe = dir.join(format!("{PREFIX}probe-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(|e| {
-        format!(
-            "{what}: cannot write into {} ({e}); give a folder you can write to",
-            dir.display()
-        )
-    })?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
 }
