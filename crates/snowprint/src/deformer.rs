@@ -8,7 +8,8 @@ use crate::mesh::MeshId;
 
 /// Largest size of a deformer, metres: a radius, a capsule's half height, a box's half extent, or a
 /// mesh vertex's distance from the mesh's origin. Up to it the capture places a shape to within
-/// 50 um of its exact surface (`tests/gpu_core.rs`, `huge_shapes_*`); beyond it, the spacing of
+/// 50 um of its exact surface (measured at 1000 m on lavapipe: spheres and boxes within 0.01 um, a
+/// capsule's straight part 26 um; `tests/gpu_core.rs`, `huge_shapes_*`); beyond it, the spacing of
 /// 32-bit floats near the shape's size would move the imprint, so larger shapes are refused.
 pub const MAX_DEFORMER_SIZE: f32 = 1000.0;
 

@@ -1220,40 +1220,78 @@ fn huge_shapes_resting_on_the_snow_are_placed_exactly() {
     let desc = SurfaceDesc::new("yard", [0.0; 3], [2.0, 2.0], 0.3);
     let id = w.add_surface(desc.clone()).unwrap();
     let l = w.layout(id).unwrap();
-    let frustum = 0.3 + ANKLE;
+    let frustum = f64::from(0.3 + ANKLE);
     let gap = 0.1f32;
     for radius in [1.0f32, 30.0, 1000.0] {
         let cy = radius + gap;
-        w.step(
-            0.0,
-            &[Deformer::new(
+        let (r, c) = (f64::from(radius), f64::from(cy));
+        // Lowest point of a round section of radius r centred at height c, at distance d.
+        let round = move |d2: f64| (d2 < r * r).then(|| c - (r * r - d2).sqrt());
+        type Want = Box<dyn Fn(f64, f64) -> Option<f64>>;
+        let cases: [(&str, Shape, Quat, Want, f64); 3] = [
+            (
+                "sphere",
                 Shape::Sphere { radius },
-                Pose::at([0.0, cy, 0.0]),
-            )],
-        )
-        .unwrap();
-        let capture = w.read_last_capture(id).unwrap().expect("captured");
-        let (r, cy) = (f64::from(radius), f64::from(cy));
-        let mut worst = 0.0f64;
-        let mut covered = 0;
-        for row in 0..l.height {
-            for col in 0..l.width {
-                // Texel centres by hand: the surface spans -1..1 m on both axes.
-                let x = -1.0 + (f64::from(col) + 0.5) * 2.0 / f64::from(l.width);
-                let z = -1.0 + (f64::from(row) + 0.5) * 2.0 / f64::from(l.height);
-                let d2 = x * x + z * z;
-                let got = f64::from(capture[(row * l.width + col) as usize]);
-                if d2 >= r * r || cy - (r * r - d2).sqrt() >= f64::from(frustum) {
-                    assert_eq!(got, 1.0, "r {r} texel ({col}, {row}): nothing there");
-                    continue;
+                Quat::IDENTITY,
+                Box::new(move |x, z| round(x * x + z * z)),
+                1e-6,
+            ),
+            (
+                // Laid along x (a quarter about +Z), its straight part longer than the surface:
+                // every texel sees the cylinder, whose section is a circle in (y, z).
+                "capsule",
+                Shape::Capsule {
+                    radius,
+                    half_height: 1.5,
+                },
+                Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
+                Box::new(move |_, z| round(z * z)),
+                50e-6,
+            ),
+            (
+                "box",
+                Shape::Box {
+                    half_extents: Vec3::splat(radius),
+                },
+                Quat::IDENTITY,
+                Box::new(move |_, _| Some(c - r)),
+                50e-6,
+            ),
+        ];
+        for (what, shape, rotation, want, tolerance) in &cases {
+            w.step(
+                0.0,
+                &[Deformer::new(
+                    *shape,
+                    Pose {
+                        position: Vec3::new(0.0, cy, 0.0),
+                        rotation: *rotation,
+                    },
+                )],
+            )
+            .unwrap();
+            let capture = w.read_last_capture(id).unwrap().expect("captured");
+            let mut worst = 0.0f64;
+            let mut covered = 0;
+            for row in 0..l.height {
+                for col in 0..l.width {
+                    // Texel centres by hand: the surface spans -1..1 m on both axes.
+                    let x = -1.0 + (f64::from(col) + 0.5) * 2.0 / f64::from(l.width);
+                    let z = -1.0 + (f64::from(row) + 0.5) * 2.0 / f64::from(l.height);
+                    let got = f64::from(capture[(row * l.width + col) as usize]);
+                    match want(x, z).filter(|&h| h < frustum) {
+                        None => assert_eq!(got, 1.0, "{what} r {r} ({col}, {row}): nothing there"),
+                        Some(h) => {
+                            covered += 1;
+                            worst = worst.max((got * frustum - h).abs());
+                        }
+                    }
                 }
-                covered += 1;
-                let want = cy - (r * r - d2).sqrt();
-                worst = worst.max((got * f64::from(frustum) - want).abs());
             }
+            assert!(covered > 100, "{what} r {r}: {covered} texels");
+            eprintln!("{what} r {r}: worst {worst:e} m");
+            assert!(worst < *tolerance, "{what} r {r}: height off by {worst} m");
         }
-        assert!(covered > 100, "r {r}: {covered} texels");
-        assert!(worst < 1e-6, "r {r}: height off by {worst} m");
     }
 }
 

@@ -132,6 +132,26 @@ fn glb_and_buffers_inside_the_root_still_load() {
         other => panic!("expected MeshUri, got {other:?}"),
     }
     Mesh::load_gltf_within(&dir.join("meshes/up.gltf"), &dir).expect("inside the root");
+    // A scene's mesh path may wander as long as it stays under the scene's folder, and a glTF in a
+    // subfolder may read a buffer beside the scene.
+    let name = dir.file_name().and_then(|n| n.to_str()).expect("temp name");
+    for path in [
+        "meshes/tet.glb".to_owned(),
+        "./meshes/../meshes/tet.glb".to_owned(),
+        format!("../{name}/meshes/tet.glb"),
+        "meshes/up.gltf".to_owned(),
+    ] {
+        let scene = dir.join("scene.toml");
+        std::fs::write(
+            &scene,
+            format!(
+                "version = 1\n[[surface]]\nname = \"yard\"\ncenter = [0, 0, 0]\nsize = [2, 2]\nsnow_depth = 0.3\n\
+                 [[deformer]]\nname = \"boot\"\nshape = \"mesh\"\npath = \"{path}\"\nkeys = [ {{ t = 0, position = [0, 0.1, 0] }} ]\n"
+            ),
+        )
+        .expect("write");
+        Scene::load(&scene).unwrap_or_else(|e| panic!("{path}: {e}"));
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -271,22 +271,49 @@ fn resolve_file(uri: &str, folder: &Path, root: &Path) -> std::result::Result<Pa
             EMBED_OR_BESIDE.into(),
         ));
     }
-    let joined = folder.join(as_path);
-    let canonical = joined.canonicalize().map_err(|e| {
+    let outside = |path: &Path| {
         (
-            format!("names {}, which cannot be opened ({e})", joined.display()),
+            format!(
+                "leads to {}, outside {}, the only folder this mesh may read from",
+                path.display(),
+                root.display()
+            ),
+            EMBED_OR_BESIDE.to_owned(),
+        )
+    };
+    // First without touching the file system: `..` that climbs out of the root is refused whether
+    // or not its target exists, so answers tell nothing about files outside the root.
+    let folder = folder.canonicalize().map_err(|e| {
+        (
+            format!(
+                "is relative to {}, which cannot be opened ({e})",
+                folder.display()
+            ),
+            "check the mesh's folder".to_owned(),
+        )
+    })?;
+    let mut lexical = PathBuf::new();
+    for c in folder.join(as_path).components() {
+        match c {
+            Component::ParentDir => {
+                lexical.pop();
+            }
+            Component::CurDir => {}
+            other => lexical.push(other),
+        }
+    }
+    if !lexical.starts_with(root) {
+        return Err(outside(&lexical));
+    }
+    // Then through the file system: a symbolic link inside the root may still lead out of it.
+    let canonical = lexical.canonicalize().map_err(|e| {
+        (
+            format!("names {}, which cannot be opened ({e})", lexical.display()),
             "put the file there or fix the uri".to_owned(),
         )
     })?;
     if !canonical.starts_with(root) {
-        return Err((
-            format!(
-                "leads to {}, outside {}, the only folder this mesh may read from",
-                canonical.display(),
-                root.display()
-            ),
-            EMBED_OR_BESIDE.into(),
-        ));
+        return Err(outside(&canonical));
     }
     Ok(canonical)
 }

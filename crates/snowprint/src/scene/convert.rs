@@ -920,6 +920,43 @@ fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShap
     } else {
         dir.display().to_string()
     };
+    // A scene may come from an untrusted mod: it and its meshes read only under its own folder.
+    let root = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let outside = || {
+        src.error(
+            &span,
+            format!(
+                "{who} has path {}, which leads outside the scene file's folder ({folder})",
+                src.quote(&span)
+            ),
+            "a scene may read only files under its own folder, so copy the mesh there and give a path relative to the scene",
+        )
+    };
+    // First as written, without asking the file system (so the answer for a path out of the
+    // folder is the same whether its target exists): the path with its `..` resolved on the
+    // folder's canonical form must stay under it.
+    // (A folder that does not exist, as for a scene given as text, is taken as written.)
+    let canonical_root = root
+        .canonicalize()
+        .or_else(|_| std::path::absolute(root))
+        .unwrap_or_else(|_| root.to_path_buf());
+    let mut lexical = canonical_root.clone();
+    for c in Path::new(written.as_str()).components() {
+        match c {
+            std::path::Component::ParentDir => {
+                lexical.pop();
+            }
+            std::path::Component::CurDir => {}
+            other => lexical.push(other),
+        }
+    }
+    if !lexical.starts_with(&canonical_root) {
+        return Err(outside());
+    }
     if !resolved.is_file() {
         let problem = if resolved.exists() {
             "is not a file"
@@ -938,25 +975,12 @@ fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShap
             ),
         ));
     }
-    // A scene may come from an untrusted mod: it and its meshes read only under its own folder.
-    let root = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
-    let inside = match (resolved.canonicalize(), root.canonicalize()) {
-        (Ok(file), Ok(root)) => file.starts_with(root),
-        _ => false,
-    };
+    // Then through the file system: a symbolic link inside the folder may lead out of it.
+    let inside = resolved
+        .canonicalize()
+        .is_ok_and(|file| file.starts_with(&canonical_root));
     if !inside {
-        return Err(src.error(
-            &span,
-            format!(
-                "{who} has path {}, which leads outside the scene file's folder ({folder})",
-                src.quote(&span)
-            ),
-            "a scene may read only files under its own folder, so copy the mesh there and give a path relative to the scene",
-        ));
+        return Err(outside());
     }
     let mesh = Mesh::load_gltf_within(&resolved, root).map_err(|e| {
         if let SnowError::MeshUri {
