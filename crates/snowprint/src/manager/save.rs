@@ -419,7 +419,7 @@ impl SnowManager {
         })?;
         Self::from_save(gpu, file).map_err(|e| SnowError::SaveFile {
             path: path.to_owned(),
-            reason: e.to_string(),
+            reason: one_line(&e.to_string()),
         })
     }
 
@@ -580,6 +580,10 @@ impl SaveFile {
     /// Read and check a save's bytes without a GPU: magic, version, every checksum and length,
     /// the settings and the planner's state. One sentence for the first thing wrong.
     pub fn parse(bytes: &[u8]) -> std::result::Result<Self, String> {
+        Self::parse_inner(bytes).map_err(|e| one_line(&e))
+    }
+
+    fn parse_inner(bytes: &[u8]) -> std::result::Result<Self, String> {
         let mut r = Reader::new(bytes);
         let head = r.take(HEADER, "the header").map_err(|_| {
             format!(
@@ -617,7 +621,15 @@ impl SaveFile {
             let raw = h.u64(&what)?;
             let stored = h.u64(&what)?;
             let crc = h.u32(&what)?;
-            let name = String::from_utf8_lossy(&tag).into_owned();
+            // A damaged tag is shown as hex, so the sentence stays one line of text.
+            let name = if tag.iter().all(u8::is_ascii_alphanumeric) {
+                String::from_utf8_lossy(&tag).into_owned()
+            } else {
+                format!(
+                    "tag {:02x}{:02x}{:02x}{:02x}",
+                    tag[0], tag[1], tag[2], tag[3]
+                )
+            };
             if raw > MAX_SECTION_BYTES {
                 return Err(format!(
                     "section {k} ({name}) claims {raw} bytes, more than {MAX_SECTION_BYTES}"
@@ -794,6 +806,19 @@ fn read_surface(
             words,
         },
     })
+}
+
+/// A message as one line of text: control characters (from damaged names or tags) escaped.
+fn one_line(s: &str) -> String {
+    s.chars()
+        .flat_map(|c| {
+            if c.is_control() {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect()
 }
 
 /// JSON for the text sections, with the error as the library's.
