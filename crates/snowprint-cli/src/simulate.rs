@@ -118,20 +118,27 @@ pub struct Done {
 /// told, the scene line of the deformer or camera at fault.
 pub fn frame_error(scene: &Scene, frame: u32, dt: f32, e: &snowprint::SnowError) -> String {
     let file = scene.path.display();
+    let mut text = e.to_string();
     let culprit = match e {
-        snowprint::SnowError::InvalidDeformer { name, .. } => name
-            .strip_prefix('#')
-            .and_then(|i| i.parse::<usize>().ok())
-            .and_then(|i| scene.deformers.get(i))
-            .or_else(|| scene.deformers.iter().find(|d| &d.name == name))
-            .map(|d| format!(" (deformer {:?}, {file}:{})", d.name, d.line)),
+        snowprint::SnowError::InvalidDeformer { name, .. } => {
+            let by_index = name
+                .strip_prefix('#')
+                .and_then(|i| i.parse::<usize>().ok())
+                .and_then(|i| scene.deformers.get(i));
+            let d = by_index.or_else(|| scene.deformers.iter().find(|d| &d.name == name));
+            if let (Some(d), Some(_)) = (d, by_index) {
+                // The library names deformers of a frame by index: give the scene's name.
+                text = text.replacen(&format!("{name:?}"), &format!("{:?}", d.name), 1);
+            }
+            d.map(|d| format!(" (deformer {:?}, {file}:{})", d.name, d.line))
+        }
         snowprint::SnowError::Scene(m) if m.starts_with("camera") => scene
             .camera
             .as_ref()
             .map(|c| format!(" ([camera], {file}:{})", c.line)),
         _ => None,
     };
-    let e = e.to_string().replace('#', "deformer #");
+    let e = text;
     format!(
         "{file}: frame {frame} (t = {:.4} s) failed{}: {e}",
         frame as f32 * dt,
