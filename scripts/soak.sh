@@ -2,7 +2,8 @@
 # Soak: a managed scene (the rooftops' surfaces under their [budget]) with a player and a sledge
 # that never stop moving, run for FRAMES frames (default 100,000) with resident memory logged every
 # 10,000 frames. Usage: scripts/soak.sh [FRAMES]; BIN names the binary (default
-# target/release/snowprint), WORK the scratch folder. docs/RELIABILITY.md records a run.
+# target/release/snowprint), WORK the scratch folder, REPORT=1 adds --report WORK/report.json.
+# docs/RELIABILITY.md records a run.
 set -euo pipefail
 FRAMES=${1:-100000}
 BIN=${BIN:-target/release/snowprint}
@@ -32,7 +33,8 @@ SECONDS_OF_MOTION=$(( FRAMES / 60 + 2 ))
 } > "$SCENE"
 echo "soak: $FRAMES frames of $SCENE ($(wc -c < "$SCENE") bytes), dump in $WORK/dump" >&2
 start=$(date +%s)
-SNOWPRINT_LOG=info "$BIN" simulate --scene "$SCENE" --frames "$FRAMES" --dump "$WORK/dump" 2>&1 \
+SNOWPRINT_LOG=info "$BIN" simulate --scene "$SCENE" --frames "$FRAMES" --dump "$WORK/dump" \
+  ${REPORT:+--report "$WORK/report.json"} 2>&1 \
   | grep --line-buffered -E 'resident memory|^snowprint: (error|.*failed)' \
-  | sed -E 's/.*(frame [0-9]+: resident memory [0-9]+ KiB).*/\1/'
+  | sed -u -E 's/.*(frame [0-9]+: resident memory [0-9]+ KiB).*/\1/'
 echo "soak: done in $(( $(date +%s) - start )) s" >&2

@@ -3,9 +3,9 @@
 //! Writes into `--out` (default `out/`): numbered frames `frame_0000.png`..., an animation
 //! `demo.gif` (and `demo.mp4` when `ffmpeg` is on the PATH), `contact_sheet.png` of six frames, and
 //! `report.json` (adapter, resolution, frames, tier, camera, per-pass GPU times or why there are
-//! none, and which surfaces were drawn with the basic material). Everything is written to a
-//! scratch folder first and moved into place at the end, the report last: a run that fails leaves
-//! no output that looks complete.
+//! none, and which surfaces were drawn with the basic material). The folder is checked before the
+//! first frame, and everything is written as one output set (`output.rs`): readers see the whole
+//! set of this run or of the one before, and a run that fails leaves the one before untouched.
 //!
 //! The world comes from one function, [`build_scene`], returning a [`DemoScene`]: swap it for
 //! another world (the library's `snowprint::demo` once it lands) without touching the rest.

@@ -137,20 +137,27 @@ pub struct Done {
 /// told, the scene line of the deformer or camera at fault.
 pub fn frame_error(scene: &Scene, frame: u32, dt: f32, e: &snowprint::SnowError) -> String {
     let file = scene.path.display();
+    let mut text = e.to_string();
     let culprit = match e {
-        snowprint::SnowError::InvalidDeformer { name, .. } => name
-            .strip_prefix('#')
-            .and_then(|i| i.parse::<usize>().ok())
-            .and_then(|i| scene.deformers.get(i))
-            .or_else(|| scene.deformers.iter().find(|d| &d.name == name))
-            .map(|d| format!(" (deformer {:?}, {file}:{})", d.name, d.line)),
+        snowprint::SnowError::InvalidDeformer { name, .. } => {
+            let by_index = name
+                .strip_prefix('#')
+                .and_then(|i| i.parse::<usize>().ok())
+                .and_then(|i| scene.deformers.get(i));
+            let d = by_index.or_else(|| scene.deformers.iter().find(|d| &d.name == name));
+            if let (Some(d), Some(_)) = (d, by_index) {
+                // The library names deformers of a frame by index: give the scene's name.
+                text = text.replacen(&format!("{name:?}"), &format!("{:?}", d.name), 1);
+            }
+            d.map(|d| format!(" (deformer {:?}, {file}:{})", d.name, d.line))
+        }
         snowprint::SnowError::Scene(m) if m.starts_with("camera") => scene
             .camera
             .as_ref()
             .map(|c| format!(" ([camera], {file}:{})", c.line)),
         _ => None,
     };
-    let e = e.to_string().replace('#', "deformer #");
+    let e = text;
     format!(
         "{file}: frame {frame} (t = {:.4} s) failed{}: {e}",
         frame as f32 * dt,
@@ -300,4 +307,50 @@ pub fn write_dump(
             .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
     }
     set.publish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> Scene {
+        Scene::parse(
+            "version = 1\n\n[camera]\ntarget = [0, 0, 0]\nkeys = [{ t = 0, eye = [0, 5, -5] }]\n\n\
+             [[surface]]\nname = \"yard\"\ncenter = [0, 0, 0]\nsize = [1, 1]\nsnow_depth = 0.3\n\n\
+             [[deformer]]\nname = \"ball\"\nshape = \"sphere\"\nradius = 0.1\n\
+             keys = [{ t = 0, position = [0, 0.1, 0] }]\n",
+            Path::new("s.toml"),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_failed_frame_names_the_deformer_by_its_scene_name_and_line() {
+        let e = snowprint::SnowError::InvalidDeformer {
+            name: "#0".into(),
+            what: "position",
+            value: "[inf, 0.0, 0.0]".into(),
+            expected: "finite",
+        };
+        assert_eq!(
+            frame_error(&scene(), 7, 0.5, &e),
+            "s.toml: frame 7 (t = 3.5000 s) failed (deformer \"ball\", s.toml:13): deformer \"ball\": position is [inf, 0.0, 0.0], but it must be finite"
+        );
+    }
+
+    #[test]
+    fn a_failed_frame_names_the_camera_line_and_nothing_for_other_errors() {
+        let e = snowprint::SnowError::Scene(
+            "camera target is [0, 0, 0], but it must be different from the eye".into(),
+        );
+        assert!(
+            frame_error(&scene(), 2, 0.5, &e)
+                .contains("failed ([camera], s.toml:3): camera target")
+        );
+        let e = snowprint::SnowError::Readback("device lost".into());
+        assert_eq!(
+            frame_error(&scene(), 2, 0.5, &e),
+            "s.toml: frame 2 (t = 1.0000 s) failed: GPU readback failed: device lost"
+        );
+    }
 }
