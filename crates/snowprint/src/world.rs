@@ -974,6 +974,8 @@ impl SnowWorld {
             ..Default::default()
         };
         if jobs.is_empty() {
+            // Nothing captured: the debug readbacks of the last step must not show an older one.
+            self.last = LastFrame::default();
             stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
             return Ok(stats);
         }

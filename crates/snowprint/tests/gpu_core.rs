@@ -1504,3 +1504,18 @@ fn capture_matches_hand_derived_cases_on_a_yawed_surface() {
         assert_eq!(stats.primitives, kept, "{what}");
     }
 }
+
+/// A step that captures nothing leaves no capture to read back: the debug readbacks never show an
+/// older step's capture as the last one.
+#[test]
+fn a_step_that_captures_nothing_clears_the_last_capture() {
+    let mut w = SnowWorld::new(common::gpu(), WorldConfig::default()).unwrap();
+    let id = w
+        .add_surface(SurfaceDesc::new("s", [0.0, 0.0, 0.0], [1.0, 1.0], 0.2))
+        .unwrap();
+    let ball = Deformer::new(Shape::Sphere { radius: 0.1 }, Pose::at([0.0, 0.15, 0.0]));
+    w.step(1.0 / 60.0, &[ball]).unwrap();
+    assert!(w.read_last_capture(id).unwrap().is_some());
+    w.step(1.0 / 60.0, &[]).unwrap();
+    assert_eq!(w.read_last_capture(id).unwrap(), None);
+}
