@@ -212,15 +212,22 @@ fn capsule_volume(c: (Vec3, Vec3, f32)) -> f32 {
     std::f32::consts::PI * r * r * (c.0.distance(c.1) + 4.0 / 3.0 * r)
 }
 
-/// Keep a waiting surface's queue to at most `cap` entries by merging neighbours (in queue order,
+/// Keep a waiting surface's queue to at most `cap` entries (once past it, merging down to three
+/// quarters of it) by merging neighbours (in queue order,
 /// which is the order of the frames) into covering swept spheres, cheapest first (the least added
 /// capsule volume). `radius` gives the radius of a ball holding a shape around its origin (for
 /// meshes, their registered bound). Returns the number of merges; every merged entry is held by
 /// what replaces it, so nothing it pressed is lost.
 pub fn bound(queue: &mut VecDeque<Imprint>, cap: usize, radius: impl Fn(&Shape) -> f32) -> usize {
     let cap = cap.max(1);
+    if queue.len() <= cap {
+        return 0;
+    }
+    // Down to three quarters of the cap, so that a queue that keeps growing is merged once every
+    // `cap / 4` pushes rather than at every push.
+    let target = (cap - cap / 4).max(1);
     let mut merges = 0;
-    while queue.len() > cap {
+    while queue.len() > target {
         let caps: Vec<(Vec3, Vec3, f32)> = queue
             .iter()
             .map(|d| capsule(&d.deformer, radius(&d.deformer.shape)))
@@ -236,7 +243,7 @@ pub fn bound(queue: &mut VecDeque<Imprint>, cap: usize, radius: impl Fn(&Shape) 
             .collect();
         pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         // Merge disjoint pairs, as many as needed (at most half the queue each round).
-        let mut need = queue.len() - cap;
+        let mut need = queue.len() - target;
         let mut taken = vec![false; caps.len()];
         let mut merged: Vec<Option<(Vec3, Vec3, f32)>> = vec![None; caps.len()];
         for &(_, i) in &pairs {
@@ -350,9 +357,9 @@ mod tests {
         }
         let before: Vec<Deformer> = q.iter().map(|e| e.deformer).collect();
         let radius = |s: &Shape| s.bounding_radius().unwrap();
-        let merges = bound(&mut q, 7, radius);
-        assert_eq!(q.len(), 7);
-        assert_eq!(merges, 33);
+        let merges = bound(&mut q, 8, radius);
+        assert_eq!(q.len(), 6, "down to three quarters of the cap");
+        assert_eq!(merges, 34);
         // Every point of every original capsule (sampled along it and around it) is inside a kept
         // entry's capsule.
         for d in &before {
@@ -379,7 +386,7 @@ mod tests {
         }
         // Within the cap, nothing changes.
         let kept: Vec<Imprint> = q.iter().copied().collect();
-        assert_eq!(bound(&mut q, 7, radius), 0);
+        assert_eq!(bound(&mut q, 8, radius), 0);
         assert_eq!(q.iter().copied().collect::<Vec<_>>(), kept);
     }
 
