@@ -475,25 +475,37 @@ impl SnowWorld {
     pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
         desc.validate()?;
         let layout = SurfaceLayout::for_size_capped(desc.size, self.config.max_resolution);
-        let needed = self.config.format.slot_bytes(layout.width, layout.height);
-        let slot = self
-            .alloc
-            .alloc(needed)
-            .ok_or_else(|| SnowError::PoolExhausted {
-                name: desc.name.clone(),
-                needed,
-                free: self.alloc.largest_free(),
-                budget: self.alloc.budget(),
-            })?;
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
-        self.queue.submit([enc.finish()]);
+        let slot = self.reserve_slot(&desc.name, &layout, None)?;
         Ok(self.insert_state(SurfaceState {
             desc,
             layout,
             slot,
             carry: 0.0,
         }))
+    }
+
+    /// A cleared slot for a surface of `layout`: first fit, or at `at` in the pool.
+    fn reserve_slot(
+        &mut self,
+        name: &str,
+        layout: &SurfaceLayout,
+        at: Option<u64>,
+    ) -> Result<Slot> {
+        let needed = self.config.format.slot_bytes(layout.width, layout.height);
+        let slot = match at {
+            Some(offset) => self.alloc.alloc_at(offset, needed),
+            None => self.alloc.alloc(needed),
+        }
+        .ok_or_else(|| SnowError::PoolExhausted {
+            name: name.to_owned(),
+            needed,
+            free: self.alloc.largest_free(),
+            budget: self.alloc.budget(),
+        })?;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
+        self.queue.submit([enc.finish()]);
+        Ok(slot)
     }
 
     fn insert_state(&mut self, state: SurfaceState) -> SurfaceId {
@@ -572,16 +584,9 @@ impl SnowWorld {
             + if f.normals { layout.texels() * 4 } else { 0 }
     }
 
-    /// Add a surface with the state of a snapshot (its heights, normals and replenishment carry),
-    /// at `at` in the pool when given (saves restore the pool's exact placement; `None`: first
-    /// fit). Fails with [`SnowError::PoolExhausted`] when there is no room, and with
-    /// [`SnowError::Snapshot`] when the snapshot does not fit this world's format or its
-    /// description's layout; nothing changes then.
-    pub fn restore_surface(
-        &mut self,
-        snapshot: &SurfaceSnapshot,
-        at: Option<u64>,
-    ) -> Result<SurfaceId> {
+    /// Whether a snapshot fits this world (its description valid, taken at this world's format,
+    /// with its description's layout, word count and a carry in `[0, 1)`); returns the layout.
+    pub fn check_snapshot(&self, snapshot: &SurfaceSnapshot) -> Result<SurfaceLayout> {
         let desc = &snapshot.desc;
         desc.validate()?;
         let layout = SurfaceLayout::for_size_capped(desc.size, self.config.max_resolution);
@@ -630,20 +635,22 @@ impl SnowWorld {
                 snapshot.carry
             ));
         }
-        let needed = self.config.format.slot_bytes(layout.width, layout.height);
-        let slot = match at {
-            Some(offset) => self.alloc.alloc_at(offset, needed),
-            None => self.alloc.alloc(needed),
-        }
-        .ok_or_else(|| SnowError::PoolExhausted {
-            name: desc.name.clone(),
-            needed,
-            free: self.alloc.largest_free(),
-            budget: self.alloc.budget(),
-        })?;
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
-        self.queue.submit([enc.finish()]);
+        Ok(layout)
+    }
+
+    /// Add a surface with the state of a snapshot (its heights, normals and replenishment carry),
+    /// at `at` in the pool when given (saves restore the pool's exact placement; `None`: first
+    /// fit). Fails with [`SnowError::PoolExhausted`] when there is no room, and with
+    /// [`SnowError::Snapshot`] when the snapshot does not fit this world's format or its
+    /// description's layout; nothing changes then.
+    pub fn restore_surface(
+        &mut self,
+        snapshot: &SurfaceSnapshot,
+        at: Option<u64>,
+    ) -> Result<SurfaceId> {
+        let layout = self.check_snapshot(snapshot)?;
+        let desc = &snapshot.desc;
+        let slot = self.reserve_slot(&desc.name, &layout, at)?;
         self.queue.write_buffer(
             &self.pool,
             slot.offset,

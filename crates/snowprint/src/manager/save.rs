@@ -528,7 +528,7 @@ impl SnowManager {
                         )));
                     }
                     // Checked as a restore would check it, then kept compressed.
-                    check_snapshot(&m.world, &s.snapshot)?;
+                    m.world.check_snapshot(&s.snapshot)?;
                     m.pages.put(s.index, Page::compress(s.snapshot));
                 }
             }
@@ -542,38 +542,6 @@ impl SnowManager {
         }
         Ok(m)
     }
-}
-
-/// Whether a snapshot fits a world (format, layout, word count), without restoring it.
-fn check_snapshot(world: &SnowWorld, s: &SurfaceSnapshot) -> Result<()> {
-    let layout = s.desc.layout();
-    let f = world.pool_format();
-    let words = (f.heights_bytes(layout.width, layout.height)
-        + if f.normals { layout.texels() * 4 } else { 0 })
-        / 4;
-    if s.format != f
-        || (s.width, s.height) != (layout.width, layout.height)
-        || s.words.len() as u64 != words
-    {
-        return Err(SnowError::Snapshot {
-            name: s.desc.name.clone(),
-            reason: format!(
-                "it holds {}x{} texels in {} words, the surface needs {}x{} in {words}",
-                s.width,
-                s.height,
-                s.words.len(),
-                layout.width,
-                layout.height
-            ),
-        });
-    }
-    if !(s.carry.is_finite() && (0.0..1.0).contains(&s.carry)) {
-        return Err(SnowError::Snapshot {
-            name: s.desc.name.clone(),
-            reason: format!("its replenishment carry {} is not in [0, 1)", s.carry),
-        });
-    }
-    Ok(())
 }
 
 impl SaveFile {
