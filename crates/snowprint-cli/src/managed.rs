@@ -191,6 +191,14 @@ pub fn simulate(
             ));
         }
     }
+    let waiting = snow.planner().pending_surfaces();
+    if failure.is_none() && waiting > 0 {
+        eprintln!(
+            "snowprint: {waiting} surfaces still hold queued imprints that could not land (their \
+             zone is unloaded, or the pool and page store have no room for them); they are kept \
+             in a --save but not in this dump"
+        );
+    }
     let merged = snow.planner().imprints_merged();
     if merged > 0 {
         eprintln!(
