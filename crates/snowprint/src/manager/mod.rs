@@ -381,6 +381,111 @@ pub struct TickStats {
     pub paged_surfaces: usize,
 }
 
+/// Apply a plan's residency changes in order: evictions page out (every heightmap to evict is
+/// read back in one round trip, before any slot is reused), admissions page in or start fresh.
+/// Returns the bytes paged out and in, and the admissions the world refused.
+fn apply_changes(
+    world: &mut SnowWorld,
+    pages: &mut PageStore,
+    world_ids: &mut [Option<SurfaceId>],
+    planner: &Planner,
+) -> Result<(u64, u64, Vec<ManagedId>)> {
+    let changes = &planner.last_plan().changes;
+    let evicting: Vec<SurfaceId> = changes
+        .iter()
+        .filter_map(|c| match *c {
+            ResidencyChange::Evict(id) => world_ids[id.0 as usize],
+            ResidencyChange::Admit(_) => None,
+        })
+        .collect();
+    let mut snaps = world.snapshot_surfaces(&evicting)?.into_iter();
+    let (mut paged_out, mut paged_in) = (0, 0);
+    let mut failed = Vec::new();
+    for change in changes {
+        match *change {
+            ResidencyChange::Evict(id) => {
+                if let Some(w) = world_ids[id.0 as usize].take() {
+                    let snap = snaps.next().ok_or_else(|| {
+                        SnowError::Readback("a page-out returned fewer surfaces".into())
+                    })?;
+                    paged_out += snap.words.len() as u64 * 4;
+                    pages.put(id.0, Page::compress(snap));
+                    world.remove_surface(w)?;
+                }
+            }
+            ResidencyChange::Admit(id) => {
+                let at = planner.slot(id).map(|s| s.offset);
+                let result = match pages.get(id.0) {
+                    Some(page) => {
+                        let snap = page.decompress()?;
+                        paged_in += snap.words.len() as u64 * 4;
+                        world.restore_surface(&snap, at)
+                    }
+                    None => world.add_surface(planner.surface(id)?.clone()),
+                };
+                match result {
+                    Ok(w) => {
+                        pages.take(id.0);
+                        world_ids[id.0 as usize] = Some(w);
+                    }
+                    Err(SnowError::PoolExhausted { name, .. }) => {
+                        tracing::warn!(
+                            "the pool refused surface {name:?} that the planner expected to fit"
+                        );
+                        failed.push(id);
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+    }
+    Ok((paged_out, paged_in, failed))
+}
+
+/// Update the planned surfaces with their queued imprints frame by frame: update `j` holds the
+/// `j`-th queued frame of every surface that has one (the first also catches snowfall up), so a
+/// surface that waited goes through the same steps as one updated in every frame.
+fn update_frame_by_frame(
+    world: &mut SnowWorld,
+    world_ids: &[Option<SurfaceId>],
+    updates: &[PlannedUpdate],
+) -> Result<()> {
+    let mut runs: Vec<(SurfaceId, f32, Vec<&[Deformer]>)> = Vec::new();
+    for u in updates {
+        let Some(w) = world_ids[u.surface.0 as usize] else {
+            continue;
+        };
+        // Runs of imprints of one frame (the queue is in frame order).
+        let mut frames: Vec<&[Deformer]> = Vec::new();
+        let mut start = 0;
+        for k in 1..=u.imprints.len() {
+            if k == u.imprints.len() || u.frames.get(k) != u.frames.get(start) {
+                frames.push(&u.imprints[start..k]);
+                start = k;
+            }
+        }
+        if frames.is_empty() {
+            frames.push(&u.imprints[..]);
+        }
+        runs.push((w, u.elapsed, frames));
+    }
+    let layers = runs.iter().map(|r| r.2.len()).max().unwrap_or(0);
+    for j in 0..layers {
+        let batch: Vec<SurfaceUpdate<'_>> = runs
+            .iter()
+            .filter_map(|(w, elapsed, frames)| {
+                frames.get(j).map(|d| SurfaceUpdate {
+                    surface: *w,
+                    elapsed: if j == 0 { *elapsed } else { 0.0 },
+                    deformers: d,
+                })
+            })
+            .collect();
+        world.update(&batch)?;
+    }
+    Ok(())
+}
+
 /// A [`SnowWorld`] run by a [`Planner`]: see the module docs.
 pub struct SnowManager {
     world: SnowWorld,
@@ -609,98 +714,14 @@ impl SnowManager {
         self.planner.tick(dt, camera, deformers)?;
         let paged_between = std::mem::take(&mut self.paged_between);
         let plan = self.planner.last_plan();
-        let evict: Vec<ManagedId> = plan
-            .changes
-            .iter()
-            .filter_map(|c| match *c {
-                ResidencyChange::Evict(id) => Some(id),
-                ResidencyChange::Admit(_) => None,
-            })
-            .collect();
-        // Every heightmap to evict is read back in one round trip, before any slot is reused.
-        let snaps = {
-            let world: Vec<SurfaceId> = evict
-                .iter()
-                .filter_map(|id| self.world_ids[id.0 as usize])
-                .collect();
-            self.world.snapshot_surfaces(&world)?
-        };
-        let mut snaps = snaps.into_iter();
-        let (mut paged_out, mut paged_in) = (paged_between, 0);
-        let mut failed = Vec::new();
-        for change in &plan.changes {
-            match *change {
-                ResidencyChange::Evict(id) => {
-                    if let Some(w) = self.world_ids[id.0 as usize].take() {
-                        let snap = snaps.next().ok_or_else(|| {
-                            SnowError::Readback("a page-out returned fewer surfaces".into())
-                        })?;
-                        paged_out += snap.words.len() as u64 * 4;
-                        self.pages.put(id.0, Page::compress(snap));
-                        self.world.remove_surface(w)?;
-                    }
-                }
-                ResidencyChange::Admit(id) => {
-                    let at = self.planner.slot(id).map(|s| s.offset);
-                    let result = match self.pages.get(id.0) {
-                        Some(page) => {
-                            let snap = page.decompress()?;
-                            paged_in += snap.words.len() as u64 * 4;
-                            self.world.restore_surface(&snap, at)
-                        }
-                        None => self.world.add_surface(self.planner.surface(id)?.clone()),
-                    };
-                    match result {
-                        Ok(w) => {
-                            self.pages.take(id.0);
-                            self.world_ids[id.0 as usize] = Some(w);
-                        }
-                        Err(SnowError::PoolExhausted { name, .. }) => {
-                            tracing::warn!(
-                                "the pool refused surface {name:?} that the planner expected to fit"
-                            );
-                            failed.push(id);
-                        }
-                        Err(e) => return Err(e),
-                    }
-                }
-            }
-        }
-        // The queued imprints are captured frame by frame: layer `j` holds the `j`-th queued
-        // frame of every surface updated (the first also catches snowfall up), so a surface that
-        // waited goes through the same steps as one updated in every frame.
-        let mut runs: Vec<(SurfaceId, f32, Vec<&[crate::Deformer]>)> = Vec::new();
-        for u in &plan.updates {
-            let Some(w) = self.world_ids[u.surface.0 as usize] else {
-                continue;
-            };
-            let mut frames = Vec::new();
-            let mut start = 0;
-            for k in 1..=u.imprints.len() {
-                if k == u.imprints.len() || u.frames[k] != u.frames[start] {
-                    frames.push(&u.imprints[start..k]);
-                    start = k;
-                }
-            }
-            if frames.is_empty() {
-                frames.push(&u.imprints[..]);
-            }
-            runs.push((w, u.elapsed, frames));
-        }
-        let layers = runs.iter().map(|r| r.2.len()).max().unwrap_or(0);
-        for j in 0..layers {
-            let updates: Vec<SurfaceUpdate<'_>> = runs
-                .iter()
-                .filter_map(|(w, elapsed, frames)| {
-                    frames.get(j).map(|d| SurfaceUpdate {
-                        surface: *w,
-                        elapsed: if j == 0 { *elapsed } else { 0.0 },
-                        deformers: d,
-                    })
-                })
-                .collect();
-            self.world.update(&updates)?;
-        }
+        let (paged_out, paged_in, failed) = apply_changes(
+            &mut self.world,
+            &mut self.pages,
+            &mut self.world_ids,
+            &self.planner,
+        )?;
+        let paged_out = paged_out + paged_between;
+        update_frame_by_frame(&mut self.world, &self.world_ids, &plan.updates)?;
         let mut stats = plan.stats.clone();
         for id in failed {
             self.planner.admission_failed(id);
