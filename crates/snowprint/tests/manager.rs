@@ -11,8 +11,8 @@ use proptest::prelude::*;
 use snowprint::manager::city::{self, WalkerPath};
 use snowprint::manager::queue;
 use snowprint::manager::{
-    CameraView, Lookup, ManagedDeformer, ManagedId, ManagerConfig, Planner, ResidencyChange,
-    SnowManager, UNLIMITED, ZoneId,
+    CameraView, CatchUp, Lookup, ManagedDeformer, ManagedId, ManagerConfig, Planner,
+    ResidencyChange, SnowManager, UNLIMITED, ZoneId,
 };
 use snowprint::pool::PoolFormat;
 
@@ -857,16 +857,18 @@ fn twenty_walkers_on_a_budget_of_two_lose_no_footprint() {
     }
 }
 
-/// Spheres dragged along curves (no lifting): the budget captures several frames of a drag in one
-/// pass. The trail is never shallower anywhere, and deeper only where two frames' sweeps meet
-/// within the blur's reach (see docs/MANAGER.md).
+/// Spheres dragged along curves (no lifting). Caught up frame by frame (the default), the budgeted
+/// trails equal the unlimited ones exactly; with `CatchUp::Union` the budget captures several frames
+/// of a drag in one pass: the trail is never shallower anywhere, and deeper only where two frames'
+/// sweeps meet within the blur's reach (see docs/MANAGER.md).
 #[test]
 fn dragged_spheres_on_a_budget_press_at_least_as_deep() {
-    let run = |k: usize| -> Vec<Heightmap> {
+    let run = |k: usize, catch_up: CatchUp| -> Vec<Heightmap> {
         let mut m = SnowManager::new(
             common::gpu(),
             ManagerConfig {
                 updates_per_frame: k,
+                catch_up,
                 ..ManagerConfig::default()
             },
         )
@@ -922,8 +924,13 @@ fn dragged_spheres_on_a_budget_press_at_least_as_deep() {
             .map(|&id| m.read_heightmap(id).unwrap())
             .collect()
     };
-    let budget = run(2);
-    let free = run(UNLIMITED);
+    let free = run(UNLIMITED, CatchUp::FrameByFrame);
+    assert_eq!(run(2, CatchUp::FrameByFrame), free, "frame by frame: exact");
+    let budget = run(2, CatchUp::Union);
+    assert_ne!(
+        budget, free,
+        "the union of a drag's frames presses a little deeper"
+    );
     for (b, f) in budget.iter().zip(&free) {
         let (vb, vf) = (b.pressed_volume(), f.pressed_volume());
         assert!(vf > 50.0, "a real trench: {vf}");

@@ -287,3 +287,24 @@ fn crc32(bytes: &[u8]) -> u32 {
     }
     !c
 }
+
+/// Every setting comes back from a save as it was, the catch-up mode included.
+#[test]
+fn a_save_keeps_every_setting() {
+    let config = ManagerConfig {
+        updates_per_frame: 3,
+        pool_bytes: 1 << 20,
+        active_distance: 42.5,
+        distance_slack_frames: 5,
+        player_slots: 2,
+        queue_cap: 77,
+        page_bytes: 123_456,
+        replenish_interval: 0.125,
+        catch_up: snowprint::manager::CatchUp::Union,
+        format: PoolFormat::new(Precision::Bits8),
+        ..ManagerConfig::default()
+    };
+    let m = SnowManager::new(common::gpu(), config.clone()).unwrap();
+    let file = SaveFile::parse(&m.to_save_bytes().unwrap()).unwrap();
+    assert_eq!(file.config, config);
+}

@@ -18,7 +18,7 @@ use std::path::Path;
 
 use super::pages::Page;
 use super::planner::{Planner, PlannerState};
-use super::{ManagedMesh, ManagerConfig, SnowManager, UNLIMITED};
+use super::{CatchUp, ManagedMesh, ManagerConfig, SnowManager, UNLIMITED};
 use crate::error::{Result, SnowError};
 use crate::gpu::GpuContext;
 use crate::mesh::{Mesh, MeshId};
@@ -106,6 +106,9 @@ struct SavedConfig {
     atlas_side: u32,
     precision_bits: u32,
     normals: bool,
+    /// `false`: frame by frame (the default); `true`: one capture of the union.
+    #[serde(default)]
+    catch_up_union: bool,
 }
 
 impl SavedConfig {
@@ -126,6 +129,7 @@ impl SavedConfig {
             atlas_side: c.atlas_side,
             precision_bits: c.format.precision.bits(),
             normals: c.format.normals,
+            catch_up_union: c.catch_up == CatchUp::Union,
         }
     }
 
@@ -164,6 +168,11 @@ impl SavedConfig {
             format: PoolFormat {
                 precision,
                 normals: self.normals,
+            },
+            catch_up: if self.catch_up_union {
+                CatchUp::Union
+            } else {
+                CatchUp::FrameByFrame
             },
         };
         config.validate().map_err(|e| e.to_string())?;
