@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use fuzz_support::{Edit, Watchdog, apply, cases, config, edit, peak_rss};
+use fuzz_support::{Edit, Watchdog, apply, cases, config, edit, finish};
 use proptest::prelude::*;
 use proptest::test_runner::TestRunner;
 use serde_json::Value;
@@ -23,8 +23,6 @@ use snowprint::{Mesh, SnowError};
 
 /// Time one input may take (loading is microseconds; this only catches hangs).
 const LIMIT: Duration = Duration::from_secs(10);
-/// Peak resident memory of the whole test process, bytes.
-const RSS_BOUND: u64 = 1 << 30;
 
 const TOKENS: &[&str] = &[
     "{",
@@ -137,29 +135,6 @@ fn load_one(bytes: Vec<u8>) -> Result<(), String> {
     }
 }
 
-fn check(
-    watchdog: &Watchdog<Vec<u8>, Result<(), String>>,
-    bytes: Vec<u8>,
-) -> Result<(), TestCaseError> {
-    match watchdog.run(bytes) {
-        Ok(Ok(())) => Ok(()),
-        Ok(Err(broken)) => Err(TestCaseError::fail(broken)),
-        Err(e) => Err(TestCaseError::fail(e)),
-    }
-}
-
-fn finish(name: &str, n: u32, start: Instant) {
-    let rss = peak_rss();
-    println!(
-        "{name}: {n} inputs in {:.1} s, peak RSS {} MiB",
-        start.elapsed().as_secs_f64(),
-        rss.map_or("unknown".to_owned(), |b| (b >> 20).to_string())
-    );
-    if let Some(rss) = rss {
-        assert!(rss < RSS_BOUND, "peak RSS {rss} bytes is over {RSS_BOUND}");
-    }
-}
-
 #[test]
 fn byte_mutated_seeds_are_answered() {
     let n = cases(10_000);
@@ -173,7 +148,7 @@ fn byte_mutated_seeds_are_answered() {
     );
     TestRunner::new(config(n))
         .run(&strategy, |(a, b, edits): (usize, usize, Vec<Edit>)| {
-            check(&watchdog, apply(&seeds[a], &seeds[b], &edits, TOKENS))
+            watchdog.check(apply(&seeds[a], &seeds[b], &edits, TOKENS))
         })
         .unwrap_or_else(|e| panic!("{e}"));
     finish("byte-mutated glTF", n, start);
@@ -339,7 +314,7 @@ fn json_mutated_seeds_are_answered() {
             } else {
                 text.into_bytes()
             };
-            check(&watchdog, bytes)
+            watchdog.check(bytes)
         })
         .unwrap_or_else(|e| panic!("{e}"));
     finish("JSON-mutated glTF", n, start);
@@ -412,7 +387,7 @@ fn generated_gltf_files_are_answered() {
     let start = Instant::now();
     let watchdog = Watchdog::new(load_one, LIMIT);
     TestRunner::new(config(n))
-        .run(&generated_gltf(), |bytes| check(&watchdog, bytes))
+        .run(&generated_gltf(), |bytes| watchdog.check(bytes))
         .unwrap_or_else(|e| panic!("{e}"));
     finish("generated glTF", n, start);
 }

@@ -2,28 +2,31 @@
 //! a real save mutated byte-wise (flips, insertions, deletions, cuts, splices), and mutated inside
 //! its sections with every length and checksum fixed up afterwards, so that the inputs reach the
 //! settings, the planner's state, the meshes and the heightmaps rather than stopping at a
-//! checksum. Every input must be answered without a panic, in time, with a manager or one
-//! sentence; the process's peak memory must stay under a stated bound.
+//! checksum. Every input runs under the fuzzers' watchdog (`fuzz_support`: a panic or a hang fails
+//! it) and must be answered with a manager or one sentence; the process's peak memory must stay
+//! under `fuzz_support::RSS_BOUND`.
 //!
 //! `SNOWPRINT_FUZZ_CASES=1000000 cargo test --release -p snowprint --test fuzz_save` makes a long
 //! run (`docs/RELIABILITY.md`, "Fuzzing: the save loader").
 
 mod common;
+mod fuzz_support;
 
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
+
+use fuzz_support::{Watchdog, cases, config, finish};
 
 use glam::Vec3;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+use proptest::test_runner::TestRunner;
 use snowprint::manager::save::SaveFile;
 use snowprint::manager::{ManagedDeformer, ManagerConfig, SnowManager, ZoneId};
 use snowprint::{Deformer, Mesh, Pose, Shape, SurfaceDesc};
 
 /// Time one input may take (a parse is microseconds, a load a few milliseconds).
 const LIMIT: Duration = Duration::from_secs(10);
-/// Peak resident memory of the whole test process, bytes.
-const RSS_BOUND: u64 = 1 << 30;
 
 /// A small real save: three surfaces (one paged out), queued imprints, a mesh re-posed while
 /// queued (so an earlier posing is saved too).
@@ -230,27 +233,46 @@ fn apply(bytes: &[u8], muts: &[Mutation]) -> Vec<u8> {
     out
 }
 
-fn peak_rss() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
+/// `SNOWPRINT_FUZZ_LOADS`: at most this many inputs that parse are also loaded on the GPU
+/// (loading builds a world, a few milliseconds on lavapipe); the others are parsed only.
+fn max_loads() -> u64 {
+    std::env::var("SNOWPRINT_FUZZ_LOADS")
         .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
-        })
-        .map_or(0, |kb| kb * 1024)
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(150)
 }
 
-fn env_count(name: &str, default: u64) -> u64 {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+static PARSED: AtomicU64 = AtomicU64::new(0);
+static LOADED: AtomicU64 = AtomicU64::new(0);
 
-/// Inputs tried (`SNOWPRINT_FUZZ_CASES`, default 2000).
-fn cases() -> u32 {
-    env_count("SNOWPRINT_FUZZ_CASES", 2000).min(u32::MAX as u64) as u32
+/// One input, on the watchdog's worker: parse it, and load what parses (up to the load count).
+/// Every answer must be one line.
+fn load_one(input: Vec<u8>) -> Result<(), String> {
+    let one_line = |e: String| {
+        if e.is_empty() || e.contains('\n') {
+            Err(format!("not one line: {e:?}"))
+        } else {
+            Ok(())
+        }
+    };
+    let file = match SaveFile::parse(&input) {
+        Ok(file) => file,
+        Err(e) => return one_line(e),
+    };
+    if PARSED.fetch_add(1, Ordering::Relaxed) >= max_loads() {
+        return Ok(());
+    }
+    LOADED.fetch_add(1, Ordering::Relaxed);
+    match SnowManager::from_save(common::gpu(), file) {
+        Ok(m) => {
+            // What loaded is usable: read every surface.
+            for (id, _) in m.surface_names().collect::<Vec<_>>() {
+                let _ = m.read_heightmap(id);
+            }
+            Ok(())
+        }
+        Err(e) => one_line(e.to_string()),
+    }
 }
 
 #[test]
@@ -258,56 +280,20 @@ fn the_save_loader_answers_every_input() {
     let seed = seed();
     // The re-assembled seed is a valid save: the fix-up is right, so mutations go deep.
     assert!(SaveFile::parse(&assemble(1, &sections(seed))).is_ok());
-    let mut runner = TestRunner::new(Config {
-        cases: cases(),
-        failure_persistence: None,
-        ..Config::default()
-    });
-    // Loading builds a GPU world (a few milliseconds on lavapipe): at most this many inputs that
-    // parse are also loaded (`SNOWPRINT_FUZZ_LOADS`, default 150); the others are parsed only.
-    let max_loads = env_count("SNOWPRINT_FUZZ_LOADS", 150);
-    let (parsed, loaded) = (std::cell::Cell::new(0u64), std::cell::Cell::new(0u64));
-    let result = runner.run(&proptest::collection::vec(mutation(), 1..4), |muts| {
-        let input = apply(seed, &muts);
-        let start = Instant::now();
-        match SaveFile::parse(&input) {
-            Ok(file) => {
-                parsed.set(parsed.get() + 1);
-                if parsed.get() > max_loads {
-                    return Ok(());
-                }
-                match SnowManager::from_save(common::gpu(), file) {
-                    Ok(m) => {
-                        // What loaded is usable: read every surface.
-                        for (id, _) in m.surface_names().collect::<Vec<_>>() {
-                            let _ = m.read_heightmap(id);
-                        }
-                    }
-                    Err(e) => prop_assert!(!e.to_string().contains('\n'), "{e}"),
-                }
-                loaded.set(loaded.get() + 1);
-            }
-            Err(e) => prop_assert!(!e.is_empty() && !e.contains('\n'), "{e}"),
-        }
-        prop_assert!(
-            start.elapsed() < LIMIT,
-            "{:?} for {:?}",
-            start.elapsed(),
-            muts
-        );
-        Ok(())
-    });
-    if let Err(e) = result {
-        panic!("{e}");
-    }
-    let rss = peak_rss();
-    let (parsed, loaded) = (parsed.get(), loaded.get());
-    eprintln!(
-        "fuzz_save: {} inputs, {parsed} parsed, {loaded} of them loaded or refused by from_save, peak RSS {} MiB",
-        cases(),
-        rss >> 20
+    let n = cases(2000);
+    let start = Instant::now();
+    let watchdog = Watchdog::new(load_one, LIMIT);
+    TestRunner::new(config(n))
+        .run(&proptest::collection::vec(mutation(), 1..4), |muts| {
+            watchdog.check(apply(seed, &muts))
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+    let (parsed, loaded) = (
+        PARSED.load(Ordering::Relaxed),
+        LOADED.load(Ordering::Relaxed),
     );
-    assert!(rss < RSS_BOUND, "peak RSS {rss} bytes");
+    println!("fuzz_save: {parsed} inputs parsed, {loaded} of them loaded or refused by from_save");
+    finish("fuzz_save", n, start);
     assert!(
         parsed > 0,
         "the structure-aware mutations reach past the checksums"

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use fuzz_support::{Edit, Watchdog, apply, cases, config, edgy_number, edit, peak_rss};
+use fuzz_support::{Edit, Watchdog, apply, cases, config, edgy_number, edit, finish};
 use proptest::prelude::*;
 use proptest::test_runner::TestRunner;
 use snowprint::SnowError;
@@ -21,8 +21,6 @@ use snowprint::scene::Scene;
 
 /// Time one input may take (parsing is microseconds; this only catches hangs).
 const LIMIT: Duration = Duration::from_secs(10);
-/// Peak resident memory of the whole test process, bytes.
-const RSS_BOUND: u64 = 1 << 30;
 
 /// Tokens inserted by the mutator.
 const TOKENS: &[&str] = &[
@@ -149,30 +147,6 @@ fn parse_one(text: String) -> Result<(), String> {
     }
 }
 
-fn check(
-    watchdog: &Watchdog<String, Result<(), String>>,
-    text: String,
-) -> Result<(), TestCaseError> {
-    match watchdog.run(text) {
-        Ok(Ok(())) => Ok(()),
-        Ok(Err(broken)) => Err(TestCaseError::fail(broken)),
-        Err(e) => Err(TestCaseError::fail(e)),
-    }
-}
-
-/// Report a run's figures (shown with `--nocapture`) and check the memory bound.
-fn finish(name: &str, n: u32, start: Instant) {
-    let rss = peak_rss();
-    println!(
-        "{name}: {n} inputs in {:.1} s, peak RSS {} MiB",
-        start.elapsed().as_secs_f64(),
-        rss.map_or("unknown".to_owned(), |b| (b >> 20).to_string())
-    );
-    if let Some(rss) = rss {
-        assert!(rss < RSS_BOUND, "peak RSS {rss} bytes is over {RSS_BOUND}");
-    }
-}
-
 #[test]
 fn mutated_seed_scenes_are_answered() {
     let n = cases(10_000);
@@ -187,7 +161,7 @@ fn mutated_seed_scenes_are_answered() {
     TestRunner::new(config(n))
         .run(&strategy, |(a, b, edits): (usize, usize, Vec<Edit>)| {
             let bytes = apply(seeds[a].as_bytes(), seeds[b].as_bytes(), &edits, TOKENS);
-            check(&watchdog, String::from_utf8_lossy(&bytes).into_owned())
+            watchdog.check(String::from_utf8_lossy(&bytes).into_owned())
         })
         .unwrap_or_else(|e| panic!("{e}"));
     finish("mutated scenes", n, start);
@@ -285,7 +259,7 @@ fn generated_scenes_are_answered() {
     let start = Instant::now();
     let watchdog = Watchdog::new(parse_one, LIMIT);
     TestRunner::new(config(n))
-        .run(&generated_scene(), |text| check(&watchdog, text))
+        .run(&generated_scene(), |text| watchdog.check(text))
         .unwrap_or_else(|e| panic!("{e}"));
     finish("generated scenes", n, start);
 }

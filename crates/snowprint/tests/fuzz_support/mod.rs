@@ -1,4 +1,4 @@
-//! Shared by `fuzz_scene.rs` and `fuzz_gltf.rs`: structure-aware mutations of valid seed files,
+//! Shared by `fuzz_scene.rs`, `fuzz_gltf.rs` and `fuzz_save.rs`: structure-aware mutations of valid seed files,
 //! a watchdog that runs each input on a worker thread under a time limit (a hang fails the test
 //! instead of stalling it), the case count from `SNOWPRINT_FUZZ_CASES`, and the process's peak RSS.
 //!
@@ -43,8 +43,35 @@ pub fn peak_rss() -> Option<u64> {
     Some(kib * 1024)
 }
 
+/// Peak resident memory of a whole fuzz test process, bytes.
+pub const RSS_BOUND: u64 = 1 << 30;
+
+/// Report a run's figures (shown with `--nocapture`) and check the memory bound.
+pub fn finish(name: &str, n: u32, start: std::time::Instant) {
+    let rss = peak_rss();
+    println!(
+        "{name}: {n} inputs in {:.1} s, peak RSS {} MiB",
+        start.elapsed().as_secs_f64(),
+        rss.map_or("unknown".to_owned(), |b| (b >> 20).to_string())
+    );
+    if let Some(rss) = rss {
+        assert!(rss < RSS_BOUND, "peak RSS {rss} bytes is over {RSS_BOUND}");
+    }
+}
+
 type Job<I, O> = (I, Sender<Result<O, String>>);
 type JobChannel<I, O> = (Sender<Job<I, O>>, Receiver<Job<I, O>>);
+
+impl<I: Send + 'static> Watchdog<I, Result<(), String>> {
+    /// Run one input as a proptest case: a broken answer, a panic or a hang fails it.
+    pub fn check(&self, input: I) -> Result<(), TestCaseError> {
+        match self.run(input) {
+            Ok(Ok(())) => Ok(()),
+            Ok(Err(broken)) => Err(TestCaseError::fail(broken)),
+            Err(e) => Err(TestCaseError::fail(e)),
+        }
+    }
+}
 
 /// Runs a function on a worker thread, one input at a time, and fails an input that panics or runs
 /// longer than the limit. After a timeout the stuck worker is abandoned and a new one started, so
