@@ -962,18 +962,7 @@ mod tests {
     fn generated_meshes_are_closed_and_outward() {
         for m in [cylinder(1.0, 2.0, 16), cone(1.0, 1.0, 16)] {
             m.validate("m").unwrap();
-            let v: f32 = m
-                .indices
-                .chunks(3)
-                .map(|t| {
-                    let (a, b, c) = (
-                        m.positions[t[0] as usize],
-                        m.positions[t[1] as usize],
-                        m.positions[t[2] as usize],
-                    );
-                    a.dot(b.cross(c)) / 6.0
-                })
-                .sum();
+            let v = m.signed_volume();
             assert!(v > 0.0, "volume {v}");
         }
     }

@@ -253,26 +253,6 @@ fn a_crowd_of_ten_thousand_presses_every_spot() {
     assert_eq!(pressed, 10_000);
 }
 
-/// A closed box mesh of half-size `h` around its origin, wound outward.
-fn box_mesh(h: Vec3) -> Mesh {
-    let p = |x: f32, y: f32, z: f32| Vec3::new(x * h.x, y * h.y, z * h.z);
-    let positions = vec![
-        p(-1., -1., -1.),
-        p(1., -1., -1.),
-        p(1., 1., -1.),
-        p(-1., 1., -1.),
-        p(-1., -1., 1.),
-        p(1., -1., 1.),
-        p(1., 1., 1.),
-        p(-1., 1., 1.),
-    ];
-    let indices = vec![
-        0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7, 3,
-        1, 2, 6, 1, 6, 5,
-    ];
-    Mesh { positions, indices }
-}
-
 mod reposing {
     use super::*;
     use proptest::prelude::*;
@@ -340,7 +320,7 @@ mod reposing {
             w.radius * (0.5 + 0.4 * phase as f32),
             w.radius * 0.7,
         );
-        box_mesh(h).positions
+        Mesh::cuboid(h).positions
     }
 
     /// The heightmaps after a flush, the bytes paged out and the most imprints queued at once.
@@ -365,7 +345,7 @@ mod reposing {
             .iter()
             .enumerate()
             .map(|(k, w)| {
-                m.add_mesh(&format!("w{k}"), &box_mesh(Vec3::splat(w.radius)))
+                m.add_mesh(&format!("w{k}"), &Mesh::cuboid(Vec3::splat(w.radius)))
                     .unwrap()
             })
             .collect();

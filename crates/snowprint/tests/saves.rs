@@ -36,22 +36,7 @@ fn world(precision: Precision) -> (SnowManager, Vec<ManagedId>, MeshId) {
             m.add_surface(d, ZoneId(i / 2)).unwrap()
         })
         .collect();
-    let cube = Mesh {
-        positions: vec![
-            Vec3::new(-0.1, -0.1, -0.1),
-            Vec3::new(0.1, -0.1, -0.1),
-            Vec3::new(0.1, 0.1, -0.1),
-            Vec3::new(-0.1, 0.1, -0.1),
-            Vec3::new(-0.1, -0.1, 0.1),
-            Vec3::new(0.1, -0.1, 0.1),
-            Vec3::new(0.1, 0.1, 0.1),
-            Vec3::new(-0.1, 0.1, 0.1),
-        ],
-        indices: vec![
-            0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7,
-            3, 1, 2, 6, 1, 6, 5,
-        ],
-    };
+    let cube = Mesh::cuboid(Vec3::splat(0.1));
     let mesh = m.add_mesh("cube", &cube).unwrap();
     (m, ids, mesh)
 }
@@ -61,19 +46,7 @@ fn world(precision: Precision) -> (SnowManager, Vec<ManagedId>, MeshId) {
 fn step(m: &mut SnowManager, mesh: MeshId, f: u32) {
     if f.is_multiple_of(4) {
         let s = 1.0 + 0.2 * ((f / 4) % 3) as f32;
-        let cube: Vec<Vec3> = [
-            (-1., -1., -1.),
-            (1., -1., -1.),
-            (1., 1., -1.),
-            (-1., 1., -1.),
-            (-1., -1., 1.),
-            (1., -1., 1.),
-            (1., 1., 1.),
-            (-1., 1., 1.),
-        ]
-        .iter()
-        .map(|&(x, y, z)| Vec3::new(x * 0.1 * s, y * 0.1, z * 0.1))
-        .collect();
+        let cube = Mesh::cuboid(Vec3::new(0.1 * s, 0.1, 0.1)).positions;
         m.pose_mesh(mesh, &cube).unwrap();
     }
     let sphere = |f: u32| Pose::at([-0.8 + f as f32 * 0.12, 0.17, 0.3]);

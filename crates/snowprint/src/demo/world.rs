@@ -281,24 +281,14 @@ mod tests {
     use super::*;
     use glam::Vec3Swizzles;
 
-    fn signed_volume(m: &Mesh) -> f32 {
-        m.indices
-            .chunks(3)
-            .map(|t| {
-                let p = |i: u32| m.positions[i as usize];
-                p(t[0]).dot(p(t[1]).cross(p(t[2]))) / 6.0
-            })
-            .sum()
-    }
-
     #[test]
     fn cylinder_and_cone_are_closed_and_outward() {
         let c = cylinder(1.0, 2.0, 64);
         let exact = std::f32::consts::PI * 2.0;
-        let v = signed_volume(&c);
+        let v = c.signed_volume();
         assert!(v > 0.98 * exact && v <= exact, "{v}");
         let k = cone_frustum(1.0, 0.0, 3.0, 64);
-        let v = signed_volume(&k);
+        let v = k.signed_volume();
         assert!(
             v > 0.98 * std::f32::consts::PI && v <= std::f32::consts::PI,
             "{v}"

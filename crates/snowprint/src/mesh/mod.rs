@@ -26,6 +26,18 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Volume enclosed, by the divergence theorem: positive for a closed mesh wound outward
+    /// (counter-clockwise seen from outside), as the capture's winding count needs.
+    pub fn signed_volume(&self) -> f32 {
+        self.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let p = |i: u32| self.positions.get(i as usize).copied().unwrap_or_default();
+                p(t[0]).dot(p(t[1]).cross(p(t[2]))) / 6.0
+            })
+            .sum()
+    }
+
     /// Check indices are in range and positions finite.
     pub fn validate(&self, name: &str) -> Result<()> {
         let err = |reason: String| {
@@ -190,31 +202,16 @@ impl Mesh {
 mod tests {
     use super::*;
 
-    /// Signed volume by the divergence theorem: positive for a closed mesh wound outward.
-    fn signed_volume(m: &Mesh) -> f32 {
-        m.indices
-            .chunks(3)
-            .map(|t| {
-                let (a, b, c) = (
-                    m.positions[t[0] as usize],
-                    m.positions[t[1] as usize],
-                    m.positions[t[2] as usize],
-                );
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum()
-    }
-
     #[test]
     fn generated_meshes_are_closed_and_outward() {
         let s = Mesh::uv_sphere(1.0, 32, 64);
         s.validate("sphere").unwrap();
-        let v = signed_volume(&s);
+        let v = s.signed_volume();
         let exact = 4.0 / 3.0 * std::f32::consts::PI;
         assert!(v > 0.97 * exact && v < exact, "sphere volume {v}");
 
         let c = Mesh::capsule(0.5, 1.0, 16, 32);
-        let v = signed_volume(&c);
+        let v = c.signed_volume();
         let exact = 4.0 / 3.0 * std::f32::consts::PI * 0.125 + std::f32::consts::PI * 0.25 * 2.0;
         assert!(
             v > 0.97 * exact && v < exact,
@@ -222,6 +219,6 @@ mod tests {
         );
 
         let b = Mesh::cuboid(Vec3::new(1.0, 2.0, 3.0));
-        assert!((signed_volume(&b) - 48.0).abs() < 1e-4);
+        assert!((b.signed_volume() - 48.0).abs() < 1e-4);
     }
 }
