@@ -26,6 +26,7 @@ pub mod capture;
 pub mod deformer;
 pub mod demo;
 pub mod error;
+mod extract;
 pub mod gpu;
 pub mod heightmap;
 pub mod manager;
@@ -39,6 +40,7 @@ pub mod world;
 
 pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};
 pub use error::{Result, SnowError};
+pub use extract::{FrameView, SurfaceView};
 pub use gpu::{Capabilities, GpuContext, GpuOptions};
 pub use heightmap::Heightmap;
 pub use manager::{

@@ -1,0 +1,78 @@
+//! The extract step: what a renderer reads of a [`SnowWorld`] to draw a frame, gathered in one
+//! call ([`SnowWorld::frame_view`]) instead of per-surface accessor calls scattered through the
+//! passes. Built from the world's public accessors only, so another renderer can do the same.
+
+use crate::error::{Result, SnowError};
+use crate::pool::{PoolFormat, Precision};
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+use crate::world::SnowWorld;
+
+/// One live surface as a renderer sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceView<'a> {
+    /// The surface's handle.
+    pub id: SurfaceId,
+    /// Where it lies and how deep its snow is.
+    pub desc: &'a SurfaceDesc,
+    /// Its heightmap's resolution.
+    pub layout: SurfaceLayout,
+    /// Word offset of its heights in the pool buffer.
+    pub heights: u32,
+    /// Word offset of its normals in the pool buffer, when the pool keeps them.
+    pub normals: Option<u32>,
+    /// Precision of its heights in the pool.
+    pub precision: Precision,
+}
+
+/// Everything of a world a frame reads: the pool buffer, its format, and every live surface
+/// with its layout and offsets in the pool.
+#[derive(Debug)]
+pub struct FrameView<'a> {
+    /// The pool buffer (`array<u32>` in WGSL).
+    pub pool_buffer: &'a wgpu::Buffer,
+    /// The pool's format.
+    pub pool_format: PoolFormat,
+    /// Every live surface, in the world's order.
+    pub surfaces: Vec<SurfaceView<'a>>,
+}
+
+impl<'a> FrameView<'a> {
+    /// A surface of the view, or the error the world gives for a handle it does not hold.
+    pub fn surface(&self, id: SurfaceId) -> Result<&SurfaceView<'a>> {
+        self.surfaces
+            .iter()
+            .find(|s| s.id == id)
+            .ok_or(SnowError::StaleHandle {
+                what: "surface",
+                index: id.index(),
+            })
+    }
+}
+
+impl SnowWorld {
+    /// What a renderer reads of the world this frame, in one call: the pool buffer and format,
+    /// and each live surface's description, layout and offsets in the pool.
+    pub fn frame_view(&self) -> FrameView<'_> {
+        let pool_format = self.pool_format();
+        let surfaces = self
+            .surfaces()
+            .filter_map(|(id, desc)| {
+                let layout = self.layout(id).ok()?;
+                let (heights, normals) = self.gpu_offsets(id).ok()?;
+                Some(SurfaceView {
+                    id,
+                    desc,
+                    layout,
+                    heights,
+                    normals,
+                    precision: pool_format.precision,
+                })
+            })
+            .collect();
+        FrameView {
+            pool_buffer: self.pool_buffer(),
+            pool_format,
+            surfaces,
+        }
+    }
+}
