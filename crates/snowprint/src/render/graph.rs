@@ -1,7 +1,7 @@
 //! The frame graph: the renderer's passes in order, each naming the resources it reads and writes.
-//! The renderer encodes its passes from this table (labels and timestamp slots come from it), and
-//! a test checks that every resource a pass reads was written by an earlier pass or comes from
-//! outside the frame.
+//! The renderer's `encode` walks this table and records entry `i` `i`-th, dispatching it to its
+//! pass's module (labels and timestamp slots come from the table), and a test checks that every
+//! resource a pass reads was written by an earlier pass or comes from outside the frame.
 
 /// A resource passes read or write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]

@@ -4,23 +4,23 @@
 //! concatenation is the import.
 
 /// Shared frame uniforms, shadow map and lighting.
-pub const FRAME: &str = include_str!("frame.wgsl");
+pub const FRAME: &str = include_str!("frame/frame.wgsl");
 /// The snow material (basic and deformable), importable by other renderers: see its header.
-pub const SNOW: &str = include_str!("snow.wgsl");
+pub const SNOW: &str = include_str!("snow/snow.wgsl");
 /// The snow pass: surface boxes, relief mapping, frag depth.
-pub const SURFACE: &str = include_str!("surface.wgsl");
+pub const SURFACE: &str = include_str!("snow/surface.wgsl");
 /// Opaque meshes and the shadow map.
-pub const MESH: &str = include_str!("mesh.wgsl");
+pub const MESH: &str = include_str!("opaque/mesh.wgsl");
 /// The night sky.
-pub const SKY: &str = include_str!("sky.wgsl");
+pub const SKY: &str = include_str!("sky/sky.wgsl");
 /// Falling snow.
-pub const SNOWFALL: &str = include_str!("snowfall.wgsl");
+pub const SNOWFALL: &str = include_str!("snowfall/snowfall.wgsl");
 /// Resolve and tonemap.
-pub const TONEMAP: &str = include_str!("tonemap.wgsl");
+pub const TONEMAP: &str = include_str!("tonemap/tonemap.wgsl");
 /// Per-surface material choice and indirect arguments.
-pub const CLASSIFY: &str = include_str!("classify.wgsl");
+pub const CLASSIFY: &str = include_str!("classify/classify.wgsl");
 /// Heightmap to filtered shading texture (depression, normal, occlusion).
-pub const HEIGHTFIELD: &str = include_str!("heightfield.wgsl");
+pub const HEIGHTFIELD: &str = include_str!("heightfield/heightfield.wgsl");
 
 /// Module of the classify pass (reads the pool through `pool/texel.wgsl`).
 pub fn classify() -> String {
@@ -33,11 +33,11 @@ pub fn heightfield() -> String {
 }
 
 /// Snow banks from the displaced channel (tessellated tier).
-pub const BANKS: &str = include_str!("tessellate/banks.wgsl");
+pub const BANKS: &str = include_str!("tessellate/banks/banks.wgsl");
 /// Dicing of the snow surfaces' meshes (tessellated tier).
-pub const DICE: &str = include_str!("tessellate/dice.wgsl");
+pub const DICE: &str = include_str!("tessellate/dice/dice.wgsl");
 /// The tessellated tier's snow: displacement, shading, shadow.
-pub const TESS_SURFACE: &str = include_str!("tessellate/tess_surface.wgsl");
+pub const TESS_SURFACE: &str = include_str!("tessellate/snow_shadow/tess_surface.wgsl");
 
 fn join(parts: &[&str]) -> String {
     parts.join("\n")

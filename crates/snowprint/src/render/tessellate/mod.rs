@@ -26,8 +26,11 @@
 //! banks' volume is that fraction of the pushed volume (see [`cpu::bank_field`] and the test
 //! `tests/render_tessellated.rs`).
 
+pub(in crate::render) mod banks;
 pub mod cpu;
+pub(in crate::render) mod dice;
 pub(crate) mod gpu;
+pub(in crate::render) mod snow_shadow;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};

@@ -1,0 +1,110 @@
+//! The moon's two shadow cascades: the near one around what the camera looks at, the far one
+//! around the snow surfaces and every shadow caster. Pure maths on the frame's inputs.
+
+use glam::{Mat4, Vec3};
+
+use super::RenderFrame;
+use super::frame::FrameSurface;
+use super::meshes::GpuMesh;
+
+/// Side of the near shadow cascade, metres.
+const NEAR_CASCADE: f32 = 12.0;
+
+/// The moon's two shadow projections and their texels in metres.
+pub(super) struct ShadowCascades {
+    pub near: Mat4,
+    pub far: Mat4,
+    pub near_texel: f32,
+    pub far_texel: f32,
+}
+
+/// The moon's two shadow cascades: the near one around what the camera looks at, the far one
+/// around the snow surfaces and every shadow caster.
+pub(super) fn shadow_cascades(
+    surfaces: &[FrameSurface<'_>],
+    frame: &RenderFrame<'_>,
+    meshes: &[GpuMesh],
+    shadow_size: u32,
+) -> ShadowCascades {
+    let mut lo = Vec3::splat(f32::MAX);
+    let mut hi = Vec3::splat(f32::MIN);
+    for s in surfaces {
+        let d = s.view.desc;
+        let m = d.local_to_world();
+        let h = d.size * 0.5;
+        for corner in [
+            Vec3::new(-h.x, 0.0, -h.y),
+            Vec3::new(h.x, 0.0, -h.y),
+            Vec3::new(-h.x, d.snow_depth, h.y),
+            Vec3::new(h.x, d.snow_depth, h.y),
+        ] {
+            let p = m.transform_point3(corner);
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    // Receivers beyond the surfaces and the casters (a backdrop, a ground to the horizon) are
+    // left out: they would spread the far cascade's texels over what casts no shadow.
+    for inst in frame.instances.iter().filter(|i| i.casts_shadow) {
+        let r = meshes[inst.mesh.0 as usize].radius;
+        let (scale, _, t) = inst.transform.to_scale_rotation_translation();
+        let r = r * scale.abs().max_element();
+        lo = lo.min(t - Vec3::splat(r));
+        hi = hi.max(t + Vec3::splat(r));
+    }
+    if lo.x > hi.x {
+        lo = Vec3::splat(-1.0);
+        hi = Vec3::splat(1.0);
+    }
+    // Snap the box outwards to whole metres so that moving characters do not shift the shadow
+    // map every frame (that would make shadow edges crawl).
+    lo = lo.floor() - Vec3::ONE;
+    hi = hi.ceil() + Vec3::ONE;
+    let center = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    let dir = frame.environment.moon_direction.normalize();
+    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let view = glam::camera::rh::view::look_at_mat4(center + dir * radius * 2.0, center, up);
+    let mut vlo = Vec3::splat(f32::MAX);
+    let mut vhi = Vec3::splat(f32::MIN);
+    for i in 0..8 {
+        let c = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        let v = view.transform_point3(c);
+        vlo = vlo.min(v);
+        vhi = vhi.max(v);
+    }
+    let (near_z, far_z) = (-vhi.z - 1.0, -vlo.z + 1.0);
+    let proj =
+        glam::camera::rh::proj::directx::orthographic(vlo.x, vhi.x, vlo.y, vhi.y, near_z, far_z);
+    let far_texel = (vhi.x - vlo.x).max(vhi.y - vlo.y) / shadow_size as f32;
+
+    // The near cascade: a square of NEAR_CASCADE metres around the point 40% of the way into
+    // it along the view, with the far cascade's depth range (every caster still casts). Its
+    // centre is snapped to whole texels in the moon's view so that a moving camera does not
+    // make its shadow edges crawl.
+    let cam = &frame.camera;
+    let forward = (cam.target - cam.eye).normalize_or(Vec3::NEG_Z);
+    let focus = view.transform_point3(cam.eye + forward * (NEAR_CASCADE * 0.4));
+    let near_texel = NEAR_CASCADE / shadow_size as f32;
+    let snap = |v: f32| (v / near_texel).round() * near_texel;
+    let (cx, cy) = (snap(focus.x), snap(focus.y));
+    let half = NEAR_CASCADE * 0.5;
+    let near_proj = glam::camera::rh::proj::directx::orthographic(
+        cx - half,
+        cx + half,
+        cy - half,
+        cy + half,
+        near_z,
+        far_z,
+    );
+    ShadowCascades {
+        near: near_proj * view,
+        far: proj * view,
+        near_texel,
+        far_texel,
+    }
+}

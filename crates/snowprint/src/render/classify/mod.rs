@@ -1,0 +1,110 @@
+//! The `classify` pass (compute, `classify.wgsl`): one workgroup per surface reads its heightmap
+//! and writes its state words: whether anything touched it (the basic or the deformable
+//! material), the deepest point, and the indirect arguments of the heightfield dispatch and of
+//! the two snow draws.
+
+use super::frame::FrameSurface;
+use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
+use super::pipeline;
+use super::readback::{Timestamps, compute_writes};
+use super::{PASSES, shaders};
+use crate::gpu::resources::{Growable, bind_group, compute_storage};
+
+pub(super) struct ClassifyPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    /// Per surface: where its heightmap lies in the pool.
+    records: Growable,
+    /// Per surface: [`STATE_WORDS`] words of state and indirect arguments, read by the later
+    /// passes.
+    pub state: Growable,
+    bind_group: Option<wgpu::BindGroup>,
+    surfaces: u32,
+}
+
+impl ClassifyPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("classify"),
+            entries: &[
+                compute_storage(0, true),
+                compute_storage(1, true),
+                compute_storage(2, false),
+            ],
+        });
+        let module = pipeline::shader(device, "classify.wgsl", shaders::classify());
+        let pipeline = pipeline::compute(device, "classify", &module, "classify", &[&layout]);
+        use wgpu::BufferUsages as U;
+        Self {
+            records: Growable::new(
+                device,
+                "classify records",
+                U::STORAGE | U::COPY_DST,
+                std::mem::size_of::<ClassifyRecord>() as u64 * 8,
+            ),
+            state: Growable::new(
+                device,
+                "surface state",
+                U::STORAGE | U::INDIRECT | U::COPY_SRC,
+                STATE_WORDS * 4 * 8,
+            ),
+            layout,
+            pipeline,
+            bind_group: None,
+            surfaces: 0,
+        }
+    }
+
+    /// Upload the surfaces' records and make room for their state.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        pool: &wgpu::Buffer,
+        surfaces: &[FrameSurface<'_>],
+    ) {
+        let n = surfaces.len();
+        let records: Vec<ClassifyRecord> = surfaces
+            .iter()
+            .map(|s| ClassifyRecord {
+                heights: s.view.heights,
+                width: s.view.layout.width,
+                height: s.view.layout.height,
+                box_vertices: BOX_VERTICES,
+                bits: s.view.precision.bits(),
+                _pad: [0; 3],
+            })
+            .collect();
+        if n > 0 {
+            self.records
+                .ensure(device, (n * std::mem::size_of::<ClassifyRecord>()) as u64);
+            queue.write_buffer(&self.records.buffer, 0, bytemuck::cast_slice(&records));
+        }
+        self.state.ensure(device, n.max(1) as u64 * STATE_WORDS * 4);
+        self.surfaces = n as u32;
+        self.bind_group = (n > 0).then(|| {
+            bind_group(
+                device,
+                "classify",
+                &self.layout,
+                &[
+                    pool.as_entire_binding(),
+                    self.records.buffer.as_entire_binding(),
+                    self.state.buffer.as_entire_binding(),
+                ],
+            )
+        });
+    }
+
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, ts: Option<&Timestamps>, slot: usize) {
+        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(PASSES[slot].name),
+            timestamp_writes: compute_writes(ts, slot),
+        });
+        if let Some(bg) = &self.bind_group {
+            p.set_pipeline(&self.pipeline);
+            p.set_bind_group(0, bg, &[]);
+            p.dispatch_workgroups(self.surfaces, 1, 1);
+        }
+    }
+}

@@ -1,0 +1,225 @@
+//! What every pass shares: the frame uniform (camera, moon, sky, lights, options; `frame.wgsl`),
+//! its bind groups with the moon's shadow map and the samplers, and the frame's list of surfaces
+//! as extracted from the world.
+
+use glam::{Vec2, Vec3};
+
+use super::cascades::ShadowCascades;
+use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
+use super::{PointLight, RenderConfig, RenderFrame, SurfaceGeometry, Tier};
+use crate::extract::SurfaceView;
+use crate::gpu::resources::{bind_group, uniform};
+use crate::view::GroundMaterial;
+
+/// Near and far planes of the camera, metres.
+pub(super) const NEAR: f32 = 0.05;
+pub(super) const FAR: f32 = 600.0;
+
+/// A surface of the frame, in the frame's order (its slot in every per-surface table).
+pub(super) struct FrameSurface<'a> {
+    /// The surface as the world's extract gives it.
+    pub view: &'a SurfaceView<'a>,
+    /// The ground under its snow.
+    pub ground: GroundMaterial,
+    /// Its tessellated-tier settings.
+    pub geometry: &'a SurfaceGeometry,
+    /// Whether it is diced this frame (the tessellated tier, and its geometry asks for it).
+    pub tessellated: bool,
+}
+
+impl FrameSurface<'_> {
+    /// Sides of a heightmap texel, metres.
+    pub fn texel(&self) -> Vec2 {
+        let (desc, layout) = (self.view.desc, self.view.layout);
+        Vec2::new(
+            desc.size.x / layout.width as f32,
+            desc.size.y / layout.height as f32,
+        )
+    }
+}
+
+/// The frame uniform's buffer, its layouts and bind groups (with the shadow map and samplers).
+pub(super) struct FrameResources {
+    /// Group 0 of the colour passes: uniform, shadow map, comparison and heightfield samplers.
+    pub layout: wgpu::BindGroupLayout,
+    /// Group 0 of the shadow passes: the uniform alone.
+    pub shadow_layout: wgpu::BindGroupLayout,
+    buffer: wgpu::Buffer,
+    /// Bind groups of `layout` and `shadow_layout` (made once: what they bind lives as long).
+    pub bind_group: wgpu::BindGroup,
+    pub shadow_bind_group: wgpu::BindGroup,
+}
+
+/// The frame's bind group layouts (made before the passes, whose pipelines use them).
+pub(super) struct FrameLayouts {
+    pub layout: wgpu::BindGroupLayout,
+    pub shadow_layout: wgpu::BindGroupLayout,
+}
+
+impl FrameLayouts {
+    pub fn new(device: &wgpu::Device, filterable: bool) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[
+                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(if filterable {
+                        wgpu::SamplerBindingType::Filtering
+                    } else {
+                        wgpu::SamplerBindingType::NonFiltering
+                    }),
+                    count: None,
+                },
+            ],
+        });
+        let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow frame"),
+            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
+        });
+        Self {
+            layout,
+            shadow_layout,
+        }
+    }
+}
+
+impl FrameResources {
+    /// The uniform buffer, samplers and bind groups over the moon's shadow map `shadow_view`.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: FrameLayouts,
+        shadow_view: &wgpu::TextureView,
+        filterable: bool,
+    ) -> Self {
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow comparison"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let filter = if filterable {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        };
+        let linear_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("heightfield"),
+            mag_filter: filter,
+            min_filter: filter,
+            ..Default::default()
+        });
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniforms"),
+            size: std::mem::size_of::<FrameUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let colour_group = bind_group(
+            device,
+            "frame",
+            &layouts.layout,
+            &[
+                buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(shadow_view),
+                wgpu::BindingResource::Sampler(&shadow_sampler),
+                wgpu::BindingResource::Sampler(&linear_sampler),
+            ],
+        );
+        let shadow_bind_group = bind_group(
+            device,
+            "shadow frame",
+            &layouts.shadow_layout,
+            &[buffer.as_entire_binding()],
+        );
+        Self {
+            layout: layouts.layout,
+            shadow_layout: layouts.shadow_layout,
+            buffer,
+            bind_group: colour_group,
+            shadow_bind_group,
+        }
+    }
+
+    /// Upload the frame's uniform.
+    pub fn prepare(&self, queue: &wgpu::Queue, uniform: &FrameUniform) {
+        queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(uniform));
+    }
+}
+
+/// The frame uniform of a frame: camera, moon and sky, the 8 lights nearest the camera, options.
+pub(super) fn frame_uniform(
+    cfg: &RenderConfig,
+    frame: &RenderFrame<'_>,
+    shadow: &ShadowCascades,
+) -> FrameUniform {
+    let (w, h) = (cfg.width * cfg.supersample, cfg.height * cfg.supersample);
+    let aspect = w as f32 / h as f32;
+    let view_proj = frame.camera.projection(aspect, NEAR, FAR) * frame.camera.view();
+    let e = &frame.environment;
+    let v4 = |v: Vec3, w: f32| [v.x, v.y, v.z, w];
+    // The 8 lights nearest the camera.
+    let mut lights: Vec<&PointLight> = frame.lights.iter().collect();
+    lights.sort_by(|a, b| {
+        a.position
+            .distance_squared(frame.camera.eye)
+            .total_cmp(&b.position.distance_squared(frame.camera.eye))
+    });
+    lights.truncate(MAX_POINT_LIGHTS);
+    let mut raw = [PointLightRaw::default(); MAX_POINT_LIGHTS];
+    for (r, l) in raw.iter_mut().zip(&lights) {
+        *r = PointLightRaw {
+            position_radius: v4(l.position, l.radius),
+            color: v4(l.color, 0.0),
+        };
+    }
+    // Surfaces the tessellated tier does not tessellate are relief mapped.
+    let tier = match cfg.tier {
+        Tier::Relief | Tier::Tessellated => 0,
+        Tier::Pom => 1,
+    };
+    FrameUniform {
+        view_proj: view_proj.to_cols_array_2d(),
+        inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+        shadow_near: shadow.near.to_cols_array_2d(),
+        shadow_far: shadow.far.to_cols_array_2d(),
+        shadow_texels: [shadow.near_texel, shadow.far_texel, 0.0, 0.0],
+        eye: v4(frame.camera.eye, frame.time),
+        moon_dir: v4(
+            e.moon_direction.normalize(),
+            e.moon_radius_degrees.to_radians().cos(),
+        ),
+        moon_color: v4(e.moon_color, 0.0),
+        sky_zenith: v4(e.sky_zenith, e.exposure),
+        sky_horizon: v4(e.sky_horizon, e.fog_density),
+        ground_bounce: v4(e.ground_bounce, e.city_glow),
+        sss_tint: v4(e.sss_tint, e.sss_strength),
+        sky_ambient: v4(e.sky_ambient, 0.0),
+        viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
+        options: [
+            cfg.debug_view.code(),
+            lights.len() as u32,
+            tier,
+            if frame.snowfall { cfg.snowflakes } else { 0 },
+        ],
+        lights: raw,
+    }
+}

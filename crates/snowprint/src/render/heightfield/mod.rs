@@ -1,0 +1,268 @@
+//! The `heightfield` pass (compute, indirect, `heightfield.wgsl`): each deformed surface's
+//! heightmap becomes its shading textures: depression, normal and ambient occlusion (`shape`),
+//! moon visibility and displaced snow (`light`). Surfaces left untouched dispatch nothing.
+//! The pass owns those textures (and the banks' two, which the tessellated tier writes).
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+
+use super::frame::FrameSurface;
+use super::gpu::{HeightfieldParams, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use super::pipeline::{self, storage_texture_entry};
+use super::readback::{Timestamps, compute_writes, f16_to_f32, map_staging};
+use super::targets::HEIGHTFIELD_FORMAT;
+use super::{PASSES, RenderError, RenderResult, SurfaceFields, shaders};
+use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
+use crate::surface::SurfaceId;
+
+/// A deformed surface's shading textures, written by the heightfield pass.
+pub(super) struct HeightfieldTexture {
+    pub size: (u32, u32),
+    /// Depression, normal x and z, ambient occlusion.
+    pub shape: wgpu::TextureView,
+    /// Moon visibility, displaced snow.
+    pub light: wgpu::TextureView,
+    /// Room for banks around each texel (the bank passes' scratch).
+    pub bank_scratch: wgpu::TextureView,
+    /// Bank heights, metres.
+    pub bank: wgpu::TextureView,
+    /// The textures of shape, light and bank, for readbacks.
+    pub textures: [wgpu::Texture; 3],
+}
+
+impl HeightfieldTexture {
+    fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
+        let texture = |label| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: HEIGHTFIELD_FORMAT,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let shape = texture("snow heightfield");
+        let light = texture("snow heightfield light");
+        let bank = texture("snow banks");
+        let scratch = texture("snow bank scratch");
+        Self {
+            size,
+            shape: view(&shape),
+            light: view(&light),
+            bank: view(&bank),
+            bank_scratch: view(&scratch),
+            textures: [shape, light, bank],
+        }
+    }
+}
+
+pub(super) struct HeightfieldPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    /// Per surface: `HeightfieldParams` in a uniform block.
+    params: Growable,
+    /// Every surface's textures (kept while its size holds).
+    textures: HashMap<SurfaceId, HeightfieldTexture>,
+    /// This frame's bind groups, in surface order.
+    bind_groups: Vec<wgpu::BindGroup>,
+}
+
+impl HeightfieldPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("heightfield"),
+            entries: &[
+                compute_storage(0, true),
+                uniform(1, wgpu::ShaderStages::COMPUTE),
+                storage_texture_entry(2),
+                storage_texture_entry(3),
+            ],
+        });
+        let module = pipeline::shader(device, "heightfield.wgsl", shaders::heightfield());
+        let pipeline = pipeline::compute(device, "heightfield", &module, "heightfield", &[&layout]);
+        Self {
+            params: Growable::new(
+                device,
+                "heightfield params",
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                UNIFORM_STRIDE * 8,
+            ),
+            layout,
+            pipeline,
+            textures: HashMap::new(),
+            bind_groups: Vec::new(),
+        }
+    }
+
+    /// A surface's textures (after [`HeightfieldPass::prepare`] of a frame that drew it).
+    pub fn texture(&self, id: SurfaceId) -> Option<&HeightfieldTexture> {
+        self.textures.get(&id)
+    }
+
+    /// Upload each surface's parameters (with the moon in its frame), make its textures at its
+    /// heightmap's size, and bind them.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        pool: &wgpu::Buffer,
+        surfaces: &[FrameSurface<'_>],
+        moon_direction: Vec3,
+    ) {
+        let stride = UNIFORM_STRIDE as usize;
+        let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
+        for (s, surface) in surfaces.iter().enumerate() {
+            let (desc, layout) = (surface.view.desc, surface.view.layout);
+            let local_to_world = desc.local_to_world();
+            let p = HeightfieldParams {
+                heights: surface.view.heights,
+                width: layout.width,
+                height: layout.height,
+                bits: surface.view.precision.bits(),
+                snow_depth: desc.snow_depth,
+                texel_x: desc.size.x / layout.width as f32,
+                texel_z: desc.size.y / layout.height as f32,
+                _pad2: 0.0,
+                light: {
+                    let l = local_to_world
+                        .inverse()
+                        .transform_vector3(moon_direction)
+                        .normalize();
+                    [l.x, l.y, l.z, 0.0]
+                },
+            };
+            bytes[s * stride..s * stride + std::mem::size_of::<HeightfieldParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        self.params.ensure(device, bytes.len() as u64);
+        queue.write_buffer(&self.params.buffer, 0, &bytes);
+        for s in surfaces {
+            let size = (s.view.layout.width, s.view.layout.height);
+            if self.textures.get(&s.view.id).is_none_or(|t| t.size != size) {
+                self.textures
+                    .insert(s.view.id, HeightfieldTexture::new(device, size));
+            }
+        }
+        self.bind_groups = surfaces
+            .iter()
+            .enumerate()
+            .map(|(s, surface)| {
+                let tex = &self.textures[&surface.view.id];
+                bind_group(
+                    device,
+                    "heightfield",
+                    &self.layout,
+                    &[
+                        pool.as_entire_binding(),
+                        uniform_block(
+                            &self.params.buffer,
+                            s,
+                            std::mem::size_of::<HeightfieldParams>(),
+                        ),
+                        wgpu::BindingResource::TextureView(&tex.shape),
+                        wgpu::BindingResource::TextureView(&tex.light),
+                    ],
+                )
+            })
+            .collect();
+    }
+
+    /// One indirect dispatch per surface, its arguments written by `classify` in `state`.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        state: &wgpu::Buffer,
+    ) {
+        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(PASSES[slot].name),
+            timestamp_writes: compute_writes(ts, slot),
+        });
+        p.set_pipeline(&self.pipeline);
+        for (s, bg) in self.bind_groups.iter().enumerate() {
+            p.set_bind_group(0, bg, &[]);
+            p.dispatch_workgroups_indirect(
+                state,
+                (s as u64 * STATE_WORDS + STATE_HEIGHTFIELD_DISPATCH) * 4,
+            );
+        }
+    }
+
+    /// A surface's smoothed depression, displaced channel and bank heights as the latest frame's
+    /// passes wrote them.
+    pub fn read_fields(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        surface: SurfaceId,
+    ) -> RenderResult<SurfaceFields> {
+        let tex = self
+            .textures
+            .get(&surface)
+            .ok_or_else(|| RenderError::Readback("the surface has no heightfield yet".into()))?;
+        let (w, h) = tex.size;
+        let row = (w * 8).div_ceil(256) * 256;
+        let mut channels = Vec::new();
+        for (texture, channel) in [
+            (&tex.textures[0], 0),
+            (&tex.textures[1], 1),
+            (&tex.textures[2], 0),
+        ] {
+            let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("field readback"),
+                size: (row * h) as u64,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = device.create_command_encoder(&Default::default());
+            encoder.copy_texture_to_buffer(
+                texture.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &staging,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: Some(h),
+                    },
+                },
+                wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+            );
+            queue.submit([encoder.finish()]);
+            let data = map_staging(device, &staging)?;
+            let mut values = Vec::with_capacity((w * h) as usize);
+            for r in 0..h {
+                for c in 0..w {
+                    let o = (r * row + c * 8 + channel * 2) as usize;
+                    values.push(f16_to_f32(u16::from_le_bytes([data[o], data[o + 1]])));
+                }
+            }
+            channels.push(values);
+        }
+        let bank = channels.pop().unwrap_or_default();
+        let displaced = channels.pop().unwrap_or_default();
+        let depression = channels.pop().unwrap_or_default();
+        Ok(SurfaceFields {
+            width: w,
+            height: h,
+            depression,
+            displaced,
+            bank,
+        })
+    }
+}

@@ -1,0 +1,160 @@
+//! The meshes a frame draws: registered meshes on the GPU, and each frame's instances uploaded
+//! grouped by mesh (all of them for the opaque pass, then the shadow casters for the shadow pass).
+
+use glam::{Mat3, Vec3};
+
+use super::gpu::InstanceRaw;
+use super::{Instance, RenderError, RenderMeshId, RenderResult, geometry};
+use crate::gpu::resources::Growable;
+use crate::mesh::Mesh;
+
+pub(super) struct GpuMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    pub radius: f32,
+}
+
+/// Draws of one mesh: its index and a range of instances.
+type Run = (u32, std::ops::Range<u32>);
+
+/// Registered meshes and the frame's instances.
+pub(super) struct MeshSet {
+    pub meshes: Vec<GpuMesh>,
+    instances: Growable,
+    /// This frame's draws: every instance, then the shadow casters.
+    draws: Vec<Run>,
+    shadow_draws: Vec<Run>,
+}
+
+impl MeshSet {
+    pub fn new(device: &wgpu::Device) -> Self {
+        Self {
+            meshes: Vec::new(),
+            instances: Growable::new(
+                device,
+                "mesh instances",
+                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                144 * 64,
+            ),
+            draws: Vec::new(),
+            shadow_draws: Vec::new(),
+        }
+    }
+
+    /// Register a mesh; normals are computed here (smooth, split at creases).
+    pub fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
+        let gpu = upload(device, mesh)?;
+        self.meshes.push(gpu);
+        Ok(RenderMeshId(self.meshes.len() as u32 - 1))
+    }
+
+    /// Replace a registered mesh.
+    pub fn update(
+        &mut self,
+        device: &wgpu::Device,
+        id: RenderMeshId,
+        mesh: &Mesh,
+    ) -> RenderResult<()> {
+        if id.0 as usize >= self.meshes.len() {
+            return Err(RenderError::StaleMesh { index: id.0 });
+        }
+        self.meshes[id.0 as usize] = upload(device, mesh)?;
+        Ok(())
+    }
+
+    /// Upload the frame's instances: all of them grouped by mesh, then the shadow casters grouped
+    /// by mesh.
+    pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &[Instance]) {
+        let mut order: Vec<usize> = (0..frame.len()).collect();
+        order.sort_by_key(|&i| frame[i].mesh.0);
+        let raw = |inst: &Instance| {
+            let normal = Mat3::from_mat4(inst.transform).inverse().transpose();
+            let c = |v: Vec3| [v.x, v.y, v.z, 0.0];
+            InstanceRaw {
+                model: inst.transform.to_cols_array_2d(),
+                normal: [c(normal.x_axis), c(normal.y_axis), c(normal.z_axis)],
+                albedo_material: [
+                    inst.albedo[0],
+                    inst.albedo[1],
+                    inst.albedo[2],
+                    inst.material.code(),
+                ],
+                params: [inst.roughness, inst.emission, inst.snow_cover, inst.seed],
+            }
+        };
+        let mut instances: Vec<InstanceRaw> = order.iter().map(|&i| raw(&frame[i])).collect();
+        let casters: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&i| frame[i].casts_shadow)
+            .collect();
+        instances.extend(casters.iter().map(|&i| raw(&frame[i])));
+        let runs = |ids: &[usize], first: u32| {
+            let mut out: Vec<Run> = Vec::new();
+            for (k, &i) in ids.iter().enumerate() {
+                let mesh = frame[i].mesh.0;
+                let at = first + k as u32;
+                match out.last_mut() {
+                    Some((m, r)) if *m == mesh => r.end = at + 1,
+                    _ => out.push((mesh, at..at + 1)),
+                }
+            }
+            out
+        };
+        self.draws = runs(&order, 0);
+        self.shadow_draws = runs(&casters, order.len() as u32);
+        if !instances.is_empty() {
+            self.instances
+                .ensure(device, std::mem::size_of_val(instances.as_slice()) as u64);
+            queue.write_buffer(&self.instances.buffer, 0, bytemuck::cast_slice(&instances));
+        }
+    }
+
+    /// Whether the frame has instances (`shadow`: shadow casters) to draw.
+    pub fn has_draws(&self, shadow: bool) -> bool {
+        !if shadow {
+            &self.shadow_draws
+        } else {
+            &self.draws
+        }
+        .is_empty()
+    }
+
+    /// Draw the frame's instances (`shadow`: the shadow casters) with the pass's pipeline and
+    /// bind groups set.
+    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, shadow: bool) {
+        p.set_vertex_buffer(1, self.instances.buffer.slice(..));
+        let runs = if shadow {
+            &self.shadow_draws
+        } else {
+            &self.draws
+        };
+        for (mesh, range) in runs {
+            let m = &self.meshes[*mesh as usize];
+            p.set_vertex_buffer(0, m.vertices.slice(..));
+            p.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+            p.draw_indexed(0..m.index_count, 0, range.clone());
+        }
+    }
+}
+
+fn upload(device: &wgpu::Device, mesh: &Mesh) -> RenderResult<GpuMesh> {
+    mesh.validate("render mesh")?;
+    let (vertices, indices) = geometry::shade_normals(mesh, geometry::CREASE_DEGREES);
+    use wgpu::util::DeviceExt;
+    Ok(GpuMesh {
+        vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("render mesh vertices"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        }),
+        indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("render mesh indices"),
+            contents: bytemuck::cast_slice(&indices),
+            usage: wgpu::BufferUsages::INDEX,
+        }),
+        index_count: indices.len() as u32,
+        radius: mesh.bounding_radius(),
+    })
+}

@@ -1,0 +1,206 @@
+//! Small builders shared by the passes: shader modules, pipeline layouts, compute and render
+//! pipelines, depth states and layout entries.
+
+use super::targets::{DEPTH_FORMAT, HEIGHTFIELD_FORMAT};
+
+/// A WGSL shader module.
+pub(super) fn shader(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}
+
+/// A pipeline layout of bind groups 0, 1, ... in order.
+pub(super) fn layout(
+    device: &wgpu::Device,
+    label: &str,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    })
+}
+
+/// A compute pipeline of one entry point.
+pub(super) fn compute(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout(device, label, groups)),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// A render pipeline with a vertex and a fragment stage (override constants on the fragment
+/// stage only).
+pub(super) struct Raster<'a> {
+    pub label: &'a str,
+    pub module: &'a wgpu::ShaderModule,
+    pub vs: &'a str,
+    pub fs: &'a str,
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    pub groups: &'a [&'a wgpu::BindGroupLayout],
+    pub primitive: wgpu::PrimitiveState,
+    pub depth: Option<wgpu::DepthStencilState>,
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    pub constants: &'a [(&'a str, f64)],
+}
+
+impl Raster<'_> {
+    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(&layout(device, self.label, self.groups)),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some(self.vs),
+                compilation_options: Default::default(),
+                buffers: self.buffers,
+            },
+            primitive: self.primitive,
+            depth_stencil: self.depth.clone(),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fs),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: self.constants,
+                    ..Default::default()
+                },
+                targets: self.targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
+
+/// A depth-only pipeline drawing into one of the moon's shadow cascades: the cascade is the
+/// override constant `constant` of the vertex stage.
+pub(super) fn shadow_caster(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    buffers: &[Option<wgpu::VertexBufferLayout>],
+    constant: &str,
+) -> [wgpu::RenderPipeline; 2] {
+    [0.0, 1.0].map(|cascade| {
+        let constants = [(constant, cascade)];
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                buffers,
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: shadow_depth_state(),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        })
+    })
+}
+
+/// Render target of the scene's HDR colour, unblended.
+pub(super) fn hdr_target() -> [Option<wgpu::ColorTargetState>; 1] {
+    [Some(wgpu::ColorTargetState {
+        format: super::targets::HDR_FORMAT,
+        blend: None,
+        write_mask: wgpu::ColorWrites::ALL,
+    })]
+}
+
+/// Back faces culled.
+pub(super) fn back_culled() -> wgpu::PrimitiveState {
+    wgpu::PrimitiveState {
+        cull_mode: Some(wgpu::Face::Back),
+        ..Default::default()
+    }
+}
+
+/// `MANUAL_FILTER` where the adapter cannot filter `Rgba16Float` (the material filters by hand).
+pub(super) fn manual_filter(filterable: bool) -> &'static [(&'static str, f64)] {
+    if filterable {
+        &[]
+    } else {
+        &[("MANUAL_FILTER", 1.0)]
+    }
+}
+
+pub(super) fn depth_state(
+    compare: wgpu::CompareFunction,
+    write: bool,
+) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(compare),
+        stencil: wgpu::StencilState::default(),
+        bias: wgpu::DepthBiasState::default(),
+    })
+}
+
+/// Depth state of everything drawn into the moon's shadow cascades (meshes, and the tessellated
+/// tier's snow): nearest wins, biased against acne by slope.
+pub(super) fn shadow_depth_state() -> Option<wgpu::DepthStencilState> {
+    depth_state(wgpu::CompareFunction::Less, true).map(|d| wgpu::DepthStencilState {
+        bias: wgpu::DepthBiasState {
+            constant: 2,
+            slope_scale: 2.0,
+            clamp: 0.0,
+        },
+        ..d
+    })
+}
+
+/// A 2D texture read in the fragment stage.
+pub(super) fn texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A heightfield texture written by a compute pass.
+pub(super) fn storage_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: HEIGHTFIELD_FORMAT,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}

@@ -1,0 +1,84 @@
+//! What a frame reports: pass times, each surface's material, the dicing's overflow.
+
+use crate::surface::SurfaceId;
+
+/// GPU time of one pass.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PassTime {
+    /// The pass's name in [`PASSES`](super::PASSES).
+    pub name: &'static str,
+    /// Milliseconds.
+    pub gpu_ms: f64,
+}
+
+/// Which snow material a surface was drawn with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SnowMaterialKind {
+    /// The basic material: nothing has pressed the surface.
+    Basic,
+    /// The deformable material.
+    Deformable,
+}
+
+/// How one surface was drawn.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SurfaceShading {
+    /// The surface (its index).
+    #[serde(serialize_with = "serialize_surface_id")]
+    pub surface: SurfaceId,
+    /// The material the GPU chose.
+    pub material: SnowMaterialKind,
+    /// The deepest print, as a fraction of the snow depth.
+    pub deepest: f32,
+    /// Triangles the dicing pass made for it (the tessellated tier; 0 otherwise or when culled).
+    pub triangles: u32,
+}
+
+fn serialize_surface_id<S: serde::Serializer>(id: &SurfaceId, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u32(id.index())
+}
+
+/// What the GPU reported about a frame.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct FrameReport {
+    /// GPU time per pass, in [`PASSES`](super::PASSES) order; empty when the adapter has no timestamp queries.
+    pub pass_times: Vec<PassTime>,
+    /// Each surface drawn and its material.
+    pub surfaces: Vec<SurfaceShading>,
+    /// Base triangles the dicing pass dropped for want of room
+    /// ([`DiceSettings::max_triangles`]); 0 when everything fit.
+    pub dice_overflow: u32,
+}
+
+impl FrameReport {
+    /// Surfaces drawn with the basic material.
+    pub fn basic_material_surfaces(&self) -> Vec<SurfaceId> {
+        self.surfaces
+            .iter()
+            .filter(|s| s.material == SnowMaterialKind::Basic)
+            .map(|s| s.surface)
+            .collect()
+    }
+}
+
+/// An offscreen frame.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// Pixels, RGBA 8 bits per channel, sRGB, rows top to bottom, no padding.
+    pub rgba8: Vec<u8>,
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+    /// GPU time per pass (empty without timestamp queries).
+    pub pass_times: Vec<PassTime>,
+    /// Surfaces drawn with the basic material.
+    pub basic_material_surfaces: Vec<SurfaceId>,
+    /// Each surface drawn and its material.
+    pub surfaces: Vec<SurfaceShading>,
+    /// Base triangles the dicing pass dropped for want of room (0 when everything fit).
+    pub dice_overflow: u32,
+    /// CPU time from the call to the pixels being back, milliseconds.
+    pub cpu_ms: f64,
+}

@@ -1,0 +1,52 @@
+//! The `sky` pass (`sky.wgsl`): the night sky, the moon and the haze, drawn as one triangle behind
+//! everything (depth test only).
+
+use super::readback::{Timestamps, render_writes};
+use super::targets::Targets;
+use super::{PASSES, pipeline, shaders};
+
+pub(super) struct SkyPass {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl SkyPass {
+    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+        let module = pipeline::shader(device, "sky.wgsl", shaders::sky());
+        let pipeline = pipeline::Raster {
+            label: "sky",
+            module: &module,
+            vs: "vs_sky",
+            fs: "fs_sky",
+            buffers: &[],
+            groups: &[frame_layout],
+            primitive: wgpu::PrimitiveState::default(),
+            depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, false),
+            targets: &pipeline::hdr_target(),
+            constants: &[],
+        }
+        .build(device);
+        Self { pipeline }
+    }
+
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        targets: &Targets,
+        frame: &wgpu::BindGroup,
+    ) {
+        let attachments = targets.color(wgpu::LoadOp::Load);
+        let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(PASSES[slot].name),
+            color_attachments: &attachments,
+            depth_stencil_attachment: targets.depth(None),
+            timestamp_writes: render_writes(ts, slot),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        p.set_pipeline(&self.pipeline);
+        p.set_bind_group(0, frame, &[]);
+        p.draw(0..3, 0..1);
+    }
+}

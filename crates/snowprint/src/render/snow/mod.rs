@@ -1,0 +1,210 @@
+//! The `snow` pass (`surface.wgsl` over the material `snow.wgsl`): each snow surface drawn as the
+//! box of its slab, with indirect draws written by `classify`: the basic material for untouched
+//! snow, the deformable one (relief mapping or POM through the heightfield) for the rest. In the
+//! tessellated tier the diced surfaces are drawn after, in a second render pass (see
+//! [`TessSurface`]); the pass's timestamps span both.
+
+use super::frame::FrameSurface;
+use super::gpu::{
+    STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, SurfaceUniform, UNIFORM_STRIDE,
+};
+use super::heightfield::HeightfieldPass;
+use super::pipeline::{self, texture_entry};
+use super::readback::{Timestamps, render_span};
+use super::targets::{KEEP, Targets};
+use super::tessellate::dice::DicePass;
+use super::tessellate::snow_shadow::TessSurface;
+use super::{PASSES, RenderConfig, shaders};
+use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
+use crate::view::GroundMaterial;
+
+pub(super) struct SnowPass {
+    layout: wgpu::BindGroupLayout,
+    basic: wgpu::RenderPipeline,
+    deformable: wgpu::RenderPipeline,
+    /// Per surface: `SurfaceUniform` in a uniform block (also bound by the tessellated draws).
+    pub uniforms: Growable,
+    /// This frame's group 1 per surface slot; `None` where the tessellated tier dices it.
+    bind_groups: Vec<Option<wgpu::BindGroup>>,
+}
+
+impl SnowPass {
+    pub fn new(
+        device: &wgpu::Device,
+        frame_layout: &wgpu::BindGroupLayout,
+        filterable: bool,
+    ) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("snow surface"),
+            entries: &[
+                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                texture_entry(1, wgpu::TextureSampleType::Float { filterable }),
+                texture_entry(2, wgpu::TextureSampleType::Float { filterable }),
+            ],
+        });
+        let module = pipeline::shader(device, "surface.wgsl", shaders::surface());
+        let snow = |label, fs, constants| {
+            pipeline::Raster {
+                label,
+                module: &module,
+                vs: "vs_surface",
+                fs,
+                buffers: &[],
+                groups: &[frame_layout, &layout],
+                primitive: pipeline::back_culled(),
+                depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
+                targets: &pipeline::hdr_target(),
+                constants,
+            }
+            .build(device)
+        };
+        let basic = snow("snow basic", "fs_basic", &[]);
+        let deformable = snow(
+            "snow deformable",
+            "fs_deformable",
+            pipeline::manual_filter(filterable),
+        );
+        Self {
+            uniforms: Growable::new(
+                device,
+                "snow surfaces",
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                UNIFORM_STRIDE * 8,
+            ),
+            layout,
+            basic,
+            deformable,
+            bind_groups: Vec::new(),
+        }
+    }
+
+    /// Upload each surface's uniform (transform, grid, ground, search and look) and bind it with
+    /// its heightfield textures.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        cfg: &RenderConfig,
+        surfaces: &[FrameSurface<'_>],
+        heightfields: &HeightfieldPass,
+    ) {
+        let search = cfg.search_settings();
+        let look = cfg.look;
+        let stride = UNIFORM_STRIDE as usize;
+        let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
+        for (s, surface) in surfaces.iter().enumerate() {
+            let (desc, layout) = (surface.view.desc, surface.view.layout);
+            let texel = surface.texel();
+            let local_to_world = desc.local_to_world();
+            let u = SurfaceUniform {
+                local_to_world: local_to_world.to_cols_array_2d(),
+                world_to_local: local_to_world.inverse().to_cols_array_2d(),
+                half_size: (desc.size * 0.5).to_array(),
+                snow_depth: desc.snow_depth,
+                texel: texel.x.max(texel.y),
+                grid: [layout.width as f32, layout.height as f32],
+                ground: match surface.ground {
+                    GroundMaterial::RoofTiles => 0,
+                    GroundMaterial::Concrete => 1,
+                },
+                index: s as u32,
+                search: [
+                    search.taps_per_texel,
+                    search.min_taps as f32,
+                    search.max_taps as f32,
+                    search.refine_taps as f32,
+                ],
+                look: [
+                    look.ground_from,
+                    look.ground_full,
+                    look.occlusion,
+                    search.shadow_taps as f32,
+                ],
+                pattern: [
+                    desc.center.x,
+                    desc.center.z,
+                    look.switch_bits() as f32,
+                    surface.geometry.macro_waves,
+                ],
+            };
+            bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        self.uniforms.ensure(device, bytes.len() as u64);
+        queue.write_buffer(&self.uniforms.buffer, 0, &bytes);
+        self.bind_groups = surfaces
+            .iter()
+            .enumerate()
+            .map(|(s, surface)| {
+                if surface.tessellated {
+                    return None;
+                }
+                let tex = heightfields.texture(surface.view.id)?;
+                Some(bind_group(
+                    device,
+                    "snow surface",
+                    &self.layout,
+                    &[
+                        uniform_block(
+                            &self.uniforms.buffer,
+                            s,
+                            std::mem::size_of::<SurfaceUniform>(),
+                        ),
+                        wgpu::BindingResource::TextureView(&tex.shape),
+                        wgpu::BindingResource::TextureView(&tex.light),
+                    ],
+                ))
+            })
+            .collect();
+    }
+
+    /// The relief-mapped surfaces (indirect draws of both materials), then the diced ones.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        targets: &Targets,
+        frame: &wgpu::BindGroup,
+        state: &wgpu::Buffer,
+        tess: &TessSurface,
+        dice: &DicePass,
+    ) {
+        {
+            let attachments = targets.color(wgpu::LoadOp::Load);
+            let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(PASSES[slot].name),
+                color_attachments: &attachments,
+                depth_stencil_attachment: targets.depth(KEEP),
+                // The pass's time spans this render pass and the tessellated one after it.
+                timestamp_writes: render_span(ts, slot, true, false),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            p.set_bind_group(0, frame, &[]);
+            for (pipeline, offset) in [
+                (&self.basic, STATE_BASIC_DRAW),
+                (&self.deformable, STATE_DEFORMABLE_DRAW),
+            ] {
+                p.set_pipeline(pipeline);
+                for (s, bg) in self.bind_groups.iter().enumerate() {
+                    if let Some(bg) = bg {
+                        p.set_bind_group(1, bg, &[]);
+                        p.draw_indirect(state, (s as u64 * STATE_WORDS + offset) * 4);
+                    }
+                }
+            }
+        }
+        let attachments = targets.color(wgpu::LoadOp::Load);
+        let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("snow (tessellated)"),
+            color_attachments: &attachments,
+            depth_stencil_attachment: targets.depth(KEEP),
+            timestamp_writes: render_span(ts, slot, false, true),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        tess.draw(&mut p, frame, dice);
+    }
+}

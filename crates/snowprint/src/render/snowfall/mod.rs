@@ -1,0 +1,61 @@
+//! The `snowfall` pass (`snowfall.wgsl`): falling flakes as instanced quads, blended over the
+//! scene and hidden by its depth. The frame uniform carries the number of flakes (0: none).
+
+use super::readback::{Timestamps, render_writes};
+use super::targets::Targets;
+use super::{PASSES, pipeline, shaders};
+
+pub(super) struct SnowfallPass {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl SnowfallPass {
+    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+        let module = pipeline::shader(device, "snowfall.wgsl", shaders::snowfall());
+        let blended = [Some(wgpu::ColorTargetState {
+            format: super::targets::HDR_FORMAT,
+            blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        let pipeline = pipeline::Raster {
+            label: "snowfall",
+            module: &module,
+            vs: "vs_flake",
+            fs: "fs_flake",
+            buffers: &[],
+            groups: &[frame_layout],
+            primitive: wgpu::PrimitiveState::default(),
+            depth: pipeline::depth_state(wgpu::CompareFunction::Less, false),
+            targets: &blended,
+            constants: &[],
+        }
+        .build(device);
+        Self { pipeline }
+    }
+
+    /// Draw `flakes` flakes (the frame uniform's count).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        targets: &Targets,
+        frame: &wgpu::BindGroup,
+        flakes: u32,
+    ) {
+        let attachments = targets.color(wgpu::LoadOp::Load);
+        let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(PASSES[slot].name),
+            color_attachments: &attachments,
+            depth_stencil_attachment: targets.depth(None),
+            timestamp_writes: render_writes(ts, slot),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if flakes > 0 {
+            p.set_pipeline(&self.pipeline);
+            p.set_bind_group(0, frame, &[]);
+            p.draw(0..6, 0..flakes);
+        }
+    }
+}

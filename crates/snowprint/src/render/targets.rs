@@ -1,0 +1,112 @@
+//! The frame's render targets: the supersampled HDR colour and depth the passes draw into, and
+//! the offscreen output with its readback buffer.
+
+/// Format of the offscreen output ([`Renderer::render`](super::Renderer::render)).
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub(super) const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+pub(super) struct Targets {
+    pub size: (u32, u32),
+    pub color_view: wgpu::TextureView,
+    pub depth_view: wgpu::TextureView,
+    pub output: wgpu::Texture,
+    pub output_view: wgpu::TextureView,
+    pub readback: wgpu::Buffer,
+    pub padded_row: u32,
+}
+
+impl Targets {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, supersample: u32) -> Self {
+        let texture = |label, w, h, format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        use wgpu::TextureUsages as U;
+        let (iw, ih) = (width * supersample, height * supersample);
+        let color = texture(
+            "scene colour",
+            iw,
+            ih,
+            HDR_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+        );
+        let depth = texture(
+            "scene depth",
+            iw,
+            ih,
+            DEPTH_FORMAT,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+        );
+        let output = texture(
+            "output",
+            width,
+            height,
+            OUTPUT_FORMAT,
+            U::RENDER_ATTACHMENT | U::COPY_SRC,
+        );
+        let padded_row = (width * 4).div_ceil(256) * 256;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("output readback"),
+            size: padded_row as u64 * height as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            size: (width, height),
+            color_view: color.create_view(&Default::default()),
+            depth_view: depth.create_view(&Default::default()),
+            output_view: output.create_view(&Default::default()),
+            output,
+            readback,
+            padded_row,
+        }
+    }
+
+    /// The scene colour as a pass's only colour attachment.
+    pub fn color(
+        &self,
+        load: wgpu::LoadOp<wgpu::Color>,
+    ) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 1] {
+        [Some(wgpu::RenderPassColorAttachment {
+            view: &self.color_view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load,
+                store: wgpu::StoreOp::Store,
+            },
+        })]
+    }
+
+    /// The scene depth as a pass's depth attachment (`None`: read-only).
+    pub fn depth(
+        &self,
+        ops: Option<wgpu::Operations<f32>>,
+    ) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {
+        Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &self.depth_view,
+            depth_ops: ops,
+            stencil_ops: None,
+        })
+    }
+}
+
+/// Load and store: a pass that draws over what earlier passes left.
+pub(super) const KEEP: Option<wgpu::Operations<f32>> = Some(wgpu::Operations {
+    load: wgpu::LoadOp::Load,
+    store: wgpu::StoreOp::Store,
+});

@@ -1,0 +1,153 @@
+//! The `banks` pass (compute, indirect, `banks.wgsl`): a share of the snow each diced surface's
+//! captures pushed down rises in banks beside the trails. Two dispatches per surface over the
+//! deformed texels only (the heightfield's indirect arguments): `bank_norm` spreads each texel's
+//! share into the scratch texture, `bank_gather` collects it into the bank heights.
+
+use super::BankParams;
+use super::gpu::texture;
+use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
+use crate::render::frame::FrameSurface;
+use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use crate::render::heightfield::HeightfieldPass;
+use crate::render::readback::{Timestamps, compute_writes};
+use crate::render::{PASSES, pipeline, shaders};
+
+pub(in crate::render) struct BanksPass {
+    layout: wgpu::BindGroupLayout,
+    norm: wgpu::ComputePipeline,
+    gather: wgpu::ComputePipeline,
+    /// Per surface: `BankParams` in a uniform block.
+    params: Growable,
+    /// This frame's bind groups (norm, gather) per surface; `None` where it is not diced.
+    bind_groups: Vec<Option<[wgpu::BindGroup; 2]>>,
+}
+
+impl BanksPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("banks"),
+            entries: &[
+                uniform(0, c),
+                texture(1, c, false),
+                texture(2, c, false),
+                texture(3, c, false),
+                pipeline::storage_texture_entry(4),
+            ],
+        });
+        let module = pipeline::shader(device, "banks.wgsl", shaders::BANKS.to_owned());
+        let norm = pipeline::compute(device, "bank norm", &module, "bank_norm", &[&layout]);
+        let gather = pipeline::compute(device, "bank gather", &module, "bank_gather", &[&layout]);
+        Self {
+            params: Growable::new(
+                device,
+                "bank params",
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                256 * 8,
+            ),
+            layout,
+            norm,
+            gather,
+            bind_groups: Vec::new(),
+        }
+    }
+
+    /// Upload each diced surface's bank parameters and bind its heightfield textures (nothing
+    /// outside the tessellated tier, `active` false).
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        active: bool,
+        surfaces: &[FrameSurface<'_>],
+        heightfields: &HeightfieldPass,
+    ) {
+        self.bind_groups.clear();
+        if !active {
+            return;
+        }
+        let stride = UNIFORM_STRIDE as usize;
+        let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
+        for (s, surface) in surfaces.iter().enumerate() {
+            if !surface.tessellated {
+                continue;
+            }
+            let (desc, layout) = (surface.view.desc, surface.view.layout);
+            let bank = BankParams::new(
+                layout.width,
+                layout.height,
+                surface.texel(),
+                desc.snow_depth,
+                surface.geometry.banks,
+            );
+            bytes[s * stride..s * stride + std::mem::size_of::<BankParams>()]
+                .copy_from_slice(bytemuck::bytes_of(&bank));
+        }
+        self.params.ensure(device, bytes.len() as u64);
+        queue.write_buffer(&self.params.buffer, 0, &bytes);
+        let tv = wgpu::BindingResource::TextureView;
+        self.bind_groups = surfaces
+            .iter()
+            .enumerate()
+            .map(|(s, surface)| {
+                if !surface.tessellated {
+                    return None;
+                }
+                let tex = heightfields.texture(surface.view.id)?;
+                let params =
+                    uniform_block(&self.params.buffer, s, std::mem::size_of::<BankParams>());
+                let norm = bind_group(
+                    device,
+                    "bank norm",
+                    &self.layout,
+                    &[
+                        params.clone(),
+                        tv(&tex.shape),
+                        tv(&tex.light),
+                        tv(&tex.bank),
+                        tv(&tex.bank_scratch),
+                    ],
+                );
+                let gather = bind_group(
+                    device,
+                    "bank gather",
+                    &self.layout,
+                    &[
+                        params,
+                        tv(&tex.shape),
+                        tv(&tex.light),
+                        tv(&tex.bank_scratch),
+                        tv(&tex.bank),
+                    ],
+                );
+                Some([norm, gather])
+            })
+            .collect();
+    }
+
+    /// Both bank passes run over the deformed surfaces only (the heightfield's dispatch).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        state: &wgpu::Buffer,
+    ) {
+        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(PASSES[slot].name),
+            timestamp_writes: compute_writes(ts, slot),
+        });
+        for (step, pipeline) in [&self.norm, &self.gather].into_iter().enumerate() {
+            p.set_pipeline(pipeline);
+            for (s, groups) in self.bind_groups.iter().enumerate() {
+                if let Some(groups) = groups {
+                    p.set_bind_group(0, &groups[step], &[]);
+                    p.dispatch_workgroups_indirect(
+                        state,
+                        (s as u64 * STATE_WORDS + STATE_HEIGHTFIELD_DISPATCH) * 4,
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,163 @@
+//! The tessellated tier's snow (`tess_surface.wgsl`): the diced mesh displaced in the vertex
+//! stage and shaded with the snow material, drawn into the moon's shadow cascades by the
+//! `snow_shadow` pass and into the scene by the `snow` pass (after the relief-mapped surfaces).
+//! Both draws bind a surface's uniform, heightfield and bank textures and state as group 1.
+
+use super::VERTEX_BYTES;
+use super::dice::DicePass;
+use super::gpu::texture;
+use crate::gpu::resources::{bind_group, uniform, uniform_block};
+use crate::render::frame::FrameSurface;
+use crate::render::gpu::SurfaceUniform;
+use crate::render::heightfield::HeightfieldPass;
+use crate::render::readback::Timestamps;
+use crate::render::shadow::ShadowPass;
+use crate::render::{pipeline, shaders};
+
+pub(in crate::render) struct TessSurface {
+    layout: wgpu::BindGroupLayout,
+    /// The tessellated snow into the scene.
+    draw: wgpu::RenderPipeline,
+    /// The tessellated snow into each shadow cascade.
+    shadow: [wgpu::RenderPipeline; 2],
+    /// This frame's group 1 per surface slot; `None` where it is not diced.
+    bind_groups: Vec<Option<wgpu::BindGroup>>,
+}
+
+impl TessSurface {
+    pub fn new(
+        device: &wgpu::Device,
+        frame_layout: &wgpu::BindGroupLayout,
+        shadow_layout: &wgpu::BindGroupLayout,
+        filterable: bool,
+    ) -> Self {
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellated snow surface"),
+            entries: &[
+                uniform(0, vf),
+                texture(1, vf, filterable),
+                texture(2, vf, filterable),
+                texture(3, vf, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: vf,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let module = pipeline::shader(device, "tess_surface.wgsl", shaders::tess_surface());
+        const VERTEX: [wgpu::VertexAttribute; 2] =
+            wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4];
+        let buffers = [Some(wgpu::VertexBufferLayout {
+            array_stride: VERTEX_BYTES,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &VERTEX,
+        })];
+        let draw = pipeline::Raster {
+            label: "snow tessellated",
+            module: &module,
+            vs: "vs_tess",
+            fs: "fs_tess",
+            buffers: &buffers,
+            groups: &[frame_layout, &layout],
+            // Skirts face outwards whichever way a mesh is wound: no culling.
+            primitive: wgpu::PrimitiveState::default(),
+            depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
+            targets: &pipeline::hdr_target(),
+            constants: pipeline::manual_filter(filterable),
+        }
+        .build(device);
+        let shadow_pipeline_layout =
+            pipeline::layout(device, "snow shadow", &[shadow_layout, &layout]);
+        let shadow = pipeline::shadow_caster(
+            device,
+            "snow shadow",
+            &shadow_pipeline_layout,
+            &module,
+            "vs_tess_shadow",
+            &buffers,
+            "TESS_SHADOW_CASCADE",
+        );
+        Self {
+            layout,
+            draw,
+            shadow,
+            bind_groups: Vec::new(),
+        }
+    }
+
+    /// Bind each diced surface's uniform (in the snow pass's `surfaces` buffer), textures and
+    /// state.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        surfaces: &[FrameSurface<'_>],
+        uniforms: &wgpu::Buffer,
+        heightfields: &HeightfieldPass,
+        state: &wgpu::Buffer,
+    ) {
+        let tv = wgpu::BindingResource::TextureView;
+        self.bind_groups = surfaces
+            .iter()
+            .enumerate()
+            .map(|(s, surface)| {
+                if !surface.tessellated {
+                    return None;
+                }
+                let tex = heightfields.texture(surface.view.id)?;
+                Some(bind_group(
+                    device,
+                    "tessellated snow surface",
+                    &self.layout,
+                    &[
+                        uniform_block(uniforms, s, std::mem::size_of::<SurfaceUniform>()),
+                        tv(&tex.shape),
+                        tv(&tex.light),
+                        tv(&tex.bank),
+                        state.as_entire_binding(),
+                    ],
+                ))
+            })
+            .collect();
+    }
+
+    /// The `snow_shadow` pass: the displaced snow into both cascades, over the meshes' shadows.
+    pub fn encode_shadow(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        shadow_frame: &wgpu::BindGroup,
+        shadow: &ShadowPass,
+        dice: &DicePass,
+    ) {
+        for cascade in 0..2 {
+            let label = if cascade == 0 {
+                "snow shadow (near cascade)"
+            } else {
+                "snow shadow (far cascade)"
+            };
+            let mut p = shadow.cascade_pass(encoder, ts, slot, cascade, label, false);
+            if dice.any() {
+                p.set_pipeline(&self.shadow[cascade]);
+                p.set_bind_group(0, shadow_frame, &[]);
+                dice.draw(&mut p, &self.bind_groups);
+            }
+        }
+    }
+
+    /// The tessellated snow into the scene (within the `snow` pass).
+    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, frame: &wgpu::BindGroup, dice: &DicePass) {
+        if dice.any() {
+            p.set_pipeline(&self.draw);
+            p.set_bind_group(0, frame, &[]);
+            dice.draw(p, &self.bind_groups);
+        }
+    }
+}
