@@ -3,9 +3,9 @@
 
 use glam::{Mat4, Vec3};
 
-use super::RenderFrame;
-use super::frame::FrameSurface;
+use super::inputs::RenderFrame;
 use super::meshes::GpuMesh;
+use crate::surface::SurfaceDesc;
 
 /// Side of the near shadow cascade, metres.
 const NEAR_CASCADE: f32 = 12.0;
@@ -20,16 +20,15 @@ pub(super) struct ShadowCascades {
 
 /// The moon's two shadow cascades: the near one around what the camera looks at, the far one
 /// around the snow surfaces and every shadow caster.
-pub(super) fn shadow_cascades(
-    surfaces: &[FrameSurface<'_>],
+pub(super) fn shadow_cascades<'a>(
+    surfaces: impl IntoIterator<Item = &'a SurfaceDesc>,
     frame: &RenderFrame<'_>,
     meshes: &[GpuMesh],
     shadow_size: u32,
 ) -> ShadowCascades {
     let mut lo = Vec3::splat(f32::MAX);
     let mut hi = Vec3::splat(f32::MIN);
-    for s in surfaces {
-        let d = s.view.desc;
+    for d in surfaces {
         let m = d.local_to_world();
         let h = d.size * 0.5;
         for corner in [

@@ -1,61 +1,7 @@
 //! The renderer's settings and errors: tiers, debug views, the material's look, and their checks.
 
+use super::error::{RenderError, RenderResult};
 use super::tessellate::{self, DiceSettings};
-use crate::error::SnowError;
-
-/// What the renderer can report instead of panicking.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    /// A setting of [`RenderConfig`] is not usable.
-    #[error("render setting {what} is {value}, but it must be {expected}")]
-    InvalidConfig {
-        /// Which setting.
-        what: &'static str,
-        /// The value given.
-        value: String,
-        /// What would be accepted.
-        expected: &'static str,
-    },
-    /// Something in a [`RenderFrame`](super::RenderFrame) is not usable.
-    #[error("render frame: {what} is {value}, but it must be {expected}")]
-    InvalidFrame {
-        /// Which part of the frame.
-        what: String,
-        /// The value given.
-        value: String,
-        /// What would be accepted.
-        expected: &'static str,
-    },
-    /// A mesh handle that this renderer did not give out.
-    #[error("render mesh handle {index} does not belong to this renderer")]
-    StaleMesh {
-        /// The handle's index.
-        index: u32,
-    },
-    /// The target view given to [`Renderer::render_to_view`](super::Renderer::render_to_view) does not have the configured size.
-    #[error(
-        "the target is {got:?} pixels but the renderer is configured for {expected:?}; call Renderer::resize first"
-    )]
-    TargetSize {
-        /// The target's size.
-        got: (u32, u32),
-        /// The configured size.
-        expected: (u32, u32),
-    },
-    /// The world refused a request (a stale surface handle, an invalid mesh).
-    #[error(transparent)]
-    World(#[from] SnowError),
-    /// The GPU did not finish or a readback failed.
-    #[error("GPU readback failed: {0}")]
-    Readback(String),
-    /// The GPU refused a pipeline or a frame (a driver that cannot compile a shader, a limit
-    /// exceeded); wgpu's message is kept.
-    #[error("the GPU refused the renderer's work: {0}")]
-    Gpu(String),
-}
-
-/// Result of the renderer.
-pub type RenderResult<T> = Result<T, RenderError>;
 
 /// How snow surfaces are drawn: traced by the talk's relief mapping, or by parallax occlusion
 /// mapping (the talk's "replace with POM?"), which takes more taps, interpolates the hit and

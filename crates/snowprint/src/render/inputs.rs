@@ -2,7 +2,7 @@
 
 use glam::{Mat4, Vec3};
 
-use super::{RenderError, RenderResult};
+use super::error::{RenderError, RenderResult};
 use crate::surface::SurfaceId;
 use crate::view::{Camera, GroundMaterial};
 

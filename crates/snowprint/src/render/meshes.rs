@@ -3,8 +3,10 @@
 
 use glam::{Mat3, Vec3};
 
+use super::error::{RenderError, RenderResult};
+use super::geometry;
 use super::gpu::InstanceRaw;
-use super::{Instance, RenderError, RenderMeshId, RenderResult, geometry};
+use super::inputs::{Instance, RenderMeshId};
 use crate::gpu::resources::Growable;
 use crate::mesh::Mesh;
 

@@ -63,6 +63,7 @@ mod cascades;
 mod classify;
 mod config;
 pub mod cpu;
+mod error;
 mod frame;
 pub mod geometry;
 pub mod gpu;
@@ -101,9 +102,8 @@ use tessellate::banks::BanksPass;
 use tessellate::dice::DicePass;
 use tessellate::snow_shadow::TessSurface;
 
-pub use config::{
-    DebugView, RenderConfig, RenderError, RenderResult, SearchSettings, SnowLook, Tier,
-};
+pub use config::{DebugView, RenderConfig, SearchSettings, SnowLook, Tier};
+pub use error::{RenderError, RenderResult};
 pub use graph::{PASSES, PassInfo, PassKind, Resource};
 pub use inputs::{Environment, Instance, MeshMaterial, PointLight, RenderFrame, RenderMeshId};
 pub use report::{FrameReport, PassTime, RenderOutput, SnowMaterialKind, SurfaceShading};
@@ -507,8 +507,8 @@ impl Renderer {
             &self.default_geometry,
             tessellated_tier,
         )?;
-        let shadow =
-            cascades::shadow_cascades(&surfaces, frame, &self.meshes.meshes, self.shadow.size);
+        let descs = surfaces.iter().map(|s| s.view.desc);
+        let shadow = cascades::shadow_cascades(descs, frame, &self.meshes.meshes, self.shadow.size);
         let uniform = frame::frame_uniform(&self.config, frame, &shadow);
         self.frame.prepare(&self.queue, &uniform);
 

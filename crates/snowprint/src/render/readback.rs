@@ -1,7 +1,8 @@
 //! Getting GPU results back to the CPU: buffer readbacks for the inspection calls, and the
 //! per-pass timestamp queries (slots `2i` and `2i + 1` of [`PASSES`](super::PASSES) entry `i`).
 
-use super::{PASSES, RenderError, RenderResult};
+use super::error::{RenderError, RenderResult};
+use super::graph::PASSES;
 
 /// Copy `size` bytes of a buffer at `offset` back to the CPU (waits for the GPU).
 pub(super) fn read_back(

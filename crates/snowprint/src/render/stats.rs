@@ -4,12 +4,12 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
 
+use super::error::{RenderError, RenderResult};
 use super::gpu::{STATE_DEEPEST, STATE_TOUCHED, STATE_WORDS};
+use super::graph::PASSES;
 use super::readback::Timestamps;
-use super::{
-    FrameReport, PASSES, PassTime, RenderError, RenderResult, SnowMaterialKind, SurfaceShading,
-    tessellate,
-};
+use super::report::{FrameReport, PassTime, SnowMaterialKind, SurfaceShading};
+use super::tessellate;
 use crate::surface::SurfaceId;
 
 /// Map state of the stats readback buffer.

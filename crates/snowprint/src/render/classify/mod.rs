@@ -5,9 +5,10 @@
 
 use super::frame::FrameSurface;
 use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
+use super::graph::PASSES;
 use super::pipeline;
 use super::readback::{Timestamps, compute_writes};
-use super::{PASSES, shaders};
+use super::shaders;
 use crate::gpu::resources::{Growable, bind_group, compute_storage};
 
 pub(super) struct ClassifyPass {

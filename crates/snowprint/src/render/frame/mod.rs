@@ -5,8 +5,10 @@
 use glam::{Vec2, Vec3};
 
 use super::cascades::ShadowCascades;
+use super::config::{RenderConfig, Tier};
 use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
-use super::{PointLight, RenderConfig, RenderFrame, SurfaceGeometry, Tier};
+use super::inputs::{PointLight, RenderFrame};
+use super::tessellate::SurfaceGeometry;
 use crate::extract::SurfaceView;
 use crate::gpu::resources::{bind_group, uniform};
 use crate::view::GroundMaterial;

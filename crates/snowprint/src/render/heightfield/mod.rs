@@ -7,12 +7,15 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
+use super::error::{RenderError, RenderResult};
 use super::frame::FrameSurface;
 use super::gpu::{HeightfieldParams, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use super::graph::PASSES;
 use super::pipeline::{self, storage_texture_entry};
 use super::readback::{Timestamps, compute_writes, f16_to_f32, map_staging};
+use super::shaders;
 use super::targets::HEIGHTFIELD_FORMAT;
-use super::{PASSES, RenderError, RenderResult, SurfaceFields, shaders};
+use super::tessellate::SurfaceFields;
 use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
 use crate::surface::SurfaceId;
 

@@ -2,10 +2,11 @@
 //! depth, lit by the moon through its shadow map and by the point lights. `mesh.wgsl` also holds
 //! the shadow pass's `vs_shadow`: both passes build on the module made by [`mesh_module`].
 
+use super::graph::PASSES;
 use super::meshes::MeshSet;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
-use super::{PASSES, gpu, pipeline, shaders};
+use super::{gpu, pipeline, shaders};
 
 /// The module of `mesh.wgsl` (after `frame.wgsl` and `snow.wgsl`).
 pub(super) fn mesh_module(device: &wgpu::Device) -> wgpu::ShaderModule {

@@ -1,9 +1,10 @@
 //! The `sky` pass (`sky.wgsl`): the night sky, the moon and the haze, drawn as one triangle behind
 //! everything (depth test only).
 
+use super::graph::PASSES;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
-use super::{PASSES, pipeline, shaders};
+use super::{pipeline, shaders};
 
 pub(super) struct SkyPass {
     pipeline: wgpu::RenderPipeline,

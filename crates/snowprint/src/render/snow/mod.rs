@@ -4,17 +4,19 @@
 //! tessellated tier the diced surfaces are drawn after, in a second render pass (see
 //! [`TessSurface`]); the pass's timestamps span both.
 
+use super::config::RenderConfig;
 use super::frame::FrameSurface;
 use super::gpu::{
     STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, SurfaceUniform, UNIFORM_STRIDE,
 };
+use super::graph::PASSES;
 use super::heightfield::HeightfieldPass;
 use super::pipeline::{self, texture_entry};
 use super::readback::{Timestamps, render_span};
+use super::shaders;
 use super::targets::{KEEP, Targets};
 use super::tessellate::dice::DicePass;
 use super::tessellate::snow_shadow::TessSurface;
-use super::{PASSES, RenderConfig, shaders};
 use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
 use crate::view::GroundMaterial;
 

@@ -1,9 +1,10 @@
 //! The `snowfall` pass (`snowfall.wgsl`): falling flakes as instanced quads, blended over the
 //! scene and hidden by its depth. The frame uniform carries the number of flakes (0: none).
 
+use super::graph::PASSES;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
-use super::{PASSES, pipeline, shaders};
+use super::{pipeline, shaders};
 
 pub(super) struct SnowfallPass {
     pipeline: wgpu::RenderPipeline,

@@ -35,7 +35,7 @@ pub(in crate::render) mod snow_shadow;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
-use super::{RenderError, RenderResult};
+use super::error::{RenderError, RenderResult};
 
 /// Largest edge level (segments per base-mesh edge). Must match nothing in WGSL: the level is a
 /// uniform there.

@@ -4,10 +4,11 @@
 
 use std::collections::HashMap;
 
+use super::graph::PASSES;
 use super::pipeline::{self, texture_entry};
 use super::readback::{Timestamps, render_writes};
+use super::shaders;
 use super::targets::Targets;
-use super::{PASSES, shaders};
 use crate::gpu::resources::bind_group;
 
 pub(super) struct TonemapPass {

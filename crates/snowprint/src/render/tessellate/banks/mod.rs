@@ -8,9 +8,10 @@ use super::gpu::texture;
 use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::readback::{Timestamps, compute_writes};
-use crate::render::{PASSES, pipeline, shaders};
+use crate::render::{pipeline, shaders};
 
 pub(in crate::render) struct BanksPass {
     layout: wgpu::BindGroupLayout,

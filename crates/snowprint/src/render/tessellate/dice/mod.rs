@@ -12,11 +12,15 @@ use super::VERTEX_BYTES;
 use super::gpu::{counters_bytes, texture};
 use super::{ARGS_BASE, ARGS_STRIDE, DiceParams, DicedKind, DicedMesh, DicedVertex, SurfaceMesh};
 use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
+use crate::render::config::RenderConfig;
+use crate::render::error::RenderResult;
 use crate::render::frame::{FAR, FrameSurface, NEAR};
 use crate::render::gpu::{FrameUniform, UNIFORM_STRIDE};
+use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
+use crate::render::inputs::RenderFrame;
 use crate::render::readback::{Timestamps, compute_writes, read_back};
-use crate::render::{PASSES, RenderConfig, RenderFrame, RenderResult, pipeline, shaders};
+use crate::render::{pipeline, shaders};
 use crate::surface::SurfaceId;
 
 /// A surface's base mesh on the GPU.
