@@ -32,7 +32,7 @@ pub struct FrameView<'a> {
     pub pool_buffer: &'a wgpu::Buffer,
     /// The pool's format.
     pub pool_format: PoolFormat,
-    /// Every live surface, in the world's order.
+    /// Every live surface, in the world's order (by slot index).
     pub surfaces: Vec<SurfaceView<'a>>,
 }
 
@@ -40,8 +40,10 @@ impl<'a> FrameView<'a> {
     /// A surface of the view, or the error the world gives for a handle it does not hold.
     pub fn surface(&self, id: SurfaceId) -> Result<&SurfaceView<'a>> {
         self.surfaces
-            .iter()
-            .find(|s| s.id == id)
+            .binary_search_by_key(&id.index(), |s| s.id.index())
+            .ok()
+            .map(|i| &self.surfaces[i])
+            .filter(|s| s.id == id)
             .ok_or(SnowError::StaleHandle {
                 what: "surface",
                 index: id.index(),
@@ -54,7 +56,7 @@ impl SnowWorld {
     /// and each live surface's description, layout and offsets in the pool.
     pub fn frame_view(&self) -> FrameView<'_> {
         let pool_format = self.pool_format();
-        let surfaces = self
+        let mut surfaces: Vec<SurfaceView<'_>> = self
             .surfaces()
             .filter_map(|(id, desc)| {
                 let layout = self.layout(id).ok()?;
@@ -69,6 +71,8 @@ impl SnowWorld {
                 })
             })
             .collect();
+        // Sorted by slot for the lookup (the world lists them so already).
+        surfaces.sort_by_key(|s| s.id.index());
         FrameView {
             pool_buffer: self.pool_buffer(),
             pool_format,
