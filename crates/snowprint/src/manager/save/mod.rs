@@ -11,7 +11,8 @@
 //! (the manager's meshes and the world meshes queued imprints name; binary), then one `SURF` per
 //! surface that holds a heightmap, resident or paged (binary: the slot's words and the
 //! replenishment carry). Reading checks everything before anything is built: a corrupt,
-//! truncated, foreign or newer file is one [`SnowError::SaveFile`](crate::SnowError::SaveFile) sentence.
+//! truncated, foreign or newer file is one
+//! [`SnowError::SaveFile`](crate::SnowError::SaveFile) sentence.
 
 use super::ManagerConfig;
 use super::planner::PlannerState;

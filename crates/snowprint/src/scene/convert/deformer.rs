@@ -161,11 +161,11 @@ fn scene_shape(
 ) -> Result<SceneShape> {
     let what = format!("{who} is {} but", kind.article());
     let radius = |v: Option<&Num>| -> Result<f32> {
-        let v = required(src, &table, v, &what, "radius", "add radius = <metres>")?;
+        let v = required(src, table, v, &what, "radius", "add radius = <metres>")?;
         number(
             src,
             v,
-            &who,
+            who,
             "radius",
             |x| x > 0.0 && x <= MAX_DEFORMER_SIZE,
             &format!(
@@ -181,7 +181,7 @@ fn scene_shape(
             let radius = radius(d.radius.as_ref())?;
             let v = required(
                 src,
-                &table,
+                table,
                 d.half_height.as_ref(),
                 &what,
                 "half_height",
@@ -190,7 +190,7 @@ fn scene_shape(
             let half_height = number(
                 src,
                 v,
-                &who,
+                who,
                 "half_height",
                 |x| (0.0..=MAX_DEFORMER_SIZE).contains(&x),
                 &format!(
@@ -205,7 +205,7 @@ fn scene_shape(
         Kind::Box => {
             let v = required(
                 src,
-                &table,
+                table,
                 d.half_extents.as_ref(),
                 &what,
                 "half_extents",
@@ -214,7 +214,7 @@ fn scene_shape(
             let h: [f32; 3] = vector(
                 src,
                 v,
-                &who,
+                who,
                 "half_extents",
                 "[x, y, z] in metres",
                 |x| x > 0.0 && x <= MAX_DEFORMER_SIZE,
@@ -229,13 +229,13 @@ fn scene_shape(
         Kind::Mesh => {
             let v = required(
                 src,
-                &table,
+                table,
                 d.path.as_ref(),
                 &what,
                 "path",
                 "add path = \"file.glb\", a glTF or GLB file relative to the scene file's folder",
             )?;
-            mesh(src, v, &who, dir)?
+            mesh(src, v, who, dir)?
         }
     };
     Ok(shape)
@@ -265,7 +265,7 @@ fn check_analytic(
         for k in keys {
             Deformer::new(analytic, k.pose())
                 .validate(name)
-                .map_err(|e| src.error(&table, e, "fix this [[deformer]] table"))?;
+                .map_err(|e| src.error(table, e, "fix this [[deformer]] table"))?;
         }
     }
     Ok(())
