@@ -19,6 +19,19 @@
 //! 4. **Budget.** Of the resident surfaces due for an update, at most `updates_per_frame` are chosen:
 //!    the player's surfaces first (up to `player_slots`), then earliest deadline first, where a
 //!    surface's deadline is the frame it became due plus a slack that grows with its distance.
+//!
+//! The tick and its first two steps are in `tick.rs`, residency in `admit.rs`, the budget in
+//! `schedule.rs`; `surface.rs` holds what is kept per surface and `state.rs` the state for saves.
+
+mod admit;
+mod schedule;
+mod state;
+mod surface;
+mod tick;
+
+pub(crate) use state::PlannerState;
+use surface::{LISTED, PAGED, REMOVED, RESIDENT, SNOWFALL, WANTED};
+use surface::{Managed, Rank, Status, TouchVolume};
 
 use std::collections::{HashMap, VecDeque};
 
@@ -85,16 +98,6 @@ pub struct Plan {
     /// The tick's statistics.
     pub stats: TickStats,
 }
-
-mod admit;
-mod schedule;
-mod state;
-mod surface;
-mod tick;
-
-pub(crate) use state::PlannerState;
-use surface::{LISTED, PAGED, REMOVED, RESIDENT, SNOWFALL, WANTED};
-use surface::{Managed, Rank, Status, TouchVolume};
 
 /// The planner. See the module docs for the tick, and `docs/MANAGER.md` for the bounds.
 ///
