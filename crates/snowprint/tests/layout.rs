@@ -315,6 +315,24 @@ fn module_of(path: &str) -> Option<String> {
     (name != "lib").then(|| name.to_string())
 }
 
+/// The items of a `{...}` import group, split at its own commas only (`a::{X, Y}, b` is two).
+fn top_level_items(group: &str) -> Vec<String> {
+    let (mut items, mut depth, mut start) = (Vec::new(), 0, 0);
+    for (k, ch) in group.char_indices() {
+        match ch {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(group[start..k].trim().to_string());
+                start = k + 1;
+            }
+            _ => {}
+        }
+    }
+    items.push(group[start..].trim().to_string());
+    items
+}
+
 /// One `crate::` reference from one module to another.
 #[derive(Clone, Debug)]
 struct Edge {
@@ -352,10 +370,7 @@ fn import_graph(
             // `crate::{a::X, b}` names several modules at once.
             let group = if rest.starts_with('{') {
                 let close = closing(rest.as_bytes(), 0).unwrap_or(rest.len() - 1);
-                rest[1..close]
-                    .split(',')
-                    .map(|s| s.trim().to_string())
-                    .collect::<Vec<_>>()
+                top_level_items(&rest[1..close])
             } else {
                 vec![rest.to_string()]
             };
@@ -647,9 +662,10 @@ fn circles_are_found_and_reported_with_their_edges() {
     assert_eq!(reexports.get("Thing").map(String::as_str), Some("c"));
     assert_eq!(reexports.get("Renamed").map(String::as_str), Some("c"));
     let files = vec![
+        // `Thing` inside `b::{...}` is b's own, not the root's re-export from c.
         (
             "a/mod.rs".to_string(),
-            "use crate::{b::X, d};\n".to_string(),
+            "use crate::{b::{X, Thing}, d};\n".to_string(),
         ),
         (
             "b.rs".to_string(),
