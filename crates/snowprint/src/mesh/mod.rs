@@ -12,6 +12,11 @@ pub use gltf_file::{
     MAX_GLTF_DEPTH, MAX_GLTF_FILE_BYTES, MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_GLTF_VERTICES,
 };
 
+/// Farthest a vertex may lie from the mesh's origin, metres: the reach of any deformer,
+/// `MAX_DEFORMER_SIZE`. Kept here so that meshes do not depend on deformers (deformers name
+/// meshes); a unit test checks that the two agree.
+const MAX_VERTEX_DISTANCE: f32 = 1000.0;
+
 /// Handle of a mesh registered with a [`crate::SnowWorld`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct MeshId(pub(crate) u32);
@@ -65,7 +70,7 @@ impl Mesh {
         if let Some(p) = self.positions.iter().find(|p| !p.is_finite()) {
             return err(format!("vertex {:?} is not finite", p.to_array()));
         }
-        let limit = crate::deformer::MAX_DEFORMER_SIZE;
+        let limit = MAX_VERTEX_DISTANCE;
         if let Some(p) = self.positions.iter().find(|p| p.length() > limit) {
             return err(format!(
                 "vertex {:?} lies {} m from the mesh's origin, farther than the {limit} m (MAX_DEFORMER_SIZE) a deformer may reach; model the mesh around its origin and at most {limit} m across",
@@ -220,5 +225,10 @@ mod tests {
 
         let b = Mesh::cuboid(Vec3::new(1.0, 2.0, 3.0));
         assert!((b.signed_volume() - 48.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn vertices_reach_as_far_as_deformers() {
+        assert_eq!(MAX_VERTEX_DISTANCE, crate::deformer::MAX_DEFORMER_SIZE);
     }
 }

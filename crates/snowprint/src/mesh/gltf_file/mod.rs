@@ -12,12 +12,20 @@
 //! reader, whose offset arithmetic assumes valid counts and strides.
 
 use std::io::Read;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 
 use super::Mesh;
 use crate::error::{Result, SnowError};
+
+mod accessors;
+#[cfg(test)]
+mod tests;
+mod uri;
+
+use accessors::{read_indices, read_positions};
+use uri::{UriRefusal, follow_uri, quote_uri};
 
 /// Most nodes a glTF file may have.
 pub const MAX_GLTF_NODES: usize = 65_536;
@@ -31,7 +39,7 @@ pub const MAX_GLTF_TRIANGLES: usize = 1 << 22;
 pub const MAX_GLTF_FILE_BYTES: u64 = 256 << 20;
 
 /// The longest URI quoted in a message, characters (a data: URI can be megabytes).
-const QUOTE_CHARS: usize = 60;
+pub(super) const QUOTE_CHARS: usize = 60;
 
 impl Mesh {
     /// Load every triangle primitive of a glTF or GLB file, with node transforms applied, into one
@@ -127,7 +135,7 @@ fn canonical_folder(root: &Path) -> std::io::Result<PathBuf> {
 }
 
 /// A whole file, refused beyond [`MAX_GLTF_FILE_BYTES`].
-fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, String> {
+pub(super) fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, String> {
     let file = std::fs::File::open(path)
         .map_err(|e| format!("cannot be opened ({e}); check the path and its permissions"))?;
     let meta = file
@@ -152,220 +160,6 @@ fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, String> {
         ));
     }
     Ok(bytes)
-}
-
-/// A URI shortened for a message.
-fn quote_uri(uri: &str) -> String {
-    if uri.chars().count() > QUOTE_CHARS {
-        let cut: String = uri.chars().take(QUOTE_CHARS - 3).collect();
-        format!("{cut}...")
-    } else {
-        uri.to_owned()
-    }
-}
-
-/// Why a URI cannot be followed: (what is wrong, what to do).
-type UriRefusal = (String, String);
-
-const EMBED_OR_BESIDE: &str =
-    "embed the data as a data: URI, or put the file in the mesh's folder and give a relative uri";
-
-/// Bytes of a `data:` URI (base64 only, as glTF writes them).
-fn data_uri(uri: &str) -> std::result::Result<Vec<u8>, UriRefusal> {
-    let rest = &uri["data:".len()..];
-    let Some(comma) = rest.find(',') else {
-        return Err((
-            "is a data: URI without a comma before its data".into(),
-            "write it as data:application/octet-stream;base64,<data>".into(),
-        ));
-    };
-    if !rest[..comma].ends_with(";base64") {
-        return Err((
-            "is a data: URI that is not base64".into(),
-            "write it as data:application/octet-stream;base64,<data>".into(),
-        ));
-    }
-    decode_base64(&rest[comma + 1..]).ok_or_else(|| {
-        (
-            "is a data: URI whose base64 data is not valid".into(),
-            "re-export the file, or check that the data was not cut or altered".into(),
-        )
-    })
-}
-
-/// Standard base64 with optional padding; ASCII whitespace is skipped.
-fn decode_base64(text: &str) -> Option<Vec<u8>> {
-    let mut out = Vec::with_capacity(text.len() / 4 * 3);
-    let (mut acc, mut bits) = (0u32, 0u32);
-    let mut padding = 0;
-    for b in text.bytes() {
-        let v = match b {
-            b'A'..=b'Z' => b - b'A',
-            b'a'..=b'z' => b - b'a' + 26,
-            b'0'..=b'9' => b - b'0' + 52,
-            b'+' | b'-' => 62,
-            b'/' | b'_' => 63,
-            b'=' => {
-                padding += 1;
-                continue;
-            }
-            b if b.is_ascii_whitespace() => continue,
-            _ => return None,
-        };
-        if padding > 0 {
-            return None;
-        }
-        acc = (acc << 6) | u32::from(v);
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
-        }
-    }
-    (padding <= 2).then_some(out)
-}
-
-/// `%XX` escapes decoded (glTF URIs are URI references).
-fn percent_decode(uri: &str) -> Option<String> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            out.push(u8::from_str_radix(hex, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).ok()
-}
-
-/// The file a relative URI names, checked to lie under `root` (canonical).
-fn resolve_file(uri: &str, folder: &Path, root: &Path) -> std::result::Result<PathBuf, UriRefusal> {
-    let decoded = percent_decode(uri).ok_or_else(|| {
-        (
-            "has a malformed %-escape or is not UTF-8".to_owned(),
-            "write it as a relative path with %XX escapes".to_owned(),
-        )
-    })?;
-    if decoded.is_empty() || decoded.contains('\0') {
-        return Err((
-            "is empty or holds a NUL character".into(),
-            EMBED_OR_BESIDE.into(),
-        ));
-    }
-    let as_path = Path::new(&decoded);
-    let absolute = decoded.starts_with('/')
-        || decoded.starts_with('\\')
-        || as_path.is_absolute()
-        || as_path
-            .components()
-            .any(|c| matches!(c, Component::Prefix(_) | Component::RootDir));
-    if absolute {
-        return Err((
-            "is an absolute path, and a mesh may read only files under its allowed folder".into(),
-            EMBED_OR_BESIDE.into(),
-        ));
-    }
-    let outside = |path: &Path| {
-        (
-            format!(
-                "leads to {}, outside {}, the only folder this mesh may read from",
-                path.display(),
-                root.display()
-            ),
-            EMBED_OR_BESIDE.to_owned(),
-        )
-    };
-    // First without touching the file system: `..` that climbs out of the root is refused whether
-    // or not its target exists, so answers tell nothing about files outside the root.
-    let folder = folder.canonicalize().map_err(|e| {
-        (
-            format!(
-                "is relative to {}, which cannot be opened ({e})",
-                folder.display()
-            ),
-            "check the mesh's folder".to_owned(),
-        )
-    })?;
-    let mut lexical = PathBuf::new();
-    for c in folder.join(as_path).components() {
-        match c {
-            Component::ParentDir => {
-                lexical.pop();
-            }
-            Component::CurDir => {}
-            other => lexical.push(other),
-        }
-    }
-    if !lexical.starts_with(root) {
-        return Err(outside(&lexical));
-    }
-    // Then through the file system: a symbolic link inside the root may still lead out of it.
-    let canonical = lexical.canonicalize().map_err(|e| {
-        (
-            format!("names {}, which cannot be opened ({e})", lexical.display()),
-            "put the file there or fix the uri".to_owned(),
-        )
-    })?;
-    if !canonical.starts_with(root) {
-        return Err(outside(&canonical));
-    }
-    Ok(canonical)
-}
-
-/// A URI that has a scheme (`file:`, `http:`), as opposed to a relative reference.
-fn scheme(uri: &str) -> Option<&str> {
-    let colon = uri.find(':')?;
-    let head = &uri[..colon];
-    let is_scheme = head.len() > 1
-        && head.starts_with(|c: char| c.is_ascii_alphabetic())
-        && head
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'));
-    is_scheme.then_some(head)
-}
-
-/// Check (and for buffers, read) one URI.
-fn follow_uri(
-    uri: &str,
-    files: Option<(&Path, &Path)>,
-    read: bool,
-) -> std::result::Result<Option<Vec<u8>>, UriRefusal> {
-    if uri.starts_with("data:") {
-        return if read {
-            data_uri(uri).map(Some)
-        } else {
-            Ok(None)
-        };
-    }
-    if let Some(s) = scheme(uri) {
-        return Err((
-            format!("has the scheme {s}:, and only relative paths and data: URIs are read"),
-            EMBED_OR_BESIDE.into(),
-        ));
-    }
-    let Some((folder, root)) = files else {
-        return Err((
-            "names a file, and this mesh was given as bytes with no folder to read files from"
-                .into(),
-            "embed the data as a data: URI or a GLB binary chunk".into(),
-        ));
-    };
-    let file = resolve_file(uri, folder, root)?;
-    if !read {
-        return Ok(None);
-    }
-    read_bounded(&file).map(Some).map_err(|reason| {
-        (
-            format!("names {}, which {reason}", file.display()),
-            "fix the file or the uri".to_owned(),
-        )
-    })
 }
 
 fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mesh> {
@@ -603,212 +397,4 @@ fn check_node_trees(doc: &gltf::Document) -> std::result::Result<(), String> {
         path.clear();
     }
     Ok(())
-}
-
-/// Where an accessor's elements lie: the buffer's bytes from the first element, the stride, the
-/// count and the element size.
-struct Elements<'a> {
-    bytes: &'a [u8],
-    stride: usize,
-    count: usize,
-    size: usize,
-}
-
-impl Elements<'_> {
-    fn get(&self, i: usize) -> &[u8] {
-        &self.bytes[i * self.stride..i * self.stride + self.size]
-    }
-}
-
-/// Locate an accessor's elements in its buffer, with every offset checked.
-fn elements<'a>(
-    accessor: &gltf::Accessor<'_>,
-    buffers: &'a [Vec<u8>],
-    size: usize,
-) -> std::result::Result<Elements<'a>, String> {
-    if accessor.sparse().is_some() {
-        return Err(
-            "is sparse, which snowprint does not read; export without sparse accessors".into(),
-        );
-    }
-    let count = accessor.count();
-    if count == 0 {
-        return Err("has count 0; an accessor needs at least one element".into());
-    }
-    let Some(view) = accessor.view() else {
-        return Err("has no bufferView; give it one".into());
-    };
-    let buffer = buffers
-        .get(view.buffer().index())
-        .ok_or("names a buffer that does not exist")?;
-    let stride = view.stride().unwrap_or(size);
-    if stride < size {
-        return Err(format!(
-            "has a byteStride of {stride}, less than its element's {size} bytes; fix the byteStride"
-        ));
-    }
-    let view_end = view
-        .offset()
-        .checked_add(view.length())
-        .filter(|&e| e <= buffer.len())
-        .ok_or_else(|| {
-            format!(
-                "has a bufferView (bytes {} to {} of buffer {}) that does not fit its {} bytes; fix the bufferView",
-                view.offset(),
-                view.offset().saturating_add(view.length()),
-                view.buffer().index(),
-                buffer.len()
-            )
-        })?;
-    let start = view.offset().checked_add(accessor.offset());
-    let end = (count - 1)
-        .checked_mul(stride)
-        .and_then(|x| x.checked_add(size))
-        .and_then(|x| x.checked_add(start?));
-    match (start, end) {
-        (Some(start), Some(end)) if end <= view_end => Ok(Elements {
-            bytes: &buffer[start..end],
-            stride,
-            count,
-            size,
-        }),
-        _ => Err(format!(
-            "has {count} elements of {size} bytes at offset {} and stride {stride}, which do not fit its bufferView of {} bytes; fix the count or the offsets",
-            accessor.offset(),
-            view.length()
-        )),
-    }
-}
-
-fn read_positions(
-    accessor: &gltf::Accessor<'_>,
-    buffers: &[Vec<u8>],
-) -> std::result::Result<Vec<Vec3>, String> {
-    use gltf::accessor::{DataType, Dimensions};
-    if accessor.data_type() != DataType::F32 || accessor.dimensions() != Dimensions::Vec3 {
-        return Err(format!(
-            "holds {:?} {:?}, but positions must be VEC3 of FLOAT; export positions as floats",
-            accessor.dimensions(),
-            accessor.data_type()
-        ));
-    }
-    if accessor.count() > MAX_GLTF_VERTICES {
-        return Err(format!(
-            "has {} vertices, more than {MAX_GLTF_VERTICES}; simplify the mesh",
-            accessor.count()
-        ));
-    }
-    let e = elements(accessor, buffers, 12)?;
-    Ok((0..e.count)
-        .map(|i| {
-            let b = e.get(i);
-            let f = |k: usize| f32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]]);
-            Vec3::new(f(0), f(4), f(8))
-        })
-        .collect())
-}
-
-fn read_indices(
-    accessor: &gltf::Accessor<'_>,
-    buffers: &[Vec<u8>],
-) -> std::result::Result<Vec<u32>, String> {
-    use gltf::accessor::{DataType, Dimensions};
-    let size = match accessor.data_type() {
-        DataType::U8 => 1,
-        DataType::U16 => 2,
-        DataType::U32 => 4,
-        other => {
-            return Err(format!(
-                "holds {other:?}, but indices must be unsigned integers; fix the componentType"
-            ));
-        }
-    };
-    if accessor.dimensions() != Dimensions::Scalar {
-        return Err(format!(
-            "holds {:?}, but indices must be SCALAR; fix the type",
-            accessor.dimensions()
-        ));
-    }
-    if accessor.count() / 3 > MAX_GLTF_TRIANGLES {
-        return Err(format!(
-            "has {} indices, more than {} triangles; simplify the mesh",
-            accessor.count(),
-            MAX_GLTF_TRIANGLES
-        ));
-    }
-    if !accessor.count().is_multiple_of(3) {
-        return Err(format!(
-            "has {} indices, not a multiple of 3 as a triangle list needs; fix the count",
-            accessor.count()
-        ));
-    }
-    let e = elements(accessor, buffers, size)?;
-    Ok((0..e.count)
-        .map(|i| {
-            let b = e.get(i);
-            match size {
-                1 => u32::from(b[0]),
-                2 => u32::from(u16::from_le_bytes([b[0], b[1]])),
-                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-            }
-        })
-        .collect())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn base64_decodes_known_values() {
-        assert_eq!(decode_base64("TWFu").unwrap(), b"Man");
-        assert_eq!(decode_base64("TWE=").unwrap(), b"Ma");
-        assert_eq!(decode_base64("TQ==").unwrap(), b"M");
-        assert_eq!(decode_base64("").unwrap(), b"");
-        assert!(decode_base64("TQ=a").is_none());
-        assert!(decode_base64("T*==").is_none());
-    }
-
-    #[test]
-    fn uris_with_a_scheme_are_told_from_relative_paths() {
-        assert_eq!(scheme("file:///etc/passwd"), Some("file"));
-        assert_eq!(scheme("http://x/y.bin"), Some("http"));
-        assert_eq!(scheme("mesh.bin"), None);
-        assert_eq!(scheme("a b/c:d.bin"), None);
-        assert_eq!(percent_decode("a%20b.bin").unwrap(), "a b.bin");
-        assert!(percent_decode("a%2").is_none());
-    }
-
-    #[test]
-    fn node_cycles_and_shared_children_are_refused() {
-        let doc = |nodes: &str| {
-            let text = format!(
-                r#"{{"asset":{{"version":"2.0"}},"scenes":[{{"nodes":[0]}}],"nodes":{nodes}}}"#
-            );
-            gltf::Gltf::from_slice(text.as_bytes()).unwrap().document
-        };
-        let e = check_node_trees(&doc(r#"[{"children":[1]},{"children":[0]}]"#)).unwrap_err();
-        assert!(e.contains("own ancestor") && e.contains("cycle"), "{e}");
-        let e = check_node_trees(&doc(r#"[{"children":[0]}]"#)).unwrap_err();
-        assert!(e.contains("node 0 lists itself"), "{e}");
-        let e = check_node_trees(&doc(r#"[{"children":[1,2]},{"children":[2]},{}]"#)).unwrap_err();
-        assert!(e.contains("node 2 is a child of both"), "{e}");
-        assert!(check_node_trees(&doc(r#"[{"children":[1,2]},{"children":[3]},{},{}]"#)).is_ok());
-        // A chain exactly MAX_GLTF_DEPTH deep is fine; one more level is not.
-        let chain = |len: usize| {
-            let nodes: Vec<String> = (0..len)
-                .map(|i| {
-                    if i + 1 < len {
-                        format!(r#"{{"children":[{}]}}"#, i + 1)
-                    } else {
-                        "{}".to_owned()
-                    }
-                })
-                .collect();
-            doc(&format!("[{}]", nodes.join(",")))
-        };
-        assert!(check_node_trees(&chain(MAX_GLTF_DEPTH)).is_ok());
-        let e = check_node_trees(&chain(MAX_GLTF_DEPTH + 1)).unwrap_err();
-        assert!(e.contains("levels deep"), "{e}");
-    }
 }

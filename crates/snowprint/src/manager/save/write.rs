@@ -1,0 +1,123 @@
+//! Writing a save: the manager's state as sections.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::bytes::{put_mesh, put_string, put_u32, put_u64, section};
+use super::config::SavedConfig;
+use super::{MAGIC, VERSION};
+use crate::error::{Result, SnowError};
+use crate::manager::SnowManager;
+use crate::mesh::Mesh;
+use crate::world::SurfaceSnapshot;
+
+impl SnowManager {
+    /// The whole snow state as the bytes of a save (see the module docs).
+    pub fn to_save_bytes(&self) -> Result<Vec<u8>> {
+        let conf = to_json(&SavedConfig::of(self.planner.config()))?;
+        let plan = to_json(&self.planner.state())?;
+        // Meshes: the manager's, and the earlier posings that queues still name.
+        let mut meshes = Vec::new();
+        put_u64(&mut meshes, self.meshes.len() as u64);
+        for m in &self.meshes {
+            put_string(&mut meshes, &m.name);
+            put_u32(&mut meshes, m.world.0);
+            put_mesh(&mut meshes, &m.mesh);
+        }
+        let retired = self.retired_meshes();
+        put_u64(&mut meshes, retired.len() as u64);
+        for (id, mesh) in &retired {
+            put_u32(&mut meshes, *id);
+            put_mesh(&mut meshes, mesh);
+        }
+        // Heightmaps: resident ones read back in one round trip, paged ones from their pages.
+        let resident: Vec<(u32, crate::SurfaceId)> = self
+            .world_ids
+            .iter()
+            .enumerate()
+            .filter_map(|(i, w)| w.map(|w| (i as u32, w)))
+            .collect();
+        let snaps = self
+            .world
+            .snapshot_surfaces(&resident.iter().map(|r| r.1).collect::<Vec<_>>())?;
+        let mut surfaces: Vec<(u32, Option<u64>, SurfaceSnapshot)> = resident
+            .iter()
+            .zip(snaps)
+            .map(|(&(i, _), s)| {
+                let offset = self
+                    .planner
+                    .slot(crate::manager::ManagedId(i))
+                    .map(|s| s.offset);
+                (i, offset, s)
+            })
+            .collect();
+        for (i, page) in self.pages.iter() {
+            surfaces.push((i, None, page.decompress()?));
+        }
+        surfaces.sort_by_key(|s| s.0);
+        let mut out = Vec::new();
+        out.extend_from_slice(&MAGIC);
+        put_u32(&mut out, VERSION);
+        put_u32(&mut out, 3 + surfaces.len() as u32);
+        let crc = crc32fast::hash(&out[..16]);
+        put_u32(&mut out, crc);
+        section(&mut out, b"CONF", &conf);
+        section(&mut out, b"PLAN", &plan);
+        section(&mut out, b"MESH", &meshes);
+        for (i, offset, s) in &surfaces {
+            let mut b = Vec::with_capacity(48 + s.words.len() * 4);
+            put_u32(&mut b, *i);
+            put_u64(&mut b, offset.unwrap_or(u64::MAX));
+            put_u32(&mut b, s.width);
+            put_u32(&mut b, s.height);
+            b.extend_from_slice(&s.carry.to_bits().to_le_bytes());
+            put_u64(&mut b, s.words.len() as u64);
+            b.extend_from_slice(bytemuck::cast_slice(&s.words));
+            section(&mut out, b"SURF", &b);
+        }
+        Ok(out)
+    }
+
+    /// The world meshes of earlier posings that queues name, with their vertices.
+    fn retired_meshes(&self) -> Vec<(u32, Mesh)> {
+        self.retired
+            .iter()
+            .filter_map(|id| self.retired_mesh.get(&id.0).map(|m| (id.0, m.clone())))
+            .collect()
+    }
+
+    /// Write a save to `path` atomically: a temporary file beside it, flushed to disk, then
+    /// renamed over it, so a reader finds the old save or the new one, never a part. Returns the
+    /// bytes written.
+    pub fn save(&self, path: &Path) -> Result<u64> {
+        let bytes = self.to_save_bytes()?;
+        let out = |reason: String| SnowError::Output {
+            path: path.to_owned(),
+            reason,
+        };
+        let name = path
+            .file_name()
+            .ok_or_else(|| out("it names no file".into()))?;
+        let tmp = path.with_file_name(format!(
+            ".{}.partial-{}",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
+        let write = || -> std::io::Result<()> {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(&bytes)?;
+            f.sync_all()?;
+            std::fs::rename(&tmp, path)
+        };
+        write().map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            out(e.to_string())
+        })?;
+        Ok(bytes.len() as u64)
+    }
+}
+
+/// JSON for the text sections, with the error as the library's.
+pub(super) fn to_json<T: serde::Serialize>(v: &T) -> Result<Vec<u8>> {
+    serde_json::to_vec(v).map_err(|e| SnowError::Scene(format!("save: {e}")))
+}
