@@ -15,11 +15,24 @@
 //! CPU reference: [`cpu`].
 
 pub mod cpu;
+mod encode;
+
+pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
 use crate::deformer::{Deformer, Pose, Shape};
+
+/// Which of the talk's two capture paths to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CaptureMode {
+    /// The talk's PC path: the lowest point of any deformer per texel, a minimum-height field.
+    #[default]
+    Depth,
+    /// The talk's console path: clear black, deformers white, a fixed imprint depth.
+    Mask,
+}
 
 /// WGSL of the capture pass.
 pub const SHADER: &str = include_str!("capture.wgsl");
