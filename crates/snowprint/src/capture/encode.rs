@@ -99,11 +99,11 @@ impl CapturePlan {
 /// viewports it draws into.
 #[derive(Clone, Copy, Debug)]
 pub struct CaptureBuffers<'a> {
-    /// [`CaptureView`]s, [`UNIFORM_STRIDE`] apart.
+    /// [`CaptureView`]s, one uniform block (256 bytes) each.
     pub views: &'a wgpu::Buffer,
     /// [`GpuPrimitive`]s.
     pub prims: &'a wgpu::Buffer,
-    /// [`MeshDraw`]s, [`UNIFORM_STRIDE`] apart.
+    /// [`MeshDraw`]s, one uniform block (256 bytes) each.
     pub draws: &'a wgpu::Buffer,
     /// Encoded depth per texel (written).
     pub capture: &'a wgpu::Buffer,

@@ -1,33 +1,13 @@
-//! A world's settings and what it reports: capture and pass settings, frame statistics, memory.
+//! A world's settings and what it reports: pass settings, frame statistics, memory (the capture
+//! settings live with the capture: [`crate::capture::CaptureConfig`]).
 
-use crate::capture::CaptureMode;
+use crate::capture::CaptureConfig;
 use crate::deformer::Deformer;
 use crate::pool::PoolFormat;
 use crate::surface::SurfaceId;
 
 #[cfg(doc)]
 use super::SnowWorld;
-
-/// How surfaces are captured.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CaptureConfig {
-    /// Depth or mask capture.
-    pub mode: CaptureMode,
-    /// Height of the frustum above the snow top, metres (default 0.25).
-    pub ankle_height: f32,
-    /// In mask mode, the fraction of the snow depth a covered texel is pressed down (default 1).
-    pub mask_depth: f32,
-}
-
-impl Default for CaptureConfig {
-    fn default() -> Self {
-        Self {
-            mode: CaptureMode::Depth,
-            ankle_height: 0.25,
-            mask_depth: 1.0,
-        }
-    }
-}
 
 /// Settings of a world.
 #[derive(Clone, Debug, PartialEq)]

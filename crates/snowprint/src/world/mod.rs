@@ -13,10 +13,8 @@ pub mod plan;
 mod readback;
 mod snapshot;
 
-pub use crate::capture::CaptureMode;
-pub use config::{
-    CaptureConfig, FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig,
-};
+pub use crate::capture::{CaptureConfig, CaptureMode};
+pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
 pub use plan::FramePlan;
 pub use snapshot::SurfaceSnapshot;
 

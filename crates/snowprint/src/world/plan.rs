@@ -9,12 +9,12 @@
 
 use std::ops::Range;
 
-use glam::{Mat4, Vec2};
+use glam::Vec2;
 
-use super::{CaptureConfig, FrameStats, PassMode, WorldConfig};
+use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
 use crate::capture::{
-    self, CaptureMode, CapturePlan, CaptureView, CaptureVolume, CapturedSurface, MeshDraw,
+    self, CaptureConfig, CaptureMode, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
 };
 use crate::deformer::{Deformer, Shape};
 use crate::gpu::resources::UNIFORM_STRIDE;
@@ -230,10 +230,7 @@ impl FramePlan {
                     let Some(radius) = mesh_radius(id) else {
                         continue;
                     };
-                    for to_local in mesh_sweep(d, &volume, radius) {
-                        draws.push(MeshDraw { to_local });
-                        draw_meshes.push(id);
-                    }
+                    capture::push_mesh_draws(d, id, radius, &volume, draws, draw_meshes);
                 }
                 _ => capture::push_primitives(d, &volume, prims),
             }
@@ -383,25 +380,4 @@ pub fn replenish(carry: f64, rate: f32, elapsed: f32, channel_max: u32) -> (f64,
     let carry = carry + rate as f64 * elapsed as f64 * channel_max as f64;
     let units = carry.floor().min(u32::MAX as f64);
     (carry - units, units as u32)
-}
-
-/// The poses a moving mesh is drawn at (mesh space to surface-local), culled against the
-/// volume: sub-steps along its motion, so that a fast hand or foot leaves a continuous sweep
-/// rather than a comb of copies.
-fn mesh_sweep(
-    d: &Deformer,
-    volume: &CaptureVolume,
-    radius: f32,
-) -> impl Iterator<Item = [[f32; 4]; 4]> {
-    let prev = d.previous.unwrap_or(d.pose);
-    let pose = d.pose;
-    let n = capture::mesh_substeps(&prev, &pose, radius);
-    let volume = *volume;
-    (1..=n).filter_map(move |k| {
-        let p = prev.lerp(&pose, k as f32 / n as f32);
-        volume.overlaps_ball(p.position, radius).then(|| {
-            let model = Mat4::from_rotation_translation(p.rotation, p.position);
-            (volume.world_to_local * model).to_cols_array_2d()
-        })
-    })
 }
