@@ -5,6 +5,13 @@
 //! renders them from below (one render pass per atlas batch), and runs the accumulation chain with
 //! one dispatch per stage over all updated surfaces. Surfaces that nothing touched and on which no
 //! snow fell are left alone.
+//!
+//! The update is a plan, then an encode (`frame.rs`): validate the updates, build the pure
+//! [`FramePlan`] on the CPU ([`plan`]: culling, sweeping, replenishment, atlas packing, records and
+//! buffer sizes), upload its tables, record it with [`crate::capture::encode`] and
+//! [`crate::accumulate::encode`], submit, and keep the plan's replenishment carries. The rest of
+//! the world is its surfaces and pool slots (here), mesh deformers (`meshes.rs`), snapshots
+//! (`snapshot.rs`) and readbacks (`readback.rs`).
 
 mod config;
 mod frame;
