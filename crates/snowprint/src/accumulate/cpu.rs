@@ -2,8 +2,8 @@
 
 use glam::Vec3;
 
+use crate::capture::CaptureMode;
 use crate::pool::Precision;
-use crate::world::CaptureMode;
 
 /// Tap offsets of the blur, texels. Must match `TAPS` in `blur.wgsl`.
 pub const TAPS: [[f32; 2]; 4] = [[-0.25, -0.75], [0.75, -0.25], [0.25, 0.75], [-0.75, 0.25]];

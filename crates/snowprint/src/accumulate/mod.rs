@@ -14,6 +14,9 @@
 //! CPU reference: [`cpu`].
 
 pub mod cpu;
+mod encode;
+
+pub use encode::{AccumulateBuffers, AccumulatePlan, encode};
 
 use crate::gpu::resources::compute_storage;
 use crate::pool::Precision;
@@ -30,9 +33,7 @@ pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
 pub const FUSED_SHADER: &str = include_str!("fused.wgsl");
 /// The indirect arguments of the listed fused pass (without the shared prelude).
 pub const SEAL_SHADER: &str = include_str!("seal.wgsl");
-/// Words before the entries of the capture's tile list: the dispatch arguments and the count.
-/// Must match `capture.wgsl`, `fused.wgsl` and `seal.wgsl`.
-pub const TILE_LIST_HEADER: u64 = 4;
+pub use crate::pool::TILE_LIST_HEADER;
 /// The arithmetic shared by every stage.
 pub const MATHS: &str = include_str!("maths.wgsl");
 /// Reading the capture buffer (for the passes that bind it).
@@ -44,8 +45,8 @@ pub const TEXEL_WRITE: &str = include_str!("../pool/texel_write.wgsl");
 
 /// Workgroup side of the separate accumulation passes.
 pub const WORKGROUP: u32 = 8;
-/// Workgroup side of the fused pass (its tile). Must match `SIDE` in `fused.wgsl`.
-pub const FUSED_WORKGROUP: u32 = 16;
+/// Workgroup side of the fused pass: one of the pool's update tiles ([`crate::pool::TILE_SIDE`]).
+pub const FUSED_WORKGROUP: u32 = crate::pool::TILE_SIDE;
 
 /// The shader source of a stage with the shared prelude, as compiled.
 pub fn with_prelude(stage: &str) -> String {

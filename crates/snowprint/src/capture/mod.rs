@@ -15,11 +15,46 @@
 //! CPU reference: [`cpu`].
 
 pub mod cpu;
+mod encode;
+
+pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
 use crate::deformer::{Deformer, Pose, Shape};
+use crate::mesh::MeshId;
+
+/// Which of the talk's two capture paths to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CaptureMode {
+    /// The talk's PC path: the lowest point of any deformer per texel, a minimum-height field.
+    #[default]
+    Depth,
+    /// The talk's console path: clear black, deformers white, a fixed imprint depth.
+    Mask,
+}
+
+/// How surfaces are captured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CaptureConfig {
+    /// Depth or mask capture.
+    pub mode: CaptureMode,
+    /// Height of the frustum above the snow top, metres (default 0.25).
+    pub ankle_height: f32,
+    /// In mask mode, the fraction of the snow depth a covered texel is pressed down (default 1).
+    pub mask_depth: f32,
+}
+
+impl Default for CaptureConfig {
+    fn default() -> Self {
+        Self {
+            mode: CaptureMode::Depth,
+            ankle_height: 0.25,
+            mask_depth: 1.0,
+        }
+    }
+}
 
 /// WGSL of the capture pass.
 pub const SHADER: &str = include_str!("capture.wgsl");
@@ -265,6 +300,32 @@ pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Ve
             }
         }
         Shape::Mesh(_) => {}
+    }
+}
+
+/// Append the draws of one mesh deformer (`mesh`, of bounding radius `radius`), mesh space to the
+/// local frame of `volume`, culled against it. A moving mesh is drawn at sub-steps along its
+/// motion ([`mesh_substeps`]), so that a fast hand or foot leaves a continuous sweep rather than a
+/// comb of copies; the pose at the end is always among them.
+pub fn push_mesh_draws(
+    deformer: &Deformer,
+    mesh: MeshId,
+    radius: f32,
+    volume: &CaptureVolume,
+    draws: &mut Vec<MeshDraw>,
+    meshes: &mut Vec<MeshId>,
+) {
+    let prev = deformer.previous.unwrap_or(deformer.pose);
+    let n = mesh_substeps(&prev, &deformer.pose, radius);
+    for k in 1..=n {
+        let p = prev.lerp(&deformer.pose, k as f32 / n as f32);
+        if volume.overlaps_ball(p.position, radius) {
+            let model = Mat4::from_rotation_translation(p.rotation, p.position);
+            draws.push(MeshDraw {
+                to_local: (volume.world_to_local * model).to_cols_array_2d(),
+            });
+            meshes.push(mesh);
+        }
     }
 }
 

@@ -26,6 +26,13 @@ pub const TEXEL_WGSL: &str = concat!(include_str!("channels.wgsl"), include_str!
 /// WGSL of `channel_max(bits)` alone (part of [`TEXEL_WGSL`]).
 pub const CHANNELS_WGSL: &str = include_str!("channels.wgsl");
 
+/// Side of the update's tiles, texels: the fused pass's workgroup, and the unit in which the
+/// capture flags what it wrote. Must match `SIDE` in `fused.wgsl`.
+pub const TILE_SIDE: u32 = 16;
+/// Words before the entries of the capture's tile list: the dispatch arguments and the count.
+/// Must match `capture.wgsl`, `fused.wgsl` and `seal.wgsl`.
+pub const TILE_LIST_HEADER: u64 = 4;
+
 /// Alignment of slots in the pool, bytes.
 pub const SLOT_ALIGN: u64 = 256;
 
@@ -265,8 +272,7 @@ pub struct SurfaceRecord {
 impl SurfaceRecord {
     /// The update's 16x16 tiles (the fused pass's workgroups) over the surface.
     pub fn tile_count(&self) -> u32 {
-        self.width.div_ceil(crate::accumulate::FUSED_WORKGROUP)
-            * self.height.div_ceil(crate::accumulate::FUSED_WORKGROUP)
+        self.width.div_ceil(TILE_SIDE) * self.height.div_ceil(TILE_SIDE)
     }
 }
 

@@ -1,0 +1,175 @@
+//! Recording a frame's accumulation chain: the records of the surfaces updated
+//! ([`AccumulatePlan`], built on the CPU by the world's frame plan) into one dispatch per stage.
+
+use super::{AccumulatePipelines, FUSED_WORKGROUP, WORKGROUP};
+use crate::gpu::resources::bind_group;
+use crate::gpu::timestamps::StageQueries;
+use crate::pool::SurfaceRecord;
+
+/// What a frame's accumulation runs over and how.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AccumulatePlan {
+    /// One record per updated surface, those that refill snow first.
+    pub records: Vec<SurfaceRecord>,
+    /// Blur and merge fused in one pass (else separate passes through the scratch buffer).
+    pub fused: bool,
+    /// Whether the pool keeps normals (a normals pass follows).
+    pub normals: bool,
+    /// With `fused`: records after the first `grid` are updated only over the tiles the capture
+    /// listed (a seal dispatch, then an indirect one).
+    pub listed: bool,
+    /// Records the fused pass's grid covers (all of them when not `listed`).
+    pub grid: u32,
+    /// Widest record, texels.
+    pub max_width: u32,
+    /// Tallest record, texels.
+    pub max_height: u32,
+    /// Texels the merge writes per invocation (two at 8 bits).
+    pub unit_texels: u32,
+}
+
+impl AccumulatePlan {
+    /// Empty it, keeping its memory.
+    pub fn clear(&mut self) {
+        self.records.clear();
+        self.listed = false;
+        self.grid = 0;
+        self.max_width = 0;
+        self.max_height = 0;
+    }
+}
+
+/// The buffers the accumulation binds, each in the layouts' binding order.
+#[derive(Clone, Copy, Debug)]
+pub struct AccumulateBuffers<'a> {
+    /// [`SurfaceRecord`]s.
+    pub records: &'a wgpu::Buffer,
+    /// The capture (encoded depth per texel).
+    pub capture: &'a wgpu::Buffer,
+    /// Mesh winding per texel.
+    pub winding: &'a wgpu::Buffer,
+    /// Blurred captures (separate passes only).
+    pub scratch: &'a wgpu::Buffer,
+    /// The heightmap pool (updated in place).
+    pub pool: &'a wgpu::Buffer,
+    /// Tile flags written by the capture.
+    pub tiles: &'a wgpu::Buffer,
+    /// The capture's tile list with its indirect dispatch.
+    pub tile_list: &'a wgpu::Buffer,
+}
+
+/// Record a frame's accumulation: fused (or blur then merge), then normals when kept; each a
+/// compute pass with one dispatch over every record (`z` is the record).
+pub fn encode(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipes: &AccumulatePipelines,
+    plan: &AccumulatePlan,
+    b: &AccumulateBuffers<'_>,
+    queries: &mut StageQueries<'_>,
+) {
+    let (max_w, max_h) = (plan.max_width, plan.max_height);
+    let records = plan.records.len() as u32;
+    if plan.fused {
+        let fused_bg = bind_group(
+            device,
+            "fused",
+            &pipes.fused_layout,
+            &[
+                b.records.as_entire_binding(),
+                b.capture.as_entire_binding(),
+                b.pool.as_entire_binding(),
+                b.winding.as_entire_binding(),
+                b.tiles.as_entire_binding(),
+                b.tile_list.as_entire_binding(),
+            ],
+        );
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fused"),
+            timestamp_writes: queries.compute("fused"),
+        });
+        pass.set_bind_group(0, &fused_bg, &[]);
+        // Every tile of the surfaces that refill snow; then only the listed tiles of the others,
+        // as many workgroups as the capture listed.
+        if plan.grid > 0 {
+            pass.set_pipeline(&pipes.fused);
+            pass.dispatch_workgroups(
+                max_w.div_ceil(FUSED_WORKGROUP),
+                max_h.div_ceil(FUSED_WORKGROUP),
+                plan.grid,
+            );
+        }
+        if plan.listed {
+            let seal_bg = bind_group(
+                device,
+                "seal",
+                &pipes.seal_layout,
+                &[b.tile_list.as_entire_binding()],
+            );
+            pass.set_pipeline(&pipes.seal);
+            pass.set_bind_group(0, &seal_bg, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&pipes.fused_listed);
+            pass.set_bind_group(0, &fused_bg, &[]);
+            pass.dispatch_workgroups_indirect(b.tile_list, 0);
+        }
+    } else {
+        let blur_bg = bind_group(
+            device,
+            "blur",
+            &pipes.blur_layout,
+            &[
+                b.records.as_entire_binding(),
+                b.capture.as_entire_binding(),
+                b.winding.as_entire_binding(),
+                b.scratch.as_entire_binding(),
+            ],
+        );
+        let merge_bg = bind_group(
+            device,
+            "merge",
+            &pipes.merge_layout,
+            &[
+                b.records.as_entire_binding(),
+                b.scratch.as_entire_binding(),
+                b.pool.as_entire_binding(),
+            ],
+        );
+        let units_w = max_w.div_ceil(plan.unit_texels);
+        for (stage, pipeline, bg, width) in [
+            ("blur", &pipes.blur, &blur_bg, max_w),
+            ("merge", &pipes.merge, &merge_bg, units_w),
+        ] {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(stage),
+                timestamp_writes: queries.compute(stage),
+            });
+            pass.set_bind_group(0, bg, &[]);
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(
+                width.div_ceil(WORKGROUP),
+                max_h.div_ceil(WORKGROUP),
+                records,
+            );
+        }
+    }
+    if plan.normals {
+        let normals_bg = bind_group(
+            device,
+            "normals",
+            &pipes.normals_layout,
+            &[b.records.as_entire_binding(), b.pool.as_entire_binding()],
+        );
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("normals"),
+            timestamp_writes: queries.compute("normals"),
+        });
+        pass.set_bind_group(0, &normals_bg, &[]);
+        pass.set_pipeline(&pipes.normals);
+        pass.dispatch_workgroups(
+            max_w.div_ceil(WORKGROUP),
+            max_h.div_ceil(WORKGROUP),
+            records,
+        );
+    }
+}

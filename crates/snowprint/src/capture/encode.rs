@@ -1,0 +1,212 @@
+//! Recording a frame's capture: what to draw where ([`CapturePlan`], built on the CPU by the
+//! world's frame plan) into render passes over the atlas, one per batch.
+
+use std::ops::Range;
+
+use super::{CapturePipelines, CaptureView, GpuPrimitive, MeshDraw};
+use crate::gpu::resources::{UNIFORM_STRIDE, bind_group, uniform_block};
+use crate::gpu::timestamps::StageQueries;
+use crate::mesh::MeshId;
+use crate::pool::TILE_LIST_HEADER;
+
+/// A mesh deformer's GPU buffers, as the capture draws it.
+#[derive(Debug)]
+pub struct CaptureMesh {
+    /// Vertex positions (`Float32x3`), posed each frame by the caller.
+    pub vertices: wgpu::Buffer,
+    /// Triangle indices (`Uint32`).
+    pub indices: wgpu::Buffer,
+    /// Indices to draw.
+    pub index_count: u32,
+    /// Vertices the mesh has (a pose must give as many).
+    pub vertex_count: usize,
+    /// Largest distance of a vertex from the mesh's origin, metres (for culling and sub-steps).
+    pub radius: f32,
+}
+
+/// One captured surface: its rectangle of the atlas and what is drawn in it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CapturedSurface {
+    /// The surface's record in the frame's update.
+    pub record: u32,
+    /// Which pass over the atlas.
+    pub batch: u32,
+    /// Left texel in the atlas.
+    pub x: u32,
+    /// Top texel in the atlas.
+    pub y: u32,
+    /// Heightmap width, texels.
+    pub width: u32,
+    /// Heightmap height, texels.
+    pub height: u32,
+    /// The surface's analytic primitives in [`CapturePlan::prims`].
+    pub prims: Range<u32>,
+    /// The surface's mesh draws in [`CapturePlan::draws`].
+    pub draws: Range<u32>,
+}
+
+/// What a frame's capture draws: one [`CapturedSurface`] and one [`CaptureView`] per captured
+/// surface (the view's index is its dynamic offset), the primitives and mesh draws they name,
+/// and the sizes of the buffers the capture writes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CapturePlan {
+    /// Captured surfaces, in view order.
+    pub surfaces: Vec<CapturedSurface>,
+    /// Their views, as uploaded.
+    pub views: Vec<CaptureView>,
+    /// Every analytic primitive of the frame, surface-local, culled and swept.
+    pub prims: Vec<GpuPrimitive>,
+    /// Every mesh draw of the frame.
+    pub draws: Vec<MeshDraw>,
+    /// The mesh of each draw.
+    pub draw_meshes: Vec<MeshId>,
+    /// Side of the atlas, texels.
+    pub atlas_side: u32,
+    /// Render passes over the atlas.
+    pub batches: u32,
+    /// Texels of the capture buffer (every captured surface, one after the other).
+    pub texels: u32,
+    /// Tile flags of the captured surfaces.
+    pub tile_flags: u32,
+}
+
+impl CapturePlan {
+    /// Empty it, keeping its memory.
+    pub fn clear(&mut self) {
+        self.surfaces.clear();
+        self.views.clear();
+        self.prims.clear();
+        self.draws.clear();
+        self.draw_meshes.clear();
+        self.atlas_side = 0;
+        self.batches = 0;
+        self.texels = 0;
+        self.tile_flags = 0;
+    }
+
+    /// Texels of the winding buffer: it counts only mesh solids, so a frame of analytic deformers
+    /// needs none.
+    pub fn winding_texels(&self) -> u32 {
+        if self.draws.is_empty() {
+            0
+        } else {
+            self.texels
+        }
+    }
+}
+
+/// The buffers a capture binds (each at least as large as its plan needs) and the atlas whose
+/// viewports it draws into.
+#[derive(Clone, Copy, Debug)]
+pub struct CaptureBuffers<'a> {
+    /// [`CaptureView`]s, one uniform block (256 bytes) each.
+    pub views: &'a wgpu::Buffer,
+    /// [`GpuPrimitive`]s.
+    pub prims: &'a wgpu::Buffer,
+    /// [`MeshDraw`]s, one uniform block (256 bytes) each.
+    pub draws: &'a wgpu::Buffer,
+    /// Encoded depth per texel (written).
+    pub capture: &'a wgpu::Buffer,
+    /// Mesh winding per texel (written).
+    pub winding: &'a wgpu::Buffer,
+    /// Tile flags (written).
+    pub tiles: &'a wgpu::Buffer,
+    /// Tile list with its indirect dispatch (written).
+    pub tile_list: &'a wgpu::Buffer,
+    /// The atlas's depth view (places the viewports only).
+    pub atlas: &'a wgpu::TextureView,
+}
+
+/// Record a frame's capture: clear what it writes, then one render pass per atlas batch, each
+/// surface in its viewport, primitives then meshes. `meshes` is indexed by [`MeshId`].
+pub fn encode(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipes: &CapturePipelines,
+    plan: &CapturePlan,
+    buffers: &CaptureBuffers<'_>,
+    meshes: &[Option<CaptureMesh>],
+    queries: &mut StageQueries<'_>,
+) {
+    // One uniform block of each table per draw, chosen by dynamic offset.
+    let view_bg = bind_group(
+        device,
+        "capture view",
+        &pipes.view_layout,
+        &[
+            uniform_block(buffers.views, 0, std::mem::size_of::<CaptureView>()),
+            buffers.prims.as_entire_binding(),
+            buffers.capture.as_entire_binding(),
+            buffers.winding.as_entire_binding(),
+            buffers.tiles.as_entire_binding(),
+            buffers.tile_list.as_entire_binding(),
+        ],
+    );
+    let draw_bg = bind_group(
+        device,
+        "capture mesh draw",
+        &pipes.draw_layout,
+        &[uniform_block(
+            buffers.draws,
+            0,
+            std::mem::size_of::<MeshDraw>(),
+        )],
+    );
+    // Nothing captured yet: 0 is the code of "no deformer over this texel".
+    enc.clear_buffer(buffers.capture, 0, Some(plan.texels.max(1) as u64 * 4));
+    let winding = plan.winding_texels();
+    if winding > 0 {
+        enc.clear_buffer(buffers.winding, 0, Some(winding as u64 * 4));
+    }
+    enc.clear_buffer(buffers.tiles, 0, Some(plan.tile_flags.max(1) as u64 * 4));
+    enc.clear_buffer(buffers.tile_list, 0, Some(TILE_LIST_HEADER * 4));
+    for batch in 0..plan.batches {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("capture"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: buffers.atlas,
+                // Only places the viewports: never cleared, read or written.
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: queries.render("capture"),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        for (k, s) in plan.surfaces.iter().enumerate() {
+            if s.batch != batch {
+                continue;
+            }
+            pass.set_viewport(
+                s.x as f32,
+                s.y as f32,
+                s.width as f32,
+                s.height as f32,
+                0.0,
+                1.0,
+            );
+            pass.set_scissor_rect(s.x, s.y, s.width, s.height);
+            pass.set_bind_group(0, &view_bg, &[(k as u64 * UNIFORM_STRIDE) as u32]);
+            if !s.prims.is_empty() {
+                pass.set_pipeline(&pipes.primitives);
+                pass.draw(0..6, s.prims.clone());
+            }
+            if !s.draws.is_empty() {
+                pass.set_pipeline(&pipes.meshes);
+                for d in s.draws.clone() {
+                    let mesh = meshes[plan.draw_meshes[d as usize].0 as usize]
+                        .as_ref()
+                        .expect("meshes are checked before a frame is planned");
+                    pass.set_bind_group(1, &draw_bg, &[(d as u64 * UNIFORM_STRIDE) as u32]);
+                    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                    pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! A world's settings and what it reports: pass settings, frame statistics, memory (the capture
+//! settings live with the capture: [`crate::capture::CaptureConfig`]).
+
+use crate::capture::CaptureConfig;
+use crate::deformer::Deformer;
+use crate::pool::PoolFormat;
+use crate::surface::SurfaceId;
+
+#[cfg(doc)]
+use super::SnowWorld;
+
+/// Settings of a world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldConfig {
+    /// Capture settings.
+    pub capture: CaptureConfig,
+    /// Bytes of GPU memory for heightmaps (the pool). Clamped to the device's largest storage
+    /// binding, with a warning.
+    pub pool_bytes: u64,
+    /// Largest side of the capture atlas, texels (clamped to the device's limit).
+    pub atlas_side: u32,
+    /// Largest heightmap side, texels: 512 as in the talk; benchmarks raise it.
+    pub max_resolution: u32,
+    /// How blur, merge and normals are dispatched.
+    pub passes: PassMode,
+    /// With [`PassMode::Fused`], the fewest tiles (16x16 texels) of captured surfaces that do not
+    /// refill snow for which the update is dispatched over the capture's list of touched tiles
+    /// rather than over every tile (where untouched ones leave at once). The list costs a fixed
+    /// few microseconds (an extra dispatch and an indirect one), a skipped tile under a
+    /// nanosecond: default 16384 (sixteen 512^2 surfaces), from the H100 figures in
+    /// `docs/PERFORMANCE.md`. 0 always lists; `u32::MAX` never does.
+    pub list_tiles_from: u32,
+    /// How heightmaps are stored: bits a channel, and whether normals are kept.
+    pub format: PoolFormat,
+}
+
+/// How the accumulation chain is dispatched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum PassMode {
+    /// The default: fused, which is the faster on every adapter measured (an H100 and llvmpipe:
+    /// `docs/PERFORMANCE.md`).
+    #[default]
+    Auto,
+    /// Blur and merge in one pass: one dispatch instead of two and no scratch round trip, at the
+    /// price of staging each tile's capture apron in workgroup memory, which suits GPUs, where a
+    /// pass costs more than its memory traffic. (Normals, when kept, follow in their own pass.)
+    Fused,
+    /// Separate passes; [`SnowWorld::read_last_blurred`] can then show stage 1's output.
+    Separate,
+}
+
+impl Default for WorldConfig {
+    fn default() -> Self {
+        Self {
+            capture: CaptureConfig::default(),
+            pool_bytes: 32 << 20,
+            atlas_side: 2048,
+            max_resolution: crate::surface::MAX_RESOLUTION,
+            passes: PassMode::Auto,
+            list_tiles_from: 16384,
+            format: PoolFormat::default(),
+        }
+    }
+}
+
+/// GPU time of each stage of one frame, milliseconds (from timestamp queries).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StageTimes {
+    /// All capture render passes.
+    pub capture_ms: f64,
+    /// All blur dispatches.
+    pub blur_ms: f64,
+    /// The merge dispatch.
+    pub merge_ms: f64,
+    /// The normals dispatch.
+    pub normals_ms: f64,
+    /// The fused blur + merge dispatch (when [`PassMode::Fused`]).
+    pub fused_ms: f64,
+}
+
+impl StageTimes {
+    /// Sum of the stages.
+    pub fn total_ms(&self) -> f64 {
+        self.capture_ms + self.blur_ms + self.merge_ms + self.normals_ms + self.fused_ms
+    }
+}
+
+/// What one [`SnowWorld::step`] did.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FrameStats {
+    /// Surfaces whose heightmap was updated.
+    pub updated: u32,
+    /// Of those, surfaces something was captured on.
+    pub captured: u32,
+    /// Capture atlas passes.
+    pub capture_batches: u32,
+    /// Analytic primitives drawn (after sweeping and culling).
+    pub primitives: u32,
+    /// Mesh draws.
+    pub mesh_draws: u32,
+    /// CPU time spent building and encoding the frame, milliseconds.
+    pub cpu_encode_ms: f64,
+    /// Per-stage GPU times, when profiling is on and the adapter has timestamp queries.
+    pub gpu: Option<StageTimes>,
+}
+
+/// Bytes of GPU memory the world holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct MemoryReport {
+    /// The pool's budget.
+    pub pool_budget: u64,
+    /// Pool bytes in slots now.
+    pub pool_used: u64,
+    /// Most pool bytes ever in slots.
+    pub pool_high_water: u64,
+    /// Scratch buffer (blurred captures of one frame, shared by every surface updated in it).
+    pub scratch: u64,
+    /// Capture atlas textures.
+    pub capture_atlas: u64,
+    /// Per-frame tables (records, views, primitives, mesh draws, capture and winding buffers).
+    pub frame_tables: u64,
+    /// How the pool stores heightmaps.
+    pub format: PoolFormat,
+}
+
+/// One surface's share of a [`SnowWorld::update`].
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceUpdate<'a> {
+    /// The surface.
+    pub surface: SurfaceId,
+    /// Seconds since the surface was last updated (for replenishment).
+    pub elapsed: f32,
+    /// Everything that touched it since then, with motion (`previous`) where known.
+    pub deformers: &'a [Deformer],
+}

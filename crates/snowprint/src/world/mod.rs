@@ -1,0 +1,408 @@
+//! The snow world: surfaces, deformers and the per-frame update.
+//!
+//! [`SnowWorld::step`] runs one frame: for every resident surface it culls the deformers against
+//! the surface's capture volume, packs the surfaces that something touches into the capture atlas,
+//! renders them from below (one render pass per atlas batch), and runs the accumulation chain with
+//! one dispatch per stage over all updated surfaces. Surfaces that nothing touched and on which no
+//! snow fell are left alone.
+//!
+//! The update is a plan, then an encode (`frame.rs`): validate the updates, build the pure
+//! [`FramePlan`] on the CPU ([`plan`]: culling, sweeping, replenishment, atlas packing, records and
+//! buffer sizes), upload its tables, record it with [`crate::capture::encode`] and
+//! [`crate::accumulate::encode`], submit, and keep the plan's replenishment carries. The rest of
+//! the world is its surfaces and pool slots (here), mesh deformers (`meshes.rs`), snapshots
+//! (`snapshot.rs`) and readbacks (`readback.rs`).
+
+mod config;
+mod frame;
+mod meshes;
+pub mod plan;
+mod readback;
+mod snapshot;
+
+pub use crate::capture::{CaptureConfig, CaptureMode};
+pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
+pub use plan::FramePlan;
+pub use snapshot::SurfaceSnapshot;
+
+use crate::accumulate::AccumulatePipelines;
+use crate::capture::{self, CaptureMesh, CapturePipelines};
+use crate::error::{Result, SnowError};
+use crate::gpu::resources::{Growable, UNIFORM_STRIDE};
+use crate::gpu::timestamps::Timestamps;
+use crate::gpu::{Capabilities, GpuContext};
+use crate::pool::{PoolFormat, Slot, SlotAllocator, SurfaceRecord};
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+
+struct SurfaceState {
+    desc: SurfaceDesc,
+    layout: SurfaceLayout,
+    slot: Slot,
+    /// Replenishment not yet applied, units (fraction kept between frames).
+    carry: f64,
+}
+
+/// What the last frame did, for debug readbacks.
+#[derive(Default)]
+struct LastFrame {
+    /// (surface index, record) of every captured surface.
+    captured: Vec<(usize, SurfaceRecord)>,
+}
+
+/// CPU memory one update reuses from the last, so that its cost does not grow with allocations.
+#[derive(Default)]
+struct FrameScratch {
+    /// The frame's plan.
+    plan: FramePlan,
+    /// Which surfaces an update lists (to refuse duplicates).
+    seen: Vec<bool>,
+    /// Uniform blocks being uploaded, [`UNIFORM_STRIDE`] apart.
+    blocks: Vec<u8>,
+}
+
+/// The snow world: every surface's heightmap in one GPU pool, updated by [`SnowWorld::step`].
+pub struct SnowWorld {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    caps: Capabilities,
+    config: WorldConfig,
+    capture_pipes: CapturePipelines,
+    acc: AccumulatePipelines,
+    pool: wgpu::Buffer,
+    alloc: SlotAllocator,
+    surfaces: Vec<Option<SurfaceState>>,
+    /// Generation of each slot of `surfaces`: bumped when its surface is removed, so that old
+    /// handles to the slot are refused (see [`SurfaceId`]).
+    generations: Vec<u32>,
+    meshes: Vec<Option<CaptureMesh>>,
+    atlases: Vec<(u32, wgpu::Texture, wgpu::TextureView)>,
+    records: Growable,
+    views: Growable,
+    prims: Growable,
+    draws: Growable,
+    capture: Growable,
+    winding: Growable,
+    /// One flag per 16x16 tile of each captured surface: set by the capture where it wrote.
+    tiles: Growable,
+    /// The flagged tiles as a list with its indirect dispatch (see `accumulate::TILE_LIST_HEADER`).
+    tile_list: Growable,
+    scratch: Growable,
+    last: LastFrame,
+    scratch_cpu: FrameScratch,
+    profiling: bool,
+    timestamps: Option<Timestamps>,
+}
+
+impl std::fmt::Debug for SnowWorld {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SnowWorld")
+            .field("surfaces", &self.surfaces.iter().flatten().count())
+            .field("pool_used", &self.alloc.used())
+            .finish()
+    }
+}
+
+impl SnowWorld {
+    /// Create a world on a GPU context.
+    pub fn new(gpu: &GpuContext, config: WorldConfig) -> Result<Self> {
+        let device = gpu.device.clone();
+        let mut config = config;
+        let c = config.capture;
+        if !(c.ankle_height.is_finite() && c.ankle_height > 0.0) {
+            return Err(SnowError::Scene(format!(
+                "capture ankle_height {} must be a finite number of metres above 0",
+                c.ankle_height
+            )));
+        }
+        if !(c.mask_depth.is_finite() && c.mask_depth > 0.0 && c.mask_depth <= 1.0) {
+            return Err(SnowError::Scene(format!(
+                "capture mask_depth {} must be a fraction in (0, 1]",
+                c.mask_depth
+            )));
+        }
+        let max_pool = gpu
+            .caps
+            .max_storage_binding
+            .min(device.limits().max_buffer_size)
+            / 256
+            * 256;
+        if config.pool_bytes > max_pool {
+            tracing::warn!(
+                "heightmap pool of {} bytes exceeds this device's largest storage binding; using {} bytes",
+                config.pool_bytes,
+                max_pool
+            );
+            config.pool_bytes = max_pool;
+        }
+        config.atlas_side = config.atlas_side.clamp(64, gpu.caps.max_texture_side);
+        if config.passes == PassMode::Auto {
+            config.passes = PassMode::Fused;
+        }
+        config.max_resolution = config.max_resolution.clamp(1, config.atlas_side);
+        let alloc = SlotAllocator::new(config.pool_bytes);
+        let pool = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("heightmap pool"),
+            size: alloc.budget().max(256),
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        use wgpu::BufferUsages as U;
+        let timestamps = gpu
+            .caps
+            .timestamps
+            .then(|| Timestamps::new(&device, &gpu.queue, "snowprint timestamps", 256));
+        Ok(Self {
+            capture_pipes: CapturePipelines::new(&device),
+            acc: AccumulatePipelines::new(&device, config.format.precision),
+            records: Growable::new(
+                &device,
+                "surface records",
+                U::STORAGE | U::COPY_DST,
+                64 * 64,
+            ),
+            views: Growable::new(
+                &device,
+                "capture views",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 16,
+            ),
+            prims: Growable::new(
+                &device,
+                "capture primitives",
+                U::STORAGE | U::COPY_DST,
+                80 * 64,
+            ),
+            draws: Growable::new(
+                &device,
+                "capture mesh draws",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 16,
+            ),
+            capture: Growable::new(
+                &device,
+                "capture",
+                U::STORAGE | U::COPY_DST | U::COPY_SRC,
+                4 * 4096,
+            ),
+            winding: Growable::new(
+                &device,
+                "capture winding",
+                U::STORAGE | U::COPY_DST | U::COPY_SRC,
+                4 * 4096,
+            ),
+            tiles: Growable::new(&device, "capture tiles", U::STORAGE | U::COPY_DST, 4 * 256),
+            tile_list: Growable::new(
+                &device,
+                "capture tile list",
+                U::STORAGE | U::INDIRECT | U::COPY_DST,
+                4 * 512,
+            ),
+            scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
+            queue: gpu.queue.clone(),
+            caps: gpu.caps.clone(),
+            device,
+            config,
+            pool,
+            alloc,
+            surfaces: Vec::new(),
+            generations: Vec::new(),
+            meshes: Vec::new(),
+            atlases: Vec::new(),
+            last: LastFrame::default(),
+            scratch_cpu: FrameScratch::default(),
+            profiling: false,
+            timestamps,
+        })
+    }
+
+    /// The world's settings (after clamping to the device).
+    pub fn config(&self) -> &WorldConfig {
+        &self.config
+    }
+
+    /// Measure each stage with GPU timestamp queries (when the adapter has them). Each
+    /// [`SnowWorld::step`] then waits for the GPU and reports [`FrameStats::gpu`].
+    pub fn set_profiling(&mut self, on: bool) {
+        self.profiling = on;
+    }
+
+    /// Whether per-stage GPU times can be measured on this device.
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps.is_some()
+    }
+
+    /// Add a surface; its heightmap starts untouched. Fails with [`SnowError::PoolExhausted`] when
+    /// the pool has no room (a normal state: remove a surface or give the pool more bytes).
+    pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
+        desc.validate()?;
+        let layout = SurfaceLayout::for_size_capped(desc.size, self.config.max_resolution);
+        let slot = self.reserve_slot(&desc.name, &layout, None)?;
+        Ok(self.insert_state(SurfaceState {
+            desc,
+            layout,
+            slot,
+            carry: 0.0,
+        }))
+    }
+
+    /// A cleared slot for a surface of `layout`: first fit, or at `at` in the pool.
+    fn reserve_slot(
+        &mut self,
+        name: &str,
+        layout: &SurfaceLayout,
+        at: Option<u64>,
+    ) -> Result<Slot> {
+        let needed = self.config.format.slot_bytes(layout.width, layout.height);
+        let slot = match at {
+            Some(offset) => self.alloc.alloc_at(offset, needed),
+            None => self.alloc.alloc(needed),
+        }
+        .ok_or_else(|| SnowError::PoolExhausted {
+            name: name.to_owned(),
+            needed,
+            free: self.alloc.largest_free(),
+            budget: self.alloc.budget(),
+        })?;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
+        self.queue.submit([enc.finish()]);
+        Ok(slot)
+    }
+
+    fn insert_state(&mut self, state: SurfaceState) -> SurfaceId {
+        // A free slot whose generation is spent (u32::MAX removals) is retired, never reused.
+        let free = (0..self.surfaces.len())
+            .find(|&i| self.surfaces[i].is_none() && self.generations[i] != u32::MAX);
+        let index = match free {
+            Some(i) => {
+                self.surfaces[i] = Some(state);
+                i
+            }
+            None => {
+                self.surfaces.push(Some(state));
+                self.generations.push(0);
+                self.surfaces.len() - 1
+            }
+        };
+        SurfaceId(index as u32, self.generations[index])
+    }
+
+    /// Remove a surface and give its pool bytes back.
+    pub fn remove_surface(&mut self, id: SurfaceId) -> Result<()> {
+        self.state(id)?;
+        let index = id.0 as usize;
+        let state = self.surfaces[index].take().expect("checked live above");
+        self.generations[index] = self.generations[index].saturating_add(1);
+        self.alloc.free(state.slot);
+        Ok(())
+    }
+
+    /// The description of a surface.
+    pub fn surface(&self, id: SurfaceId) -> Result<&SurfaceDesc> {
+        Ok(&self.state(id)?.desc)
+    }
+
+    /// Heightmap resolution of a surface.
+    pub fn layout(&self, id: SurfaceId) -> Result<SurfaceLayout> {
+        Ok(self.state(id)?.layout)
+    }
+
+    /// Every live surface.
+    pub fn surfaces(&self) -> impl Iterator<Item = (SurfaceId, &SurfaceDesc)> {
+        self.surfaces.iter().enumerate().filter_map(|(i, s)| {
+            s.as_ref()
+                .map(|s| (SurfaceId(i as u32, self.generations[i]), &s.desc))
+        })
+    }
+
+    fn state(&self, id: SurfaceId) -> Result<&SurfaceState> {
+        let index = id.0 as usize;
+        self.surfaces
+            .get(index)
+            .and_then(Option::as_ref)
+            .filter(|_| self.generations[index] == id.1)
+            .ok_or(SnowError::StaleHandle {
+                what: "surface",
+                index: id.0,
+            })
+    }
+
+    /// Bytes of GPU memory held.
+    pub fn memory(&self) -> MemoryReport {
+        MemoryReport {
+            pool_budget: self.alloc.budget(),
+            pool_used: self.alloc.used(),
+            pool_high_water: self.alloc.high_water(),
+            scratch: self.scratch.buffer.size(),
+            capture_atlas: self
+                .atlases
+                .iter()
+                .map(|a| a.0 as u64 * a.0 as u64 * 2)
+                .sum(),
+            frame_tables: self.records.buffer.size()
+                + self.views.buffer.size()
+                + self.prims.buffer.size()
+                + self.draws.buffer.size()
+                + self.capture.buffer.size()
+                + self.winding.buffer.size()
+                + self.tiles.buffer.size()
+                + self.tile_list.buffer.size(),
+            format: self.config.format,
+        }
+    }
+
+    fn atlas(&mut self, side: u32) -> usize {
+        if let Some(i) = self.atlases.iter().position(|a| a.0 == side) {
+            return i;
+        }
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("capture atlas"),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: capture::ATLAS_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        self.atlases.push((side, texture, view));
+        self.atlases.len() - 1
+    }
+
+    /// Pool placement of a surface's slot, for renderers that read the heightmap on the GPU:
+    /// `(heights word offset, normals word offset when kept)`. Valid while the surface lives;
+    /// read the heights with `pool/texel.wgsl` ([`crate::pool::TEXEL_WGSL`]) at
+    /// [`SnowWorld::pool_format`]'s precision.
+    pub fn gpu_offsets(&self, id: SurfaceId) -> Result<(u32, Option<u32>)> {
+        let s = self.state(id)?;
+        Ok((
+            s.slot.heights_word(),
+            s.slot
+                .normals_word(&self.config.format, s.layout.width, s.layout.height),
+        ))
+    }
+
+    /// How the pool stores heightmaps.
+    pub fn pool_format(&self) -> PoolFormat {
+        self.config.format
+    }
+
+    /// The pool buffer (`array<u32>` in WGSL), for renderers that sample heightmaps on the GPU.
+    pub fn pool_buffer(&self) -> &wgpu::Buffer {
+        &self.pool
+    }
+
+    /// The device's capabilities as checked at start.
+    pub fn capabilities(&self) -> &Capabilities {
+        &self.caps
+    }
+}

@@ -1,0 +1,383 @@
+//! The frame plan: everything one update decides on the CPU, before a GPU command is recorded.
+//!
+//! [`FramePlan::build`] culls each surface's deformers against its capture volume, sweeps the
+//! analytic ones into primitives (sub-steps along their motion) and the meshes into draws,
+//! counts the snow each surface refills (carrying the fraction), packs the captured surfaces into
+//! the atlas, writes the surface records and capture views, and sizes every per-frame buffer. It
+//! needs no GPU, so it is tested on its own (`plan/tests.rs`); [`crate::capture::encode`] and
+//! [`crate::accumulate::encode`] then record it.
+
+use std::ops::Range;
+
+use glam::Vec2;
+
+use super::{FrameStats, PassMode, WorldConfig};
+use crate::accumulate::AccumulatePlan;
+use crate::capture::{
+    self, CaptureConfig, CaptureMode, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
+};
+use crate::deformer::{Deformer, Shape};
+use crate::gpu::resources::UNIFORM_STRIDE;
+use crate::mesh::MeshId;
+use crate::pool::{
+    MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+};
+use crate::surface::{SurfaceDesc, SurfaceLayout};
+
+#[cfg(test)]
+mod tests;
+
+/// The settings of a world that a plan follows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanSettings {
+    /// Capture settings.
+    pub capture: CaptureConfig,
+    /// How the pool stores heightmaps.
+    pub format: PoolFormat,
+    /// Fused or separate accumulation ([`PassMode::Auto`] is fused).
+    pub passes: PassMode,
+    /// See [`WorldConfig::list_tiles_from`].
+    pub list_tiles_from: u32,
+    /// Largest side of the capture atlas, texels.
+    pub atlas_side: u32,
+}
+
+impl PlanSettings {
+    /// The settings of a world's configuration.
+    pub fn of(config: &WorldConfig) -> Self {
+        Self {
+            capture: config.capture,
+            format: config.format,
+            passes: config.passes,
+            list_tiles_from: config.list_tiles_from,
+            atlas_side: config.atlas_side,
+        }
+    }
+
+    fn fused(&self) -> bool {
+        self.passes != PassMode::Separate
+    }
+}
+
+/// One surface to update, as the plan sees it: its description, its place in the pool, the
+/// replenishment it carried, and what touched it.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanSurface<'a> {
+    /// The world's index of the surface (carried to the plan's outputs).
+    pub index: usize,
+    /// The surface.
+    pub desc: &'a SurfaceDesc,
+    /// Its heightmap resolution.
+    pub layout: SurfaceLayout,
+    /// Word offset of its heights in the pool.
+    pub heights_word: u32,
+    /// Word offset of its normals, when the pool keeps them.
+    pub normals_word: Option<u32>,
+    /// Replenishment carried from earlier updates, units (a fraction in `[0, 1)`).
+    pub carry: f64,
+    /// Seconds since its last update.
+    pub elapsed: f32,
+    /// Everything that touched it since then.
+    pub deformers: &'a [Deformer],
+}
+
+/// A surface the plan updates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlannedSurface {
+    /// The world's index of the surface.
+    pub index: usize,
+    /// Whether something is captured on it (else it only refills snow).
+    pub captured: bool,
+}
+
+/// Bytes each per-frame buffer must hold for the plan (0: not used this frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BufferSizes {
+    /// Surface records.
+    pub records: u64,
+    /// Capture views, one uniform block each.
+    pub views: u64,
+    /// Analytic primitives.
+    pub prims: u64,
+    /// Mesh draws, one uniform block each.
+    pub draws: u64,
+    /// Blurred captures (separate passes only).
+    pub scratch: u64,
+    /// The capture.
+    pub capture: u64,
+    /// Mesh winding (only when meshes are drawn).
+    pub winding: u64,
+    /// Tile flags.
+    pub tiles: u64,
+    /// The tile list with its header.
+    pub tile_list: u64,
+}
+
+/// One surface's work while the plan is built.
+#[derive(Clone, Debug)]
+struct Job {
+    surface: PlannedSurface,
+    record: SurfaceRecord,
+    half_size: Vec2,
+    prims: Range<u32>,
+    draws: Range<u32>,
+}
+
+/// Everything one update records, decided on the CPU. Kept by the world and rebuilt each frame
+/// ([`FramePlan::rebuild`]) so that its vectors are reused.
+#[derive(Clone, Debug, Default)]
+pub struct FramePlan {
+    /// The updated surfaces, parallel to `accumulate.records`: those that refill snow first.
+    pub surfaces: Vec<PlannedSurface>,
+    /// What the capture draws.
+    pub capture: CapturePlan,
+    /// What the accumulation runs over.
+    pub accumulate: AccumulatePlan,
+    /// The replenishment carry of every surface planned (updated or not), to keep once the frame
+    /// is submitted: `(index, carry)`.
+    pub carries: Vec<(usize, f64)>,
+    /// What each per-frame buffer must hold.
+    pub sizes: BufferSizes,
+    jobs: Vec<Job>,
+    rects: Vec<(u32, u32)>,
+}
+
+impl FramePlan {
+    /// Plan a frame of `surfaces` (each listed once). `mesh_radius` gives the bounding radius of
+    /// a registered mesh (`None`: not registered; its deformers are skipped).
+    pub fn build<'a>(
+        settings: &PlanSettings,
+        surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
+        mesh_radius: impl Fn(MeshId) -> Option<f32>,
+    ) -> Self {
+        let mut plan = Self::default();
+        plan.rebuild(settings, surfaces, mesh_radius);
+        plan
+    }
+
+    /// [`FramePlan::build`] into this plan, reusing its memory.
+    pub fn rebuild<'a>(
+        &mut self,
+        settings: &PlanSettings,
+        surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
+        mesh_radius: impl Fn(MeshId) -> Option<f32>,
+    ) {
+        self.clear();
+        for s in surfaces {
+            self.plan_surface(settings, &s, &mesh_radius);
+        }
+        // Surfaces that refill snow first: the fused grid covers records 0..dense; the others are
+        // updated only where the capture listed a tile.
+        self.jobs.sort_by_key(|j| j.record.replenish_units == 0);
+        self.pack_atlas(settings);
+        self.write_tables(settings);
+    }
+
+    /// Whether nothing is updated (no GPU work at all).
+    pub fn is_empty(&self) -> bool {
+        self.surfaces.is_empty()
+    }
+
+    /// What the frame does, as [`FrameStats`] counts them (times left at zero).
+    pub fn stats(&self) -> FrameStats {
+        FrameStats {
+            updated: self.surfaces.len() as u32,
+            captured: self.capture.surfaces.len() as u32,
+            capture_batches: self.capture.batches,
+            primitives: self.capture.prims.len() as u32,
+            mesh_draws: self.capture.draws.len() as u32,
+            ..Default::default()
+        }
+    }
+
+    fn clear(&mut self) {
+        self.surfaces.clear();
+        self.capture.clear();
+        self.accumulate.clear();
+        self.carries.clear();
+        self.sizes = BufferSizes::default();
+        self.jobs.clear();
+        self.rects.clear();
+    }
+
+    /// Replenishment, culling and sweeping of one surface; a job when there is anything to do.
+    fn plan_surface(
+        &mut self,
+        settings: &PlanSettings,
+        s: &PlanSurface<'_>,
+        mesh_radius: &impl Fn(MeshId) -> Option<f32>,
+    ) {
+        let (carry, units) = replenish(
+            s.carry,
+            s.desc.replenish_rate,
+            s.elapsed,
+            settings.format.precision.channel_max(),
+        );
+        self.carries.push((s.index, carry));
+        let frustum_height = s.desc.snow_depth + settings.capture.ankle_height;
+        let volume = CaptureVolume {
+            world_to_local: s.desc.world_to_local(),
+            half_size: s.desc.size * 0.5,
+            frustum_height,
+        };
+        let prims = &mut self.capture.prims;
+        let (draws, draw_meshes) = (&mut self.capture.draws, &mut self.capture.draw_meshes);
+        let p0 = prims.len() as u32;
+        let d0 = draws.len() as u32;
+        for d in s.deformers {
+            match d.shape {
+                Shape::Mesh(id) => {
+                    let Some(radius) = mesh_radius(id) else {
+                        continue;
+                    };
+                    capture::push_mesh_draws(d, id, radius, &volume, draws, draw_meshes);
+                }
+                _ => capture::push_primitives(d, &volume, prims),
+            }
+        }
+        let (p1, d1) = (prims.len() as u32, draws.len() as u32);
+        let captured = p1 > p0 || d1 > d0;
+        if !captured && units == 0 {
+            return;
+        }
+        let texel = s.desc.size / Vec2::new(s.layout.width as f32, s.layout.height as f32);
+        let mode = match settings.capture.mode {
+            CaptureMode::Depth => 0,
+            CaptureMode::Mask => 1,
+        } | if d1 > d0 { MODE_MESHES } else { 0 };
+        self.jobs.push(Job {
+            surface: PlannedSurface {
+                index: s.index,
+                captured,
+            },
+            record: SurfaceRecord {
+                heights: s.heights_word,
+                normals: s.normals_word.unwrap_or(NO_NORMALS),
+                scratch: 0,
+                width: s.layout.width,
+                height: s.layout.height,
+                atlas_x: 0,
+                atlas_y: 0,
+                mode,
+                replenish_units: units,
+                batch: NO_CAPTURE,
+                mask_fraction: settings.capture.mask_depth,
+                snow_depth: s.desc.snow_depth,
+                frustum_height,
+                texel_x: texel.x,
+                texel_z: texel.y,
+                tiles: 0,
+            },
+            half_size: volume.half_size,
+            prims: p0..p1,
+            draws: d0..d1,
+        });
+    }
+
+    /// Place captured surfaces in the atlas, the capture buffer and the tile flags.
+    fn pack_atlas(&mut self, settings: &PlanSettings) {
+        self.rects.extend(
+            self.jobs
+                .iter()
+                .filter(|j| j.surface.captured)
+                .map(|j| (j.record.width, j.record.height)),
+        );
+        // The atlas is cleared whole every pass, so keep it as small as the frame allows: the
+        // smallest power-of-two side that holds every rectangle in one batch, up to the limit.
+        let (placements, atlas_side) =
+            capture::pack_atlas_compact(&self.rects, settings.atlas_side);
+        let c = &mut self.capture;
+        c.atlas_side = atlas_side;
+        c.batches = placements.iter().map(|p| p.batch + 1).max().unwrap_or(0);
+        let captured = self.jobs.iter_mut().filter(|j| j.surface.captured);
+        for (job, p) in captured.zip(&placements) {
+            let r = &mut job.record;
+            r.atlas_x = p.x;
+            r.atlas_y = p.y;
+            r.batch = p.batch;
+            r.scratch = c.texels;
+            c.texels += r.width * r.height;
+            r.tiles = c.tile_flags;
+            c.tile_flags += r.tile_count();
+        }
+    }
+
+    /// Records, views, the accumulation's dispatch shape and the buffer sizes.
+    fn write_tables(&mut self, settings: &PlanSettings) {
+        let dense = self
+            .jobs
+            .iter()
+            .take_while(|j| j.record.replenish_units > 0)
+            .count();
+        let still_tiles: u64 = self.jobs[dense..]
+            .iter()
+            .filter(|j| j.surface.captured)
+            .map(|j| j.record.tile_count() as u64)
+            .sum();
+        let fused = settings.fused();
+        let listed = fused && still_tiles > 0 && still_tiles >= settings.list_tiles_from as u64;
+        let a = &mut self.accumulate;
+        a.fused = fused;
+        a.normals = settings.format.normals;
+        a.unit_texels = settings.format.precision.unit_texels();
+        a.listed = listed;
+        // Without the list, the grid covers every record.
+        a.grid = if listed { dense } else { self.jobs.len() } as u32;
+        a.max_width = self.jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
+        a.max_height = self.jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
+        let c = &mut self.capture;
+        for (j, job) in self.jobs.iter().enumerate() {
+            self.surfaces.push(job.surface);
+            a.records.push(job.record);
+            if !job.surface.captured {
+                continue;
+            }
+            let r = &job.record;
+            c.surfaces.push(CapturedSurface {
+                record: j as u32,
+                batch: r.batch,
+                x: r.atlas_x,
+                y: r.atlas_y,
+                width: r.width,
+                height: r.height,
+                prims: job.prims.clone(),
+                draws: job.draws.clone(),
+            });
+            c.views.push(CaptureView {
+                half_size: job.half_size.to_array(),
+                frustum_height: r.frustum_height,
+                offset: r.scratch,
+                origin: [r.atlas_x as f32, r.atlas_y as f32],
+                texels: [r.width as f32, r.height as f32],
+                tiles: r.tiles,
+                tiles_x: r.width.div_ceil(TILE_SIDE),
+                record: if listed { j as u32 } else { capture::NO_LIST },
+                pad: 0,
+            });
+        }
+        if self.jobs.is_empty() {
+            return;
+        }
+        let texels = c.texels.max(1) as u64 * 4;
+        self.sizes = BufferSizes {
+            records: (a.records.len() * std::mem::size_of::<SurfaceRecord>()) as u64,
+            views: c.views.len().max(1) as u64 * UNIFORM_STRIDE,
+            prims: std::mem::size_of_val(c.prims.as_slice()) as u64,
+            draws: c.draws.len() as u64 * UNIFORM_STRIDE,
+            // The blurred capture goes through memory only when blur and merge are separate.
+            scratch: if fused { 0 } else { texels },
+            capture: texels,
+            winding: c.winding_texels() as u64 * 4,
+            tiles: c.tile_flags.max(1) as u64 * 4,
+            tile_list: (TILE_LIST_HEADER + 2 * c.tile_flags as u64) * 4,
+        };
+    }
+}
+
+/// Add a surface's replenishment over `elapsed` seconds to its carry: `(new carry, whole units
+/// refilled now)`, units of `1 / channel_max` of the snow depth.
+pub fn replenish(carry: f64, rate: f32, elapsed: f32, channel_max: u32) -> (f64, u32) {
+    let carry = carry + rate as f64 * elapsed as f64 * channel_max as f64;
+    let units = carry.floor().min(u32::MAX as f64);
+    (carry - units, units as u32)
+}

@@ -1,0 +1,318 @@
+//! The frame plan without a GPU: culling, sweeping, replenishment, atlas packing, dispatch shape.
+
+use glam::{Quat, Vec2};
+use proptest::prelude::*;
+
+use super::*;
+use crate::deformer::Pose;
+use crate::pool::Precision;
+
+fn settings() -> PlanSettings {
+    PlanSettings::of(&WorldConfig::default())
+}
+
+/// Surfaces `descs` at consecutive pool offsets, each touched by `deformers[i]`.
+fn inputs<'a>(
+    descs: &'a [SurfaceDesc],
+    deformers: &'a [Vec<Deformer>],
+    elapsed: f32,
+) -> Vec<PlanSurface<'a>> {
+    let mut word = 0;
+    descs
+        .iter()
+        .zip(deformers)
+        .enumerate()
+        .map(|(index, (desc, deformers))| {
+            let layout = SurfaceLayout::for_size_capped(desc.size, 512);
+            let s = PlanSurface {
+                index,
+                desc,
+                layout,
+                heights_word: word,
+                normals_word: None,
+                carry: 0.0,
+                elapsed,
+                deformers,
+            };
+            word += layout.width * layout.height;
+            s
+        })
+        .collect()
+}
+
+fn no_meshes(_: MeshId) -> Option<f32> {
+    None
+}
+
+fn sphere_at(p: [f32; 3]) -> Deformer {
+    Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at(p))
+}
+
+/// A surface 4 x 4 m, 0.3 m of snow, at `x` along the street, that does not refill.
+fn still(name: &str, x: f32) -> SurfaceDesc {
+    let mut d = SurfaceDesc::new(name, [x, 0.0, 0.0], [4.0, 4.0], 0.3);
+    d.replenish_rate = 0.0;
+    d
+}
+
+#[test]
+fn deformers_are_culled_against_each_capture_volume() {
+    let descs = [still("a", 0.0), still("b", 10.0), still("c", 20.0)];
+    let deformers = vec![
+        // Over a: captured.
+        vec![sphere_at([0.5, 0.1, 0.5])],
+        // Beside b (outside its 4 m square) and above its frustum (0.3 + 0.25 m): nothing.
+        vec![sphere_at([13.0, 0.1, 0.0]), sphere_at([10.0, 0.8, 0.0])],
+        // Nothing over c.
+        vec![],
+    ];
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.1), no_meshes);
+    assert_eq!(
+        plan.surfaces,
+        vec![PlannedSurface {
+            index: 0,
+            captured: true
+        }]
+    );
+    assert_eq!(plan.capture.prims.len(), 1);
+    assert_eq!(plan.capture.surfaces.len(), 1);
+    assert_eq!(plan.capture.surfaces[0].prims, 0..1);
+    // Every surface planned keeps its carry, updated or not.
+    assert_eq!(plan.carries, vec![(0, 0.0), (1, 0.0), (2, 0.0)]);
+    let stats = plan.stats();
+    assert_eq!((stats.updated, stats.captured, stats.primitives), (1, 1, 1));
+}
+
+#[test]
+fn nothing_to_do_plans_nothing() {
+    let descs = [still("a", 0.0)];
+    let deformers = vec![vec![sphere_at([30.0, 0.1, 0.0])]];
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.1), no_meshes);
+    assert!(plan.is_empty());
+    assert_eq!(plan.sizes, BufferSizes::default());
+    assert_eq!(plan.capture.batches, 0);
+}
+
+#[test]
+fn a_moving_capsule_is_drawn_at_its_sub_steps() {
+    let descs = [still("a", 0.0)];
+    let (radius, half_height) = (0.05, 0.1);
+    let from = Pose::at([-1.0, 0.1, 0.0]);
+    let to = Pose::at([1.0, 0.1, 0.0]);
+    let capsule = Shape::Capsule {
+        radius,
+        half_height,
+    };
+    let deformers = vec![vec![Deformer::moving(capsule, from, to)]];
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.0), no_meshes);
+    // 2 m in steps of half the radius, at most MAX_SUBSTEPS, both ends drawn.
+    let n = capture::substeps(2.0, radius);
+    assert_eq!(n, capture::MAX_SUBSTEPS);
+    assert_eq!(plan.capture.prims.len() as u32, n + 1);
+    // A sphere is swept exactly: one capsule whatever the distance.
+    let sphere = Shape::Sphere { radius: 0.2 };
+    let deformers = vec![vec![Deformer::moving(sphere, from, to)]];
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.0), no_meshes);
+    assert_eq!(plan.capture.prims.len(), 1);
+    // At rest, one capsule.
+    let deformers = vec![vec![Deformer::new(capsule, to)]];
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.0), no_meshes);
+    assert_eq!(plan.capture.prims.len(), 1);
+}
+
+#[test]
+fn a_moving_mesh_is_drawn_at_its_sub_steps_and_culled() {
+    let descs = [still("a", 0.0)];
+    let id = MeshId(0);
+    let from = Pose::at([-0.1, 0.1, 0.0]);
+    let to = Pose {
+        rotation: Quat::from_rotation_y(0.5),
+        ..Pose::at([0.1, 0.1, 0.0])
+    };
+    let deformers = vec![vec![Deformer::moving(Shape::Mesh(id), from, to)]];
+    let radius = 0.2;
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.0), |m| {
+        (m == id).then_some(radius)
+    });
+    let n = capture::mesh_substeps(&from, &to, radius);
+    assert!(n > 1);
+    assert_eq!(plan.capture.draws.len() as u32, n);
+    assert_eq!(plan.capture.draw_meshes, vec![id; n as usize]);
+    assert_eq!(plan.accumulate.records[0].mode & MODE_MESHES, MODE_MESHES);
+    assert_eq!(plan.capture.winding_texels(), plan.capture.texels);
+    // An unregistered mesh draws nothing.
+    let plan = FramePlan::build(&settings(), inputs(&descs, &deformers, 0.0), no_meshes);
+    assert!(plan.is_empty());
+}
+
+/// Units refilled over `frames` updates of `dt`, the carry fed back as the world does.
+fn refilled(rate: f32, dt: f32, frames: u32, precision: Precision) -> u64 {
+    let mut desc = still("a", 0.0);
+    desc.replenish_rate = rate;
+    let mut s = settings();
+    s.format.precision = precision;
+    let mut carry = 0.0;
+    let mut total = 0u64;
+    let mut plan = FramePlan::default();
+    let nothing = [vec![]];
+    for _ in 0..frames {
+        let mut input = inputs(std::slice::from_ref(&desc), &nothing, dt);
+        input[0].carry = carry;
+        plan.rebuild(&s, input, no_meshes);
+        carry = plan.carries[0].1;
+        assert!((0.0..1.0).contains(&carry));
+        total += plan
+            .accumulate
+            .records
+            .first()
+            .map_or(0, |r| r.replenish_units) as u64;
+    }
+    total
+}
+
+#[test]
+fn replenishment_over_many_frames_is_the_whole_units_of_rate_times_time() {
+    // Exact in binary: 0.25 of the depth a second, 1/64 s frames, 16 bits.
+    let total = refilled(0.25, 1.0 / 64.0, 1000, Precision::Bits16);
+    assert_eq!(total, (0.25 * 1000.0 / 64.0 * 65535.0f64).floor() as u64);
+    // A slow snowfall at 60 Hz that refills less than a unit a frame at 8 bits.
+    let (rate, dt) = (0.01f32, 1.0f32 / 60.0);
+    let total = refilled(rate, dt, 6000, Precision::Bits8);
+    let exact = rate as f64 * dt as f64 * 255.0 * 6000.0;
+    assert_eq!(total, exact.floor() as u64);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Units refilled over many frames equal floor(rate * t * max) (but where the exact total
+    /// lies within rounding of a whole unit).
+    #[test]
+    fn replenishment_carries_the_fraction(
+        rate in 0.0f32..0.05,
+        dt in 0.001f32..0.1,
+        frames in 1u32..400,
+        bits in prop::sample::select(vec![8u32, 16, 32]),
+    ) {
+        let precision = Precision::from_bits(bits).unwrap();
+        let total = refilled(rate, dt, frames, precision);
+        let exact = rate as f64 * dt as f64 * precision.channel_max() as f64 * frames as f64;
+        let near_whole = (exact - exact.round()).abs() < 1e-6 * exact.max(1.0);
+        prop_assume!(!near_whole);
+        prop_assert_eq!(total, exact.floor() as u64);
+    }
+
+    /// Captured surfaces are placed inside the atlas, in its batches, never overlapping, each
+    /// exactly once, with the capture buffer and tile flags laid out one after the other.
+    #[test]
+    fn atlas_batches_never_overlap_and_cover_every_captured_surface(
+        sizes in prop::collection::vec((1.0f32..20.0, 1.0f32..20.0, any::<bool>()), 1..24),
+        atlas_side in prop::sample::select(vec![64u32, 256, 512, 1024]),
+    ) {
+        let descs: Vec<SurfaceDesc> = sizes
+            .iter()
+            .enumerate()
+            .map(|(i, &(w, h, _))| {
+                let mut d = still(&format!("s{i}"), i as f32 * 50.0);
+                d.size = Vec2::new(w, h);
+                d
+            })
+            .collect();
+        let deformers: Vec<Vec<Deformer>> = sizes
+            .iter()
+            .enumerate()
+            .map(|(i, &(_, _, touched))| {
+                if touched { vec![sphere_at([i as f32 * 50.0, 0.1, 0.0])] } else { vec![] }
+            })
+            .collect();
+        let mut s = settings();
+        s.atlas_side = atlas_side;
+        // The world caps heightmaps at the atlas side.
+        let mut input = inputs(&descs, &deformers, 0.1);
+        for p in &mut input {
+            p.layout = SurfaceLayout::for_size_capped(p.desc.size, atlas_side);
+        }
+        let plan = FramePlan::build(&s, input, no_meshes);
+        let c = &plan.capture;
+        let touched: Vec<usize> = (0..sizes.len()).filter(|&i| sizes[i].2).collect();
+        let mut seen: Vec<usize> = c.surfaces.iter().map(|s| plan.surfaces[s.record as usize].index).collect();
+        seen.sort();
+        prop_assert_eq!(seen, touched);
+        prop_assert!(c.atlas_side <= atlas_side.max(64));
+        let (mut texels, mut flags) = (0, 0);
+        for (k, a) in c.surfaces.iter().enumerate() {
+            prop_assert!(a.batch < c.batches);
+            prop_assert!(a.x + a.width <= c.atlas_side && a.y + a.height <= c.atlas_side);
+            let r = &plan.accumulate.records[a.record as usize];
+            prop_assert_eq!((r.atlas_x, r.atlas_y, r.batch), (a.x, a.y, a.batch));
+            prop_assert_eq!((r.width, r.height), (a.width, a.height));
+            prop_assert_eq!((r.scratch, r.tiles), (texels, flags));
+            prop_assert_eq!(c.views[k].offset, r.scratch);
+            texels += r.width * r.height;
+            flags += r.tile_count();
+            for b in &c.surfaces[k + 1..] {
+                let apart = a.batch != b.batch
+                    || a.x + a.width <= b.x
+                    || b.x + b.width <= a.x
+                    || a.y + a.height <= b.y
+                    || b.y + b.height <= a.y;
+                prop_assert!(apart, "{:?} and {:?} overlap", a, b);
+            }
+        }
+        prop_assert_eq!((c.texels, c.tile_flags), (texels, flags));
+        // An empty plan needs no buffer at all.
+        let capture_bytes = if plan.is_empty() { 0 } else { texels.max(1) as u64 * 4 };
+        prop_assert_eq!(plan.sizes.capture, capture_bytes);
+    }
+}
+
+#[test]
+fn surfaces_that_refill_come_first_and_the_rest_are_listed() {
+    let mut refill = still("refill", 0.0);
+    refill.replenish_rate = 0.1;
+    let descs = [still("a", 10.0), refill, still("b", 20.0)];
+    let deformers = vec![
+        vec![sphere_at([10.0, 0.1, 0.0])],
+        vec![],
+        vec![sphere_at([20.0, 0.1, 0.0])],
+    ];
+    let mut s = settings();
+    s.list_tiles_from = 0;
+    let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
+    let order: Vec<usize> = plan.surfaces.iter().map(|p| p.index).collect();
+    assert_eq!(order, vec![1, 0, 2]);
+    let a = &plan.accumulate;
+    assert!(a.fused && a.listed);
+    assert_eq!(a.grid, 1);
+    assert_eq!(plan.capture.views[0].record, 1);
+    // Never listing: the grid covers every record and the views say so.
+    s.list_tiles_from = u32::MAX;
+    let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
+    assert!(!plan.accumulate.listed);
+    assert_eq!(plan.accumulate.grid, 3);
+    assert!(
+        plan.capture
+            .views
+            .iter()
+            .all(|v| v.record == capture::NO_LIST)
+    );
+    // Separate passes never list, and need the scratch buffer.
+    s.passes = PassMode::Separate;
+    s.list_tiles_from = 0;
+    let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
+    assert!(!plan.accumulate.fused && !plan.accumulate.listed);
+    assert_eq!(plan.sizes.scratch, plan.sizes.capture);
+}
+
+#[test]
+fn rebuilding_reuses_the_plan() {
+    let descs = [still("a", 0.0)];
+    let deformers = vec![vec![sphere_at([0.0, 0.1, 0.0])]];
+    let mut plan = FramePlan::default();
+    plan.rebuild(&settings(), inputs(&descs, &deformers, 0.1), no_meshes);
+    let first = plan.clone();
+    plan.rebuild(&settings(), inputs(&descs, &deformers, 0.1), no_meshes);
+    assert_eq!(plan.capture, first.capture);
+    assert_eq!(plan.accumulate, first.accumulate);
+    assert_eq!(plan.surfaces, first.surfaces);
+}

@@ -1,0 +1,135 @@
+//! Reading a world's heightmaps, normals and last captures back to the CPU (waits for the GPU).
+
+use super::{PassMode, SnowWorld};
+use crate::accumulate;
+use crate::capture;
+use crate::error::{Result, SnowError};
+use crate::gpu::readback;
+use crate::heightmap::Heightmap;
+use crate::surface::SurfaceId;
+
+#[cfg(doc)]
+use crate::pool::PoolFormat;
+
+impl SnowWorld {
+    /// Copy `size` bytes of a GPU buffer to the CPU.
+    fn download(&self, source: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<u8>> {
+        readback::download(&self.device, &self.queue, source, offset, size)
+    }
+
+    /// The words of a surface's heights region as stored (layout per precision: see
+    /// [`crate::pool`]; at 16 bits, depression in the low 16 bits and displaced in the high 16).
+    pub fn read_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
+        let s = self.state(id)?;
+        let bytes = self.download(
+            &self.pool,
+            s.slot.offset,
+            self.config
+                .format
+                .heights_bytes(s.layout.width, s.layout.height),
+        )?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// A surface's `(depression, displaced)` channels in units of `1 / channel_max` of the snow
+    /// depth at the pool's precision, row-major.
+    pub fn read_channels(&self, id: SurfaceId) -> Result<(Vec<u32>, Vec<u32>)> {
+        let s = self.state(id)?;
+        let words = self.read_packed(id)?;
+        self.config
+            .format
+            .decode(s.layout.width, s.layout.height, &words)
+    }
+
+    /// Read a surface's current heightmap back to the CPU (waits for the GPU), in 16-bit units
+    /// whatever the pool's precision (exact at 8 and 16 bits, rounded to nearest at 32).
+    pub fn read_heightmap(&self, id: SurfaceId) -> Result<Heightmap> {
+        let s = self.state(id)?;
+        let (depression, displaced) = self.read_channels(id)?;
+        Ok(Heightmap::from_channels(
+            s.layout.width,
+            s.layout.height,
+            self.config.format.precision,
+            &depression,
+            &displaced,
+        ))
+    }
+
+    /// Read a surface's packed normals (see [`crate::accumulate::cpu::unpack_normal`]). Fails
+    /// when the pool keeps no normals ([`PoolFormat::normals`]).
+    pub fn read_normals_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
+        let s = self.state(id)?;
+        let Some(word) = s
+            .slot
+            .normals_word(&self.config.format, s.layout.width, s.layout.height)
+        else {
+            return Err(SnowError::Readback(
+                "this world keeps no normals; set WorldConfig.format.normals to keep them".into(),
+            ));
+        };
+        let bytes = self.download(&self.pool, word as u64 * 4, s.layout.texels() * 4)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// Read a surface's normals in its local frame.
+    pub fn read_normals(&self, id: SurfaceId) -> Result<Vec<glam::Vec3>> {
+        Ok(self
+            .read_normals_packed(id)?
+            .into_iter()
+            .map(accumulate::cpu::unpack_normal)
+            .collect())
+    }
+
+    /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing), when
+    /// it was captured in that step; `None` otherwise.
+    pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        self.state(id)?;
+        let Some(&(_, r)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
+            return Ok(None);
+        };
+        let bytes = self.download(
+            &self.capture.buffer,
+            r.scratch as u64 * 4,
+            (r.width * r.height) as u64 * 4,
+        )?;
+        // The winding buffer holds this surface's texels only when meshes were drawn over it.
+        let winding = if r.mode & crate::pool::MODE_MESHES != 0 {
+            self.download(
+                &self.winding.buffer,
+                r.scratch as u64 * 4,
+                (r.width * r.height) as u64 * 4,
+            )?
+        } else {
+            vec![0; (r.width * r.height) as usize * 4]
+        };
+        let codes: &[u32] = bytemuck::cast_slice(&bytes);
+        let winding: &[i32] = bytemuck::cast_slice(&winding);
+        // As capture_read.wgsl reads it: inside a mesh solid at the ground, depth 0.
+        Ok(Some(
+            codes
+                .iter()
+                .zip(winding)
+                .map(|(&v, &n)| if n > 0 { 0.0 } else { capture::decode_depth(v) })
+                .collect(),
+        ))
+    }
+
+    /// Debug readback of the last step: the blurred capture (stage 1 output) of a surface, when it
+    /// was captured in that step by separate stages ([`PassMode::Separate`]; the fused pass keeps
+    /// stage 1's output in registers).
+    pub fn read_last_blurred(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        self.state(id)?;
+        if self.config.passes == PassMode::Fused {
+            return Ok(None);
+        }
+        let Some(&(_, r)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
+            return Ok(None);
+        };
+        let bytes = self.download(
+            &self.scratch.buffer,
+            r.scratch as u64 * 4,
+            (r.width * r.height) as u64 * 4,
+        )?;
+        Ok(Some(bytemuck::cast_slice(&bytes).to_vec()))
+    }
+}
