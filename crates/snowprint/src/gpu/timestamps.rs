@@ -51,6 +51,22 @@ impl Timestamps {
     pub fn capacity(&self) -> u32 {
         self.capacity
     }
+
+    /// The query set (for passes that place their writes themselves, as the renderer's fixed
+    /// slots do).
+    pub fn query_set(&self) -> &wgpu::QuerySet {
+        &self.set
+    }
+
+    /// The buffer the queries resolve into (`QUERY_RESOLVE | COPY_SRC`, 8 bytes a query).
+    pub fn resolve_buffer(&self) -> &wgpu::Buffer {
+        &self.resolve
+    }
+
+    /// Nanoseconds a timestamp tick.
+    pub fn period_ns(&self) -> f32 {
+        self.period_ns
+    }
 }
 
 /// The passes measured in one frame, in order, each by a pair of timestamps named by its stage.

@@ -206,7 +206,7 @@ impl Renderer {
             timestamps: gpu
                 .caps
                 .timestamps
-                .then(|| Timestamps::new(&device, &gpu.queue)),
+                .then(|| readback::new_timestamps(&device, &gpu.queue)),
             stats: StatsReadback::new(&device),
             shadow,
             frame,

@@ -3,8 +3,10 @@
 
 use super::error::{RenderError, RenderResult};
 use super::graph::PASSES;
+use crate::gpu::{readback, timestamps};
 
-/// Copy `size` bytes of a buffer at `offset` back to the CPU (waits for the GPU).
+/// Copy `size` bytes of a buffer at `offset` back to the CPU (waits for the GPU), through the
+/// library's one readback path (`gpu::readback`), `size` rounded up to whole words.
 pub(super) fn read_back(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -12,41 +14,19 @@ pub(super) fn read_back(
     offset: u64,
     size: u64,
 ) -> RenderResult<Vec<u8>> {
-    let size = size.div_ceil(4) * 4;
-    if size == 0 {
-        return Ok(Vec::new());
-    }
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("render readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
-    queue.submit([encoder.finish()]);
-    map_staging(device, &staging)
+    readback::download(device, queue, buffer, offset, size.div_ceil(4) * 4).map_err(readback_error)
 }
 
 /// Map a staging buffer whose copy has been submitted, and take its bytes (waits for the GPU).
 pub(super) fn map_staging(device: &wgpu::Device, staging: &wgpu::Buffer) -> RenderResult<Vec<u8>> {
-    let slice = staging.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| RenderError::Readback(format!("{e:?}")))?
-        .to_vec();
-    staging.unmap();
-    Ok(data)
+    readback::map_read(device, staging, 0, staging.size()).map_err(readback_error)
+}
+
+fn readback_error(e: crate::SnowError) -> RenderError {
+    match e {
+        crate::SnowError::Readback(reason) => RenderError::Readback(reason),
+        other => RenderError::Readback(other.to_string()),
+    }
 }
 
 /// A half float's value.
@@ -61,31 +41,18 @@ pub(super) fn f16_to_f32(h: u16) -> f32 {
     }
 }
 
-/// Timestamp queries of the frame's passes, two per entry of [`PASSES`].
-pub(super) struct Timestamps {
-    pub set: wgpu::QuerySet,
-    pub resolve: wgpu::Buffer,
-    pub period_ns: f32,
-}
+/// Timestamp queries of the frame's passes, two per entry of [`PASSES`] (the library's one query
+/// set type, `gpu::timestamps`, with the renderer placing its writes at fixed slots).
+pub(super) type Timestamps = timestamps::Timestamps;
 
-impl Timestamps {
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
-        let count = 2 * PASSES.len() as u32;
-        Self {
-            set: device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("render pass timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count,
-            }),
-            resolve: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("render timestamp resolve"),
-                size: count as u64 * 8,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            period_ns: queue.get_timestamp_period(),
-        }
-    }
+/// The renderer's query set: two timestamps per entry of [`PASSES`].
+pub(super) fn new_timestamps(device: &wgpu::Device, queue: &wgpu::Queue) -> Timestamps {
+    Timestamps::new(
+        device,
+        queue,
+        "render pass timestamps",
+        2 * PASSES.len() as u32,
+    )
 }
 
 /// The timestamp writes of a pass's render passes: `begin` and `end` say whether this render
@@ -97,7 +64,7 @@ pub(super) fn render_span(
     end: bool,
 ) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
     ts.map(|t| wgpu::RenderPassTimestampWrites {
-        query_set: &t.set,
+        query_set: t.query_set(),
         beginning_of_pass_write_index: begin.then_some(2 * slot as u32),
         end_of_pass_write_index: end.then_some(2 * slot as u32 + 1),
     })
@@ -117,7 +84,7 @@ pub(super) fn compute_writes(
     slot: usize,
 ) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
     ts.map(|t| wgpu::ComputePassTimestampWrites {
-        query_set: &t.set,
+        query_set: t.query_set(),
         beginning_of_pass_write_index: Some(2 * slot as u32),
         end_of_pass_write_index: Some(2 * slot as u32 + 1),
     })

@@ -84,9 +84,14 @@ impl StatsReadback {
         }
         encoder.copy_buffer_to_buffer(from.counters, 0, &self.buffer, state_bytes, dice_bytes);
         if let Some(ts) = from.timestamps {
-            encoder.resolve_query_set(&ts.set, 0..2 * PASSES.len() as u32, &ts.resolve, 0);
+            encoder.resolve_query_set(
+                ts.query_set(),
+                0..2 * PASSES.len() as u32,
+                ts.resolve_buffer(),
+                0,
+            );
             encoder.copy_buffer_to_buffer(
-                &ts.resolve,
+                ts.resolve_buffer(),
                 0,
                 &self.buffer,
                 state_bytes + dice_bytes,
@@ -198,7 +203,7 @@ impl StatsReadback {
                 let dt = tick(2 * i + 1).saturating_sub(tick(2 * i));
                 pass_times.push(PassTime {
                     name: p.name,
-                    gpu_ms: dt as f64 * ts.period_ns as f64 * 1e-6,
+                    gpu_ms: dt as f64 * ts.period_ns() as f64 * 1e-6,
                 });
             }
         }
