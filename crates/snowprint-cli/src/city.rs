@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use glam::Vec3;
-use snowprint::manager::city::{self, SurfaceKind};
 use snowprint::manager::{CameraView, ManagerConfig, SnowManager};
 use snowprint::{GpuContext, GpuOptions};
+use snowprint_demo::city::{self, SurfaceKind};
 
 use crate::output::OutputSet;
 use crate::progress::Progress;

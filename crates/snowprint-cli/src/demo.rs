@@ -7,71 +7,22 @@
 //! first frame, and everything is written as one output set (`output.rs`): readers see the whole
 //! set of this run or of the one before, and a run that fails leaves the one before untouched.
 //!
-//! The world comes from one function, [`build_scene`], returning a [`DemoScene`]: swap it for
-//! another world (the library's `snowprint::demo` once it lands) without touching the rest.
+//! The world comes from one function, [`build_scene`] (in the demo crate, `snowprint_demo::scene`),
+//! returning a [`DemoScene`]: swap it for another world without touching the rest.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use snowprint::render::{
-    DebugView, Environment, Instance, PointLight, RenderConfig, RenderFrame, Renderer, Tier,
-};
-use snowprint::{
-    Camera, GpuContext, GpuOptions, GroundMaterial, SnowWorld, SurfaceId, WorldConfig,
-};
+use snowprint::render::{DebugView, RenderConfig, RenderFrame, Renderer, Tier};
+use snowprint::{GpuContext, GpuOptions, SnowWorld, WorldConfig};
+
+use snowprint_demo::scene::build_scene;
 
 use crate::output::OutputSet;
 use crate::progress::Progress;
 
 #[path = "contact_sheet.rs"]
 mod contact_sheet;
-#[path = "demo_world.rs"]
-mod demo_world;
-#[path = "standin.rs"]
-mod standin;
-
-/// A world the demo can simulate and draw. Built once (surfaces into the world, meshes into the
-/// renderer), then asked what happens at each moment.
-pub trait DemoScene {
-    /// A short description for the report.
-    fn name(&self) -> &str;
-    /// Snow surfaces with the ground under each.
-    fn surfaces(&self) -> &[(SurfaceId, GroundMaterial)];
-    /// Street lamps and other point lights.
-    fn lights(&self) -> &[PointLight];
-    /// Moon, sky and haze (both demos: the moonlit night).
-    fn environment(&self) -> Environment {
-        Environment::moonlit_night()
-    }
-    /// Advance the snow of `world` from `t0` to `t1`: whatever presses the snow meanwhile, with
-    /// its poses at both ends (by `SnowWorld::step`, or per surface by `SnowWorld::update`).
-    fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String>;
-    /// Meshes to draw at time `t`.
-    fn instances(&self, t: f32) -> Vec<Instance>;
-    /// Names of the cameras.
-    fn cameras(&self) -> &[&'static str];
-    /// Seconds of the action a camera's clip covers.
-    fn span(&self, camera: &str) -> (f32, f32);
-    /// A camera at time `t`; `None` for an unknown name.
-    fn camera(&self, name: &str, t: f32) -> Option<Camera>;
-}
-
-/// The demo world by name: `rooftops`, the library's demo world (`snowprint::demo`), or
-/// `standin`, the small world this command carried before that one existed. This is the one place
-/// where a world plugs into the renderer's demo.
-pub fn build_scene(
-    name: &str,
-    world: &mut SnowWorld,
-    renderer: &mut Renderer,
-) -> Result<Box<dyn DemoScene>, String> {
-    match name {
-        "rooftops" => Ok(Box::new(demo_world::LibraryDemo::new(world, renderer)?)),
-        "standin" => Ok(Box::new(standin::StandIn::new(world, renderer)?)),
-        _ => Err(format!(
-            "unknown scene {name:?}; use rooftops, standin or city"
-        )),
-    }
-}
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

@@ -11,10 +11,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{ManagedDeformer, ZoneId};
-use crate::deformer::{Deformer, Pose, Shape};
-use crate::surface::SurfaceDesc;
-use crate::view::{Camera, GroundMaterial};
+use snowprint::deformer::{Deformer, Pose, Shape};
+use snowprint::manager::{ManagedDeformer, ZoneId};
+use snowprint::surface::SurfaceDesc;
+use snowprint::view::{Camera, GroundMaterial};
 
 /// Metres from one block to the next.
 pub const BLOCK_PITCH: f32 = 30.0;

@@ -4,8 +4,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::TickStats;
-use crate::error::{Result, SnowError};
+use snowprint::TickStats;
+use snowprint::error::{Result, SnowError};
 
 const WIDTH: f32 = 960.0;
 const LEFT: f32 = 80.0;

@@ -1,5 +1,5 @@
-//! The stand-in demo world (`snowprint demo --scene standin`), built in code before the library's
-//! own demo world (`snowprint::demo`) existed and kept as a small, self-contained second world:
+//! The stand-in demo world (`snowprint demo --scene standin`), built in code before the demo crate's
+//! own demo world ([`crate::DemoWorld`]) existed and kept as a small, self-contained second world:
 //! three flat roofs at different heights (concrete, roof tiles, and one nobody walks on, so
 //! it keeps the basic material), a street with lamps, facades with lit windows, a water tower, and
 //! capsule people: one walks (heel, ball, arch and toe blocks per boot), one runs down the street, one
@@ -12,7 +12,7 @@ use snowprint::{
     Camera, Deformer, GroundMaterial, Mesh, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
 };
 
-use crate::demo::DemoScene;
+use super::DemoScene;
 
 const TAU: f32 = std::f32::consts::TAU;
 const PI: f32 = std::f32::consts::PI;
