@@ -2,7 +2,7 @@
 //! resolution and deformers per surface, against a plain copy of the same bytes measured in the
 //! same run.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::Vec3;
@@ -538,9 +538,9 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         "statistic": "median",
         "rows": rows,
     });
-    write(
-        &outputs.path("bench.json"),
-        &serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
+    outputs.write(
+        "bench.json",
+        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
     )?;
     for sweep in ["surfaces", "resolution", "deformers"] {
         let pts: Vec<&Row> = rows.iter().filter(|r| r.sweep == sweep).collect();
@@ -560,7 +560,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
                 ),
             ],
         );
-        write(&outputs.path(&format!("bench_{sweep}.svg")), &svg)?;
+        outputs.write(&format!("bench_{sweep}.svg"), svg)?;
     }
     outputs.publish()?;
     eprintln!("snowprint: wrote {}", args.out.display());
@@ -739,11 +739,6 @@ fn precision_errors(gpu: &GpuContext, frames: u32) -> Result<Vec<PrecisionError>
         });
     }
     Ok(out)
-}
-
-/// Write a file of the output set (in its staging folder: the set is published as a whole).
-fn write(path: &Path, text: &str) -> Result<(), String> {
-    std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// A log-log line plot as SVG.

@@ -70,9 +70,7 @@ pub fn run(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), Stri
         Some(budget),
     )?;
     let map = city_map(&snow, &city, &ids)?;
-    let map_path = set.path("city_map.png");
-    std::fs::write(&map_path, map)
-        .map_err(|e| format!("cannot write {}: {e}", map_path.display()))?;
+    set.write("city_map.png", map)?;
     set.publish()?;
     eprintln!(
         "snowprint: city of {} surfaces and {} walkers, {frames} frames: {resident} surfaces hold a heightmap at the end, {evictions} evictions, longest wait {longest_wait} frames; wrote city_report.json, city_pool.svg and city_map.png to {}",

@@ -302,16 +302,9 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
                 renderer.set_tier(args.tier);
                 let sheet =
                     contact_sheet::side_by_side(&pair[0], &pair[1], "relief", "tessellated");
-                let path = staging.path("compare_tiers.png");
-                sheet
-                    .save(&path)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                staging.write_with("compare_tiers.png", |path| sheet.save(path))?;
             }
-            let name = format!("frame_{k:04}.png");
-            let path = staging.path(&name);
-            image
-                .save(&path)
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            staging.write_with(&format!("frame_{k:04}.png"), |path| image.save(path))?;
             if k % gif_every == 0 {
                 gif.add(&image)?;
             }
@@ -325,10 +318,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     bar.set_message("encoding");
     gif.finish()?;
     let sheet = contact_sheet::compose(&sheet_images);
-    let sheet_path = staging.path("contact_sheet.png");
-    sheet
-        .save(&sheet_path)
-        .map_err(|e| format!("cannot write {}: {e}", sheet_path.display()))?;
+    staging.write_with("contact_sheet.png", |path| sheet.save(path))?;
     let mp4 = if frames > 1 {
         let fps = (1000.0 / delay_ms as f32).round().max(1.0);
         let dir = staging.staging().to_owned();
@@ -428,9 +418,7 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         "wall_seconds": wall.elapsed().as_secs_f64(),
     });
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
-    let report_path = staging.path("report.json");
-    std::fs::write(&report_path, text)
-        .map_err(|e| format!("cannot write {}: {e}", report_path.display()))?;
+    staging.write("report.json", text)?;
     let files = staging.names().len();
     staging.publish()?;
     eprintln!(
