@@ -374,6 +374,49 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             gpu.info.name
         );
     }
+    let configs = configs(quick);
+    let mut bar = Progress::new(configs.len() as u64, "bench", "configurations")?;
+    let mut rows = Vec::new();
+    for c in &configs {
+        bar.set_message(&format!(
+            "{} x {}^2, {} deformers",
+            c.surfaces, c.resolution, c.deformers
+        ));
+        rows.push(measure(&gpu, c, args)?);
+        bar.inc(1);
+    }
+    bar.finish();
+
+    print_rows(&gpu, &rows);
+    let (fits, errors) = talk_memory(&gpu, quick)?;
+    let report = serde_json::json!({
+        "memory_talk_pool": {
+            "pool_bytes": 2u64 << 20,
+            "layout": "depression and displaced snow per texel at the pool's precision, updated in place (no history per surface: the capture buffers of a frame are shared by every surface in it); normals not kept (the renderer derives them)",
+            "fits": fits,
+        },
+        "precision_error_vs_32_bit": errors,
+        "adapter": snowprint::gpu::describe(&gpu.info),
+        "timestamps": timestamps,
+        "frames": args.frames,
+        "warmup": args.warmup,
+        "statistic": "median",
+        "rows": rows,
+    });
+    outputs.write(
+        "bench.json",
+        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
+    )?;
+    write_plots(&mut outputs, &gpu.info.name, &rows)?;
+    outputs.publish()?;
+    eprintln!("snowprint: wrote {}", args.out.display());
+    Ok(())
+}
+
+/// The configurations to measure: the talk's frame (fused and as separate passes, at each
+/// precision), then the sweeps (`quick`: small ones only) and, unless quick, the 1024
+/// surfaces of 512^2.
+fn configs(quick: bool) -> Vec<Config> {
     let cfg = |sweep, surfaces, resolution, deformers, passes| Config {
         sweep,
         surfaces,
@@ -430,18 +473,12 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             cfg("many_512", 1024, 512, 1, fused),
         )));
     }
-    let mut bar = Progress::new(configs.len() as u64, "bench", "configurations")?;
-    let mut rows = Vec::new();
-    for c in &configs {
-        bar.set_message(&format!(
-            "{} x {}^2, {} deformers",
-            c.surfaces, c.resolution, c.deformers
-        ));
-        rows.push(measure(&gpu, c, args)?);
-        bar.inc(1);
-    }
-    bar.finish();
+    configs
+}
 
+/// The rows as a table on stdout, under the adapter and how it was timed.
+fn print_rows(gpu: &GpuContext, rows: &[Row]) {
+    let timestamps = gpu.caps.timestamps;
     println!(
         "adapter: {}\ntimestamps: {}\n",
         snowprint::gpu::describe(&gpu.info),
@@ -470,7 +507,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         "copy_us",
         "x_copy"
     );
-    for r in &rows {
+    for r in rows {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
@@ -493,11 +530,17 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             r.ratio_to_copy
         );
     }
-    // The talk's memory: how many 512^2 surfaces a real 2 MiB pool holds at each precision, and
-    // what each precision costs in accuracy against 32 bits on the talk's frame.
+}
+
+/// The talk's memory: how many 512^2 surfaces a real 2 MiB pool holds at each precision, and
+/// what each precision costs in accuracy against 32 bits on the talk's frame (printed as well).
+fn talk_memory(
+    gpu: &GpuContext,
+    quick: bool,
+) -> Result<(Vec<PoolFit>, Vec<PrecisionError>), String> {
     let fits = Precision::ALL
         .into_iter()
-        .map(|p| talk_pool_fit(&gpu, p))
+        .map(|p| talk_pool_fit(gpu, p))
         .collect::<Result<Vec<_>, _>>()?;
     println!(
         "\nmemory: 512^2 surfaces (both channels, no history, no normals) in the talk's 2 MiB pool"
@@ -508,7 +551,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             f.precision_bits, f.bytes_per_surface, f.surfaces
         );
     }
-    let errors = precision_errors(&gpu, if quick { 30 } else { 120 })?;
+    let errors = precision_errors(gpu, if quick { 30 } else { 120 })?;
     println!(
         "\nprecision: {} frames of the talk's frame (2 x 512^2, 10 moving spheres each, snow refilling), against 32 bits",
         errors[0].frames
@@ -524,24 +567,11 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             e.displaced_mean
         );
     }
-    let report = serde_json::json!({
-        "memory_talk_pool": {
-            "pool_bytes": 2u64 << 20,
-            "layout": "depression and displaced snow per texel at the pool's precision, updated in place (no history per surface: the capture buffers of a frame are shared by every surface in it); normals not kept (the renderer derives them)",
-            "fits": fits,
-        },
-        "precision_error_vs_32_bit": errors,
-        "adapter": snowprint::gpu::describe(&gpu.info),
-        "timestamps": timestamps,
-        "frames": args.frames,
-        "warmup": args.warmup,
-        "statistic": "median",
-        "rows": rows,
-    });
-    outputs.write(
-        "bench.json",
-        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
-    )?;
+    Ok((fits, errors))
+}
+
+/// One SVG plot a sweep: the update's time and the copy's against the swept quantity.
+fn write_plots(outputs: &mut OutputSet, adapter: &str, rows: &[Row]) -> Result<(), String> {
     for sweep in ["surfaces", "resolution", "deformers"] {
         let pts: Vec<&Row> = rows.iter().filter(|r| r.sweep == sweep).collect();
         let x = |r: &Row| match sweep {
@@ -550,7 +580,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             _ => r.deformers_per_surface as f64,
         };
         let svg = plot_svg(
-            &format!("update time vs {sweep} ({})", gpu.info.name),
+            &format!("update time vs {sweep} ({})", adapter),
             sweep,
             &[
                 ("update", pts.iter().map(|r| (x(r), r.update_us)).collect()),
@@ -562,8 +592,6 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         );
         outputs.write(&format!("bench_{sweep}.svg"), svg)?;
     }
-    outputs.publish()?;
-    eprintln!("snowprint: wrote {}", args.out.display());
     Ok(())
 }
 
