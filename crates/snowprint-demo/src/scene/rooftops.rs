@@ -181,7 +181,8 @@ impl LibraryDemo {
 
 impl DemoScene for LibraryDemo {
     fn name(&self) -> &str {
-        "snowprint_demo (DemoWorld::build)"
+        // The name the report has always given this world (kept for readers of report.json).
+        "snowprint::demo (DemoWorld::build)"
     }
 
     fn surfaces(&self) -> &[(SurfaceId, GroundMaterial)] {
