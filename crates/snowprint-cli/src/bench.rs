@@ -579,7 +579,7 @@ fn write_plots(outputs: &mut OutputSet, adapter: &str, rows: &[Row]) -> Result<(
             "resolution" => r.resolution as f64,
             _ => r.deformers_per_surface as f64,
         };
-        let svg = plot_svg(
+        let svg = snowprint_demo::plot::log_log_svg(
             &format!("update time vs {sweep} ({})", adapter),
             sweep,
             &[
@@ -589,7 +589,7 @@ fn write_plots(outputs: &mut OutputSet, adapter: &str, rows: &[Row]) -> Result<(
                     pts.iter().map(|r| (x(r), r.copy_us)).collect(),
                 ),
             ],
-        );
+        )?;
         outputs.write(&format!("bench_{sweep}.svg"), svg)?;
     }
     Ok(())
@@ -767,77 +767,4 @@ fn precision_errors(gpu: &GpuContext, frames: u32) -> Result<Vec<PrecisionError>
         });
     }
     Ok(out)
-}
-
-/// A log-log line plot as SVG.
-pub fn plot_svg(title: &str, x_label: &str, series: &[(&str, Vec<(f64, f64)>)]) -> String {
-    let (w, h, m) = (640.0, 400.0, 60.0);
-    let all: Vec<(f64, f64)> = series
-        .iter()
-        .flat_map(|s| s.1.iter().copied())
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-        .collect();
-    let lx = |v: f64| v.log10();
-    let (x0, x1) = all.iter().fold((f64::MAX, f64::MIN), |a, p| {
-        (a.0.min(lx(p.0)), a.1.max(lx(p.0)))
-    });
-    let (y0, y1) = all.iter().fold((f64::MAX, f64::MIN), |a, p| {
-        (a.0.min(lx(p.1)), a.1.max(lx(p.1)))
-    });
-    let (x0, x1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0));
-    let (y0, y1) = (y0.floor(), y1.ceil().max(y0.floor() + 1.0));
-    let px = |v: f64| m + (lx(v) - x0) / (x1 - x0) * (w - 2.0 * m);
-    let py = |v: f64| h - m - (lx(v) - y0) / (y1 - y0) * (h - 2.0 * m);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{}\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">{title}</text>\n",
-        w / 2.0
-    );
-    for d in (x0 as i32)..=(x1 as i32) {
-        let x = m + (d as f64 - x0) / (x1 - x0) * (w - 2.0 * m);
-        s += &format!(
-            "<line x1=\"{x}\" y1=\"{m}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{d}</text>\n",
-            h - m,
-            h - m + 16.0
-        );
-    }
-    for d in (y0 as i32)..=(y1 as i32) {
-        let y = h - m - (d as f64 - y0) / (y1 - y0) * (h - 2.0 * m);
-        s += &format!(
-            "<line x1=\"{m}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{d} us</text>\n",
-            w - m,
-            m - 4.0,
-            y + 4.0
-        );
-    }
-    s += &format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n",
-        w / 2.0,
-        h - 12.0
-    );
-    let colors = ["#1f77b4", "#d62728", "#2ca02c"];
-    for (i, (name, pts)) in series.iter().enumerate() {
-        let c = colors[i % colors.len()];
-        let path: Vec<String> = pts
-            .iter()
-            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-            .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
-            .collect();
-        s += &format!(
-            "<polyline fill=\"none\" stroke=\"{c}\" stroke-width=\"2\" points=\"{}\"/>\n",
-            path.join(" ")
-        );
-        for p in pts.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0) {
-            s += &format!(
-                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3\" fill=\"{c}\"/>\n",
-                px(p.0),
-                py(p.1)
-            );
-        }
-        s += &format!(
-            "<text x=\"{}\" y=\"{}\" fill=\"{c}\">{name}</text>\n",
-            m + 10.0,
-            m + 16.0 + 16.0 * i as f64
-        );
-    }
-    s + "</svg>\n"
 }

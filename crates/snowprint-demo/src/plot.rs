@@ -1,26 +1,29 @@
-//! A picture of a run: pool bytes used against the budget, and surface updates and evictions per
-//! frame, as a self-contained SVG (hand-written: no plotting dependency).
+//! Pictures of runs as self-contained SVG, drawn with `plotters` (its SVG backend only): the
+//! surface manager's run (pool bytes used against the budget, surface updates and evictions per
+//! frame, [`svg`]) and the command's benchmark sweeps (log-log lines, [`log_log_svg`]).
 
-use std::fmt::Write as _;
 use std::path::Path;
 
+use plotters::coord::Shift;
+use plotters::prelude::*;
 use snowprint::TickStats;
 use snowprint::error::{Result, SnowError};
 
-const WIDTH: f32 = 960.0;
-const LEFT: f32 = 80.0;
-const RIGHT: f32 = 20.0;
-const POOL_TOP: f32 = 50.0;
-const POOL_HEIGHT: f32 = 220.0;
-const UPDATES_TOP: f32 = 330.0;
-const UPDATES_HEIGHT: f32 = 150.0;
-const HEIGHT: f32 = 530.0;
+const WIDTH: u32 = 960;
+const HEIGHT: u32 = 530;
+/// Height of the pool panel (the title above it, the updates panel below).
+const POOL_PANEL: u32 = 270;
 
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+const POOL_FILL: RGBColor = RGBColor(0x9e, 0xca, 0xe1);
+const POOL_LINE: RGBColor = RGBColor(0x31, 0x82, 0xbd);
+const BUDGET: RGBColor = RGBColor(0xd6, 0x27, 0x28);
+/// The colour of an update bar: one bar a frame that updated something.
+pub const UPDATE_BAR: RGBColor = RGBColor(0x74, 0xc4, 0x76);
+const UPDATE_BUDGET: RGBColor = RGBColor(0x31, 0xa3, 0x54);
+
+/// A drawing error as a sentence (drawing into a string fails only on a bug of the plot).
+fn drawing<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+    format!("cannot draw the plot: {e}")
 }
 
 fn bytes_label(b: f64) -> String {
@@ -36,160 +39,174 @@ fn bytes_label(b: f64) -> String {
 /// Top: pool bytes in slots (filled) and the budget (dashed). Bottom: surfaces updated per frame
 /// (bars, with the budget's level when it is finite) and surfaces evicted (red ticks below the
 /// axis).
-pub fn svg(frames: &[TickStats], title: &str, updates_per_frame: Option<usize>) -> String {
-    let mut s = String::new();
-    let plot_w = WIDTH - LEFT - RIGHT;
-    let n = frames.len().max(1) as f32;
-    let x_of = |i: usize| LEFT + plot_w * i as f32 / n;
+pub fn svg(
+    frames: &[TickStats],
+    title: &str,
+    updates_per_frame: Option<usize>,
+) -> std::result::Result<String, String> {
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(drawing)?;
+        let body = root
+            .titled(title, ("sans-serif", 16).into_font().style(FontStyle::Bold))
+            .map_err(drawing)?;
+        let (pool, updates) = body.split_vertically(POOL_PANEL - 30);
+        pool_panel(&pool, frames)?;
+        updates_panel(&updates, frames, updates_per_frame)?;
+        root.present().map_err(drawing)?;
+    }
+    Ok(out)
+}
+
+/// The frame number at the left edge of bucket `i` of `frames` (one past the last at the end).
+fn frame_at(frames: &[TickStats], i: usize) -> u64 {
+    frames
+        .get(i)
+        .map_or(frames.last().map_or(0, |f| f.frame + 1), |f| f.frame)
+}
+
+fn pool_panel(
+    area: &DrawingArea<SVGBackend, Shift>,
+    frames: &[TickStats],
+) -> std::result::Result<(), String> {
+    let n = frames.len().max(1) as f64;
     let budget = frames
         .iter()
         .map(|f| f.pool_bytes_budget)
         .max()
         .unwrap_or(0);
     let peak = frames.iter().map(|f| f.pool_bytes_used).max().unwrap_or(0);
-    let y_max = (budget.max(peak).max(1) as f64 * 1.1) as f32;
-    let pool_y = |b: u64| POOL_TOP + POOL_HEIGHT * (1.0 - b as f32 / y_max);
-    let most_updates = frames.iter().map(|f| f.updated.len()).max().unwrap_or(0);
-    let u_max = most_updates.max(updates_per_frame.unwrap_or(0)).max(1) as f32 * 1.15;
-    let upd_y = |u: f32| UPDATES_TOP + UPDATES_HEIGHT * (1.0 - u / u_max);
-
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{LEFT}" y="24" font-size="16" font-weight="bold">{}</text>"#,
-        escape(title)
-    );
-
-    // Pool panel.
-    let _ = writeln!(
-        s,
-        r##"<text x="{LEFT}" y="{}" fill="#333">heightmap pool: bytes in slots (blue) and budget (dashed); peak {} of {}</text>"##,
-        POOL_TOP - 8.0,
+    let y_max = budget.max(peak).max(1) as f64 * 1.1;
+    let caption = format!(
+        "heightmap pool: bytes in slots (blue) and budget (dashed); peak {} of {}",
         bytes_label(peak as f64),
         bytes_label(budget as f64)
     );
-    let bottom = POOL_TOP + POOL_HEIGHT;
-    let mut area = format!("M{LEFT:.1},{bottom:.1}");
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 12))
+        .margin_right(20)
+        .y_label_area_size(80)
+        .x_label_area_size(10)
+        .build_cartesian_2d(0.0..n, 0.0..y_max)
+        .map_err(drawing)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(5)
+        .y_label_formatter(&|b| bytes_label(*b))
+        .draw()
+        .map_err(drawing)?;
+    // The bytes in slots as steps, one a frame (a bucket of frames in a long run).
+    let mut area_points = vec![(0.0, 0.0)];
     for (i, f) in frames.iter().enumerate() {
-        let y = pool_y(f.pool_bytes_used);
-        let _ = write!(area, " L{:.1},{y:.1} L{:.1},{y:.1}", x_of(i), x_of(i + 1));
+        let y = f.pool_bytes_used as f64;
+        area_points.push((i as f64, y));
+        area_points.push((i as f64 + 1.0, y));
     }
-    let _ = write!(area, " L{:.1},{bottom:.1} Z", x_of(frames.len()));
-    let _ = writeln!(
-        s,
-        r##"<path d="{area}" fill="#9ecae1" stroke="#3182bd" stroke-width="1"/>"##
-    );
-    let by = pool_y(budget);
-    let _ = writeln!(
-        s,
-        r##"<line x1="{LEFT}" y1="{by:.1}" x2="{:.1}" y2="{by:.1}" stroke="#d62728" stroke-width="1.5" stroke-dasharray="6 4"/>"##,
-        WIDTH - RIGHT
-    );
-    for k in 0..=4 {
-        let b = y_max as f64 * k as f64 / 4.0;
-        let y = pool_y(b as u64);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{:.1}" y1="{y:.1}" x2="{LEFT}" y2="{y:.1}" stroke="#333"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
-            LEFT - 4.0,
-            LEFT - 6.0,
-            y + 4.0,
-            bytes_label(b)
-        );
-    }
-    let _ = writeln!(
-        s,
-        r##"<rect x="{LEFT}" y="{POOL_TOP}" width="{plot_w}" height="{POOL_HEIGHT}" fill="none" stroke="#333"/>"##
-    );
+    area_points.push((frames.len() as f64, 0.0));
+    chart
+        .draw_series(std::iter::once(Polygon::new(
+            area_points.clone(),
+            POOL_FILL.filled(),
+        )))
+        .map_err(drawing)?;
+    chart
+        .draw_series(std::iter::once(PathElement::new(area_points, POOL_LINE)))
+        .map_err(drawing)?;
+    let b = budget as f64;
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(0.0, b), (n, b)],
+            6,
+            4,
+            BUDGET.stroke_width(2),
+        ))
+        .map_err(drawing)?;
+    Ok(())
+}
 
-    // Updates panel.
-    let label = match updates_per_frame {
+fn updates_panel(
+    area: &DrawingArea<SVGBackend, Shift>,
+    frames: &[TickStats],
+    updates_per_frame: Option<usize>,
+) -> std::result::Result<(), String> {
+    let n = frames.len().max(1) as f64;
+    let most = frames.iter().map(|f| f.updated.len()).max().unwrap_or(0);
+    let u_max = most.max(updates_per_frame.unwrap_or(0)).max(1) as f64 * 1.15;
+    // Evictions are drawn below the axis, in the bottom 15 % of the panel.
+    let below = u_max * 0.2;
+    let caption = match updates_per_frame {
         Some(k) => {
             format!("surfaces updated per frame (bars, budget {k} dashed); evictions (red, below)")
         }
         None => "surfaces updated per frame (bars); evictions (red, below)".to_owned(),
     };
-    let _ = writeln!(
-        s,
-        r##"<text x="{LEFT}" y="{}" fill="#333">{label}</text>"##,
-        UPDATES_TOP - 8.0
-    );
-    let base = UPDATES_TOP + UPDATES_HEIGHT;
-    let mut bars = String::new();
-    let mut evictions = String::new();
-    for (i, f) in frames.iter().enumerate() {
-        let (x0, x1) = (x_of(i), x_of(i + 1));
-        if !f.updated.is_empty() {
-            let y = upd_y(f.updated.len() as f32);
-            let _ = write!(bars, "M{x0:.1},{base:.1} V{y:.1} H{x1:.1} V{base:.1} Z ");
-        }
-        if !f.evicted.is_empty() {
-            let len = 4.0 + 3.0 * f.evicted.len().min(6) as f32;
-            let _ = write!(
-                evictions,
-                "M{:.1},{:.1} v{len:.1} ",
-                (x0 + x1) * 0.5,
-                base + 2.0
-            );
-        }
-    }
-    let _ = writeln!(s, r##"<path d="{bars}" fill="#74c476" stroke="none"/>"##);
-    let _ = writeln!(
-        s,
-        r##"<path d="{evictions}" stroke="#d62728" stroke-width="1.5"/>"##
-    );
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 12))
+        .margin_right(20)
+        .y_label_area_size(80)
+        .x_label_area_size(40)
+        .build_cartesian_2d(0.0..n, -below..u_max)
+        .map_err(drawing)?;
+    let step = (most.max(1) / 4).max(1);
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(9)
+        .x_label_formatter(&|x| frame_at(frames, x.round().max(0.0) as usize).to_string())
+        .x_desc("frame")
+        .y_labels(5)
+        .y_label_formatter(&|u| {
+            let k = u.round();
+            if k >= 0.0 && (k - u).abs() < 1e-6 && (k as usize).is_multiple_of(step) {
+                format!("{k}")
+            } else {
+                String::new()
+            }
+        })
+        .draw()
+        .map_err(drawing)?;
+    chart
+        .draw_series(
+            frames
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| !f.updated.is_empty())
+                .map(|(i, f)| {
+                    Rectangle::new(
+                        [(i as f64, 0.0), (i as f64 + 1.0, f.updated.len() as f64)],
+                        UPDATE_BAR.filled(),
+                    )
+                }),
+        )
+        .map_err(drawing)?;
+    chart
+        .draw_series(
+            frames
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| !f.evicted.is_empty())
+                .map(|(i, f)| {
+                    let x = i as f64 + 0.5;
+                    let len = below * (0.3 + 0.1 * f.evicted.len().min(6) as f64);
+                    PathElement::new(vec![(x, 0.0), (x, -len)], BUDGET.stroke_width(2))
+                }),
+        )
+        .map_err(drawing)?;
     if let Some(k) = updates_per_frame {
-        let y = upd_y(k as f32);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#31a354" stroke-dasharray="6 4"/>"##,
-            WIDTH - RIGHT
-        );
+        let y = k as f64;
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(0.0, y), (n, y)],
+                6,
+                4,
+                UPDATE_BUDGET.stroke_width(1),
+            ))
+            .map_err(drawing)?;
     }
-    for k in 0..=most_updates.max(updates_per_frame.unwrap_or(0)).min(1000) {
-        let step = (most_updates.max(1) / 4).max(1);
-        if k % step != 0 {
-            continue;
-        }
-        let y = upd_y(k as f32);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{:.1}" y1="{y:.1}" x2="{LEFT}" y2="{y:.1}" stroke="#333"/><text x="{:.1}" y="{:.1}" text-anchor="end">{k}</text>"##,
-            LEFT - 4.0,
-            LEFT - 6.0,
-            y + 4.0
-        );
-    }
-    let _ = writeln!(
-        s,
-        r##"<rect x="{LEFT}" y="{UPDATES_TOP}" width="{plot_w}" height="{UPDATES_HEIGHT}" fill="none" stroke="#333"/>"##
-    );
-    // Frame axis.
-    let ticks = 8.min(frames.len().max(1));
-    for k in 0..=ticks {
-        let i = frames.len() * k / ticks;
-        let x = x_of(i);
-        let frame = frames
-            .get(i)
-            .map_or(frames.last().map_or(0, |f| f.frame + 1), |f| f.frame);
-        let _ = writeln!(
-            s,
-            r##"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{frame}</text>"##,
-            base + 34.0
-        );
-    }
-    let _ = writeln!(
-        s,
-        r##"<text x="{:.1}" y="{:.1}" text-anchor="middle" fill="#333">frame</text>"##,
-        LEFT + plot_w * 0.5,
-        HEIGHT - 4.0
-    );
-    s.push_str("</svg>\n");
-    s
+    Ok(())
 }
 
 /// Write [`svg`] to a file.
@@ -199,10 +216,87 @@ pub fn write_svg(
     title: &str,
     updates_per_frame: Option<usize>,
 ) -> Result<()> {
-    std::fs::write(path, svg(frames, title, updates_per_frame)).map_err(|e| SnowError::Output {
+    let output = |reason: String| SnowError::Output {
         path: path.to_owned(),
-        reason: e.to_string(),
-    })
+        reason,
+    };
+    let svg = svg(frames, title, updates_per_frame).map_err(output)?;
+    std::fs::write(path, svg).map_err(|e| output(e.to_string()))
+}
+
+/// A log-log line plot as SVG: each series a line with its points marked, named in a legend;
+/// points at or below zero on either axis are left out.
+pub fn log_log_svg(
+    title: &str,
+    x_label: &str,
+    series: &[(&str, Vec<(f64, f64)>)],
+) -> std::result::Result<String, String> {
+    let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0;
+    let all: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.1.iter().filter(positive).copied())
+        .collect();
+    // Whole decades around the points (one decade when there are none).
+    let decades = |v: &mut dyn Iterator<Item = f64>| {
+        let (lo, hi) = v.fold((f64::MAX, f64::MIN), |(lo, hi), x| {
+            (lo.min(x.log10()), hi.max(x.log10()))
+        });
+        let lo = if lo.is_finite() && lo < f64::MAX {
+            lo.floor()
+        } else {
+            0.0
+        };
+        let hi = hi.ceil().max(lo + 1.0);
+        10f64.powf(lo)..10f64.powf(hi)
+    };
+    let xs = decades(&mut all.iter().map(|p| p.0));
+    let ys = decades(&mut all.iter().map(|p| p.1));
+    let colors = [
+        RGBColor(0x1f, 0x77, 0xb4),
+        RGBColor(0xd6, 0x27, 0x28),
+        RGBColor(0x2c, 0xa0, 0x2c),
+    ];
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (640, 400)).into_drawing_area();
+        root.fill(&WHITE).map_err(drawing)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 14))
+            .margin(10)
+            .margin_right(30)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xs.log_scale(), ys.log_scale())
+            .map_err(drawing)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .x_label_formatter(&|v| format!("{v}"))
+            .y_label_formatter(&|v| format!("{v} us"))
+            .draw()
+            .map_err(drawing)?;
+        for (i, (name, pts)) in series.iter().enumerate() {
+            let c = colors[i % colors.len()];
+            let pts: Vec<(f64, f64)> = pts.iter().filter(positive).copied().collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))
+                .map_err(drawing)?
+                .label(*name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(drawing)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(drawing)?;
+        root.present().map_err(drawing)?;
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -221,11 +315,15 @@ mod tests {
                 ..Default::default()
             })
             .collect();
-        let svg = svg(&frames, "a <city> & more", Some(2));
+        let svg = svg(&frames, "a <city> & more", Some(2)).unwrap();
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("a &lt;city&gt; &amp; more"));
-        // Frames 1, 2, 4, 5, 7, 8 updated something.
-        assert_eq!(svg.matches(" Z ").count(), 6);
+        // Frames 1, 2, 4, 5, 7, 8 updated something: one bar each, in the bars' colour.
+        let bar = format!(
+            "fill=\"#{:02X}{:02X}{:02X}\"",
+            UPDATE_BAR.0, UPDATE_BAR.1, UPDATE_BAR.2
+        );
+        assert_eq!(svg.matches(&bar).count(), 6, "{svg}");
         assert!(svg.contains("2.00 MiB"));
         // Every element that opens closes.
         assert_eq!(svg.matches("<text").count(), svg.matches("</text>").count());
@@ -233,7 +331,7 @@ mod tests {
 
     #[test]
     fn empty_run_still_draws() {
-        let s = svg(&[], "nothing", None);
+        let s = svg(&[], "nothing", None).unwrap();
         assert!(s.contains("</svg>"));
     }
 
