@@ -2,7 +2,7 @@
 //! resolution and deformers per surface, against a plain copy of the same bytes measured in the
 //! same run.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::Vec3;
@@ -374,6 +374,49 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             gpu.info.name
         );
     }
+    let configs = configs(quick);
+    let mut bar = Progress::new(configs.len() as u64, "bench", "configurations")?;
+    let mut rows = Vec::new();
+    for c in &configs {
+        bar.set_message(&format!(
+            "{} x {}^2, {} deformers",
+            c.surfaces, c.resolution, c.deformers
+        ));
+        rows.push(measure(&gpu, c, args)?);
+        bar.inc(1);
+    }
+    bar.finish();
+
+    print_rows(&gpu, &rows);
+    let (fits, errors) = talk_memory(&gpu, quick)?;
+    let report = serde_json::json!({
+        "memory_talk_pool": {
+            "pool_bytes": 2u64 << 20,
+            "layout": "depression and displaced snow per texel at the pool's precision, updated in place (no history per surface: the capture buffers of a frame are shared by every surface in it); normals not kept (the renderer derives them)",
+            "fits": fits,
+        },
+        "precision_error_vs_32_bit": errors,
+        "adapter": snowprint::gpu::describe(&gpu.info),
+        "timestamps": timestamps,
+        "frames": args.frames,
+        "warmup": args.warmup,
+        "statistic": "median",
+        "rows": rows,
+    });
+    outputs.write(
+        "bench.json",
+        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
+    )?;
+    write_plots(&mut outputs, &gpu.info.name, &rows)?;
+    outputs.publish()?;
+    eprintln!("snowprint: wrote {}", args.out.display());
+    Ok(())
+}
+
+/// The configurations to measure: the talk's frame (fused and as separate passes, at each
+/// precision), then the sweeps (`quick`: small ones only) and, unless quick, the 1024
+/// surfaces of 512^2.
+fn configs(quick: bool) -> Vec<Config> {
     let cfg = |sweep, surfaces, resolution, deformers, passes| Config {
         sweep,
         surfaces,
@@ -430,18 +473,12 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             cfg("many_512", 1024, 512, 1, fused),
         )));
     }
-    let mut bar = Progress::new(configs.len() as u64, "bench", "configurations")?;
-    let mut rows = Vec::new();
-    for c in &configs {
-        bar.set_message(&format!(
-            "{} x {}^2, {} deformers",
-            c.surfaces, c.resolution, c.deformers
-        ));
-        rows.push(measure(&gpu, c, args)?);
-        bar.inc(1);
-    }
-    bar.finish();
+    configs
+}
 
+/// The rows as a table on stdout, under the adapter and how it was timed.
+fn print_rows(gpu: &GpuContext, rows: &[Row]) {
+    let timestamps = gpu.caps.timestamps;
     println!(
         "adapter: {}\ntimestamps: {}\n",
         snowprint::gpu::describe(&gpu.info),
@@ -470,7 +507,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
         "copy_us",
         "x_copy"
     );
-    for r in &rows {
+    for r in rows {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
@@ -493,11 +530,17 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             r.ratio_to_copy
         );
     }
-    // The talk's memory: how many 512^2 surfaces a real 2 MiB pool holds at each precision, and
-    // what each precision costs in accuracy against 32 bits on the talk's frame.
+}
+
+/// The talk's memory: how many 512^2 surfaces a real 2 MiB pool holds at each precision, and
+/// what each precision costs in accuracy against 32 bits on the talk's frame (printed as well).
+fn talk_memory(
+    gpu: &GpuContext,
+    quick: bool,
+) -> Result<(Vec<PoolFit>, Vec<PrecisionError>), String> {
     let fits = Precision::ALL
         .into_iter()
-        .map(|p| talk_pool_fit(&gpu, p))
+        .map(|p| talk_pool_fit(gpu, p))
         .collect::<Result<Vec<_>, _>>()?;
     println!(
         "\nmemory: 512^2 surfaces (both channels, no history, no normals) in the talk's 2 MiB pool"
@@ -508,7 +551,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             f.precision_bits, f.bytes_per_surface, f.surfaces
         );
     }
-    let errors = precision_errors(&gpu, if quick { 30 } else { 120 })?;
+    let errors = precision_errors(gpu, if quick { 30 } else { 120 })?;
     println!(
         "\nprecision: {} frames of the talk's frame (2 x 512^2, 10 moving spheres each, snow refilling), against 32 bits",
         errors[0].frames
@@ -524,24 +567,11 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             e.displaced_mean
         );
     }
-    let report = serde_json::json!({
-        "memory_talk_pool": {
-            "pool_bytes": 2u64 << 20,
-            "layout": "depression and displaced snow per texel at the pool's precision, updated in place (no history per surface: the capture buffers of a frame are shared by every surface in it); normals not kept (the renderer derives them)",
-            "fits": fits,
-        },
-        "precision_error_vs_32_bit": errors,
-        "adapter": snowprint::gpu::describe(&gpu.info),
-        "timestamps": timestamps,
-        "frames": args.frames,
-        "warmup": args.warmup,
-        "statistic": "median",
-        "rows": rows,
-    });
-    write(
-        &outputs.path("bench.json"),
-        &serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?,
-    )?;
+    Ok((fits, errors))
+}
+
+/// One SVG plot a sweep: the update's time and the copy's against the swept quantity.
+fn write_plots(outputs: &mut OutputSet, adapter: &str, rows: &[Row]) -> Result<(), String> {
     for sweep in ["surfaces", "resolution", "deformers"] {
         let pts: Vec<&Row> = rows.iter().filter(|r| r.sweep == sweep).collect();
         let x = |r: &Row| match sweep {
@@ -549,8 +579,8 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             "resolution" => r.resolution as f64,
             _ => r.deformers_per_surface as f64,
         };
-        let svg = plot_svg(
-            &format!("update time vs {sweep} ({})", gpu.info.name),
+        let svg = snowprint_demo::plot::log_log_svg(
+            &format!("update time vs {sweep} ({})", adapter),
             sweep,
             &[
                 ("update", pts.iter().map(|r| (x(r), r.update_us)).collect()),
@@ -559,11 +589,9 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
                     pts.iter().map(|r| (x(r), r.copy_us)).collect(),
                 ),
             ],
-        );
-        write(&outputs.path(&format!("bench_{sweep}.svg")), &svg)?;
+        )?;
+        outputs.write(&format!("bench_{sweep}.svg"), svg)?;
     }
-    outputs.publish()?;
-    eprintln!("snowprint: wrote {}", args.out.display());
     Ok(())
 }
 
@@ -739,82 +767,4 @@ fn precision_errors(gpu: &GpuContext, frames: u32) -> Result<Vec<PrecisionError>
         });
     }
     Ok(out)
-}
-
-/// Write a file of the output set (in its staging folder: the set is published as a whole).
-fn write(path: &Path, text: &str) -> Result<(), String> {
-    std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
-}
-
-/// A log-log line plot as SVG.
-pub fn plot_svg(title: &str, x_label: &str, series: &[(&str, Vec<(f64, f64)>)]) -> String {
-    let (w, h, m) = (640.0, 400.0, 60.0);
-    let all: Vec<(f64, f64)> = series
-        .iter()
-        .flat_map(|s| s.1.iter().copied())
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-        .collect();
-    let lx = |v: f64| v.log10();
-    let (x0, x1) = all.iter().fold((f64::MAX, f64::MIN), |a, p| {
-        (a.0.min(lx(p.0)), a.1.max(lx(p.0)))
-    });
-    let (y0, y1) = all.iter().fold((f64::MAX, f64::MIN), |a, p| {
-        (a.0.min(lx(p.1)), a.1.max(lx(p.1)))
-    });
-    let (x0, x1) = (x0.floor(), x1.ceil().max(x0.floor() + 1.0));
-    let (y0, y1) = (y0.floor(), y1.ceil().max(y0.floor() + 1.0));
-    let px = |v: f64| m + (lx(v) - x0) / (x1 - x0) * (w - 2.0 * m);
-    let py = |v: f64| h - m - (lx(v) - y0) / (y1 - y0) * (h - 2.0 * m);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{}\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">{title}</text>\n",
-        w / 2.0
-    );
-    for d in (x0 as i32)..=(x1 as i32) {
-        let x = m + (d as f64 - x0) / (x1 - x0) * (w - 2.0 * m);
-        s += &format!(
-            "<line x1=\"{x}\" y1=\"{m}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{d}</text>\n",
-            h - m,
-            h - m + 16.0
-        );
-    }
-    for d in (y0 as i32)..=(y1 as i32) {
-        let y = h - m - (d as f64 - y0) / (y1 - y0) * (h - 2.0 * m);
-        s += &format!(
-            "<line x1=\"{m}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{d} us</text>\n",
-            w - m,
-            m - 4.0,
-            y + 4.0
-        );
-    }
-    s += &format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n",
-        w / 2.0,
-        h - 12.0
-    );
-    let colors = ["#1f77b4", "#d62728", "#2ca02c"];
-    for (i, (name, pts)) in series.iter().enumerate() {
-        let c = colors[i % colors.len()];
-        let path: Vec<String> = pts
-            .iter()
-            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-            .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
-            .collect();
-        s += &format!(
-            "<polyline fill=\"none\" stroke=\"{c}\" stroke-width=\"2\" points=\"{}\"/>\n",
-            path.join(" ")
-        );
-        for p in pts.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0) {
-            s += &format!(
-                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3\" fill=\"{c}\"/>\n",
-                px(p.0),
-                py(p.1)
-            );
-        }
-        s += &format!(
-            "<text x=\"{}\" y=\"{}\" fill=\"{c}\">{name}</text>\n",
-            m + 10.0,
-            m + 16.0 + 16.0 * i as f64
-        );
-    }
-    s + "</svg>\n"
 }

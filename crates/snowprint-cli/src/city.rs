@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use glam::Vec3;
-use snowprint::manager::city::{self, SurfaceKind};
 use snowprint::manager::{CameraView, ManagerConfig, SnowManager};
 use snowprint::{GpuContext, GpuOptions};
+use snowprint_demo::city::{self, SurfaceKind};
 
 use crate::output::OutputSet;
 use crate::progress::Progress;
@@ -70,9 +70,7 @@ pub fn run(gpu: &GpuOptions, out: &Path, frames: Option<u32>) -> Result<(), Stri
         Some(budget),
     )?;
     let map = city_map(&snow, &city, &ids)?;
-    let map_path = set.path("city_map.png");
-    std::fs::write(&map_path, map)
-        .map_err(|e| format!("cannot write {}: {e}", map_path.display()))?;
+    set.write("city_map.png", map)?;
     set.publish()?;
     eprintln!(
         "snowprint: city of {} surfaces and {} walkers, {frames} frames: {resident} surfaces hold a heightmap at the end, {evictions} evictions, longest wait {longest_wait} frames; wrote city_report.json, city_pool.svg and city_map.png to {}",

@@ -7,71 +7,22 @@
 //! first frame, and everything is written as one output set (`output.rs`): readers see the whole
 //! set of this run or of the one before, and a run that fails leaves the one before untouched.
 //!
-//! The world comes from one function, [`build_scene`], returning a [`DemoScene`]: swap it for
-//! another world (the library's `snowprint::demo` once it lands) without touching the rest.
+//! The world comes from one function, [`build_scene`] (in the demo crate, `snowprint_demo::scene`),
+//! returning a [`DemoScene`]: swap it for another world without touching the rest.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use snowprint::render::{
-    DebugView, Environment, Instance, PointLight, RenderConfig, RenderFrame, Renderer, Tier,
-};
-use snowprint::{
-    Camera, GpuContext, GpuOptions, GroundMaterial, SnowWorld, SurfaceId, WorldConfig,
-};
+use snowprint::render::{DebugView, RenderConfig, RenderFrame, Renderer, SurfaceShading, Tier};
+use snowprint::{GpuContext, GpuOptions, SnowWorld, WorldConfig};
+
+use snowprint_demo::scene::{DemoScene, build_scene};
 
 use crate::output::OutputSet;
 use crate::progress::Progress;
 
 #[path = "contact_sheet.rs"]
 mod contact_sheet;
-#[path = "demo_world.rs"]
-mod demo_world;
-#[path = "standin.rs"]
-mod standin;
-
-/// A world the demo can simulate and draw. Built once (surfaces into the world, meshes into the
-/// renderer), then asked what happens at each moment.
-pub trait DemoScene {
-    /// A short description for the report.
-    fn name(&self) -> &str;
-    /// Snow surfaces with the ground under each.
-    fn surfaces(&self) -> &[(SurfaceId, GroundMaterial)];
-    /// Street lamps and other point lights.
-    fn lights(&self) -> &[PointLight];
-    /// Moon, sky and haze (both demos: the moonlit night).
-    fn environment(&self) -> Environment {
-        Environment::moonlit_night()
-    }
-    /// Advance the snow of `world` from `t0` to `t1`: whatever presses the snow meanwhile, with
-    /// its poses at both ends (by `SnowWorld::step`, or per surface by `SnowWorld::update`).
-    fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String>;
-    /// Meshes to draw at time `t`.
-    fn instances(&self, t: f32) -> Vec<Instance>;
-    /// Names of the cameras.
-    fn cameras(&self) -> &[&'static str];
-    /// Seconds of the action a camera's clip covers.
-    fn span(&self, camera: &str) -> (f32, f32);
-    /// A camera at time `t`; `None` for an unknown name.
-    fn camera(&self, name: &str, t: f32) -> Option<Camera>;
-}
-
-/// The demo world by name: `rooftops`, the library's demo world (`snowprint::demo`), or
-/// `standin`, the small world this command carried before that one existed. This is the one place
-/// where a world plugs into the renderer's demo.
-pub fn build_scene(
-    name: &str,
-    world: &mut SnowWorld,
-    renderer: &mut Renderer,
-) -> Result<Box<dyn DemoScene>, String> {
-    match name {
-        "rooftops" => Ok(Box::new(demo_world::LibraryDemo::new(world, renderer)?)),
-        "standin" => Ok(Box::new(standin::StandIn::new(world, renderer)?)),
-        _ => Err(format!(
-            "unknown scene {name:?}; use rooftops, standin or city"
-        )),
-    }
-}
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -190,301 +141,31 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         staging.check_name(name)?;
     }
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
-    let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
-    let (default_frames, default_size, default_ss) = if software {
-        (60, (800, 450), 1)
-    } else {
-        (240, (1280, 720), 2)
-    };
-    let frames = args.frames.unwrap_or(default_frames);
-    let (width, height) = args.size.unwrap_or(default_size);
-    let supersample = args.supersample.unwrap_or(default_ss);
-    let sim_hz = args.sim_hz.unwrap_or(if software { 30 } else { 60 });
-    if !(1..=1000).contains(&sim_hz) {
-        return Err(format!(
-            "--sim-hz {sim_hz}: give 1 to 1000 steps per second"
-        ));
-    }
-    let sim_dt = 1.0 / sim_hz as f32;
-    let mut notes = Vec::new();
-    if software && (args.frames.is_none() || args.size.is_none() || args.supersample.is_none()) {
-        let note = format!(
-            "{} is a software adapter: defaults scaled down to {frames} frames of {width}x{height}, no supersampling, 30 simulation steps per second (a GPU gets 240 frames of 1280x720, 2x2 supersampled, 60 steps per second); pass --frames/--size/--supersample/--sim-hz to change",
-            ctx.info.name
-        );
-        eprintln!("snowprint: {note}");
-        notes.push(note);
-    }
+    let mut settings = Settings::new(&ctx, args)?;
 
     let mut world = SnowWorld::new(&ctx, WorldConfig::default()).map_err(|e| e.to_string())?;
-    let mut config = RenderConfig::new(width, height, args.tier);
-    config.supersample = supersample;
-    config.debug_view = args.debug_view;
-    if software {
-        config.snowflakes = 3000;
-    } else {
-        config.shadow_map_size = 4096;
-    }
-    let mut renderer = Renderer::new(&ctx, config).map_err(|e| e.to_string())?;
+    let mut renderer =
+        Renderer::new(&ctx, settings.render_config(args)).map_err(|e| e.to_string())?;
     let scene = build_scene(&args.scene, &mut world, &mut renderer)?;
-    if !scene.cameras().contains(&args.camera.as_str()) {
-        return Err(format!(
-            "unknown camera {:?}; this demo has {}",
-            args.camera,
-            scene.cameras().join(", ")
-        ));
-    }
-    let (mut t0, mut t1) = scene.span(&args.camera);
-    if let Some(f) = args.from {
-        t0 = f;
-    }
-    if let Some(t) = args.to {
-        t1 = t;
-    }
-    let (_, end) = scene.span(&args.camera);
-    let end = end.max(
-        scene
-            .cameras()
-            .iter()
-            .map(|c| scene.span(c).1)
-            .fold(0.0, f32::max),
-    );
-    if t1 > end {
-        return Err(format!(
-            "--to {}: the action of this demo ends at {end} s; give --to at most {end}",
-            if t1 >= 1e6 {
-                format!("{t1:e}")
-            } else {
-                t1.to_string()
-            }
-        ));
-    }
-    if !(t0.is_finite() && t1.is_finite() && t0 >= 0.0 && t1 >= t0) {
-        return Err(format!(
-            "--from {t0} / --to {t1}: give 0 <= from <= to seconds"
-        ));
-    }
-    let times: Vec<f32> = (0..frames)
-        .map(|k| {
-            if frames == 1 {
-                t1
-            } else {
-                t0 + (t1 - t0) * k as f32 / (frames - 1) as f32
-            }
-        })
-        .collect();
-
-    let sheet_frames = contact_sheet::pick(frames as usize, 6);
-    let mut sheet_images = Vec::new();
-    let gif_path = staging.path("demo.gif");
-    let delay_ms = if frames > 1 {
-        ((t1 - t0) / (frames - 1) as f32 * 1000.0).clamp(20.0, 200.0) as u32
-    } else {
-        1000
+    let clip = Clip::new(scene.as_ref(), args, settings.frames)?;
+    let mut demo = Demo {
+        args,
+        scene: scene.as_ref(),
+        world: &mut world,
+        renderer: &mut renderer,
+        staging: &mut staging,
     };
-    // The GIF keeps at most 120 frames (every k-th), so that it stays a few megabytes.
-    let gif_every = frames.div_ceil(120) as usize;
-    let mut gif =
-        contact_sheet::GifWriter::create(&gif_path, width, height, delay_ms * gif_every as u32)?;
-
-    let mut bar = Progress::new(frames as u64, "demo", "frames")?;
-    bar.set_message("simulating");
-
-    let mut sim_t = 0.0f32;
-    let mut sim_ms = 0.0;
-    let mut render_ms = Vec::new();
-    let mut pass_ms: Vec<(&'static str, Vec<f64>)> = Vec::new();
-    let mut first_surfaces = None;
-    let mut last_surfaces = Vec::new();
-    let mut last_overflow = 0;
-    let instances_count;
-    {
-        let mut last_instances = 0;
-        for (k, &t) in times.iter().enumerate() {
-            bar.set_message("simulating");
-            let start = Instant::now();
-            while sim_t + sim_dt <= t + 1e-4 {
-                scene.advance(&mut world, sim_t, sim_t + sim_dt)?;
-                sim_t += sim_dt;
-            }
-            sim_ms += start.elapsed().as_secs_f64() * 1e3;
-            bar.set_message("rendering");
-            let camera = scene
-                .camera(&args.camera, t)
-                .ok_or_else(|| format!("camera {:?} has no view at {t} s", args.camera))?;
-            let instances = scene.instances(t);
-            last_instances = instances.len();
-            let frame = RenderFrame {
-                camera,
-                time: t,
-                surfaces: scene.surfaces(),
-                instances: &instances,
-                lights: scene.lights(),
-                environment: scene.environment(),
-                snowfall: !args.no_snowfall,
-            };
-            let out = renderer.render(&world, &frame).map_err(|e| e.to_string())?;
-            render_ms.push(out.cpu_ms);
-            for p in &out.pass_times {
-                match pass_ms.iter_mut().find(|(n, _)| *n == p.name) {
-                    Some((_, v)) => v.push(p.gpu_ms),
-                    None => pass_ms.push((p.name, vec![p.gpu_ms])),
-                }
-            }
-            if first_surfaces.is_none() {
-                first_surfaces = Some(out.surfaces.clone());
-            }
-            last_surfaces = out.surfaces.clone();
-            last_overflow = out.dice_overflow;
-            let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
-                .ok_or("the renderer returned a frame of the wrong size")?;
-            if args.compare_tiers && k + 1 == times.len() {
-                let mut pair = Vec::new();
-                for tier in [Tier::Relief, Tier::Tessellated] {
-                    renderer.set_tier(tier);
-                    let o = renderer.render(&world, &frame).map_err(|e| e.to_string())?;
-                    pair.push(
-                        image::RgbaImage::from_raw(o.width, o.height, o.rgba8)
-                            .ok_or("the renderer returned a frame of the wrong size")?,
-                    );
-                }
-                renderer.set_tier(args.tier);
-                let sheet =
-                    contact_sheet::side_by_side(&pair[0], &pair[1], "relief", "tessellated");
-                let path = staging.path("compare_tiers.png");
-                sheet
-                    .save(&path)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-            }
-            let name = format!("frame_{k:04}.png");
-            let path = staging.path(&name);
-            image
-                .save(&path)
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-            if k % gif_every == 0 {
-                gif.add(&image)?;
-            }
-            if sheet_frames.contains(&k) {
-                sheet_images.push((k, t, image));
-            }
-            bar.inc(1);
-        }
-        instances_count = last_instances;
-    }
-    bar.set_message("encoding");
-    gif.finish()?;
-    let sheet = contact_sheet::compose(&sheet_images);
-    let sheet_path = staging.path("contact_sheet.png");
-    sheet
-        .save(&sheet_path)
-        .map_err(|e| format!("cannot write {}: {e}", sheet_path.display()))?;
-    let mp4 = if frames > 1 {
-        let fps = (1000.0 / delay_ms as f32).round().max(1.0);
-        let dir = staging.staging().to_owned();
-        let made = contact_sheet::encode_mp4(&dir, &staging.path("demo.mp4"), fps);
-        if !made {
-            let _ = std::fs::remove_file(dir.join("demo.mp4"));
-            staging.forget("demo.mp4");
-            notes.push("ffmpeg is not on the PATH (or failed): no demo.mp4".into());
-        }
-        made
-    } else {
-        false
-    };
-    bar.finish();
-
-    let surfaces_json: Vec<serde_json::Value> = scene
-        .surfaces()
-        .iter()
-        .map(|(id, ground)| {
-            let desc = world.surface(*id).ok();
-            let first = first_surfaces
-                .as_ref()
-                .and_then(|v| v.iter().find(|s| s.surface == *id))
-                .map(|s| s.material);
-            let last = last_surfaces.iter().find(|s| s.surface == *id);
-            serde_json::json!({
-                "index": id.index(),
-                "name": desc.map(|d| d.name.clone()),
-                "size_m": desc.map(|d| d.size.to_array()),
-                "snow_depth_m": desc.map(|d| d.snow_depth),
-                "heightmap": world.layout(*id).ok().map(|l| [l.width, l.height]),
-                "ground": ground,
-                "material_first_frame": first,
-                "material_last_frame": last.map(|s| s.material),
-                "deepest_print_last_frame": last.map(|s| s.deepest),
-                "diced_triangles_last_frame": last.map(|s| s.triangles),
-            })
-        })
-        .collect();
-    let basic_last: Vec<u32> = last_surfaces
-        .iter()
-        .filter(|s| s.material == snowprint::render::SnowMaterialKind::Basic)
-        .map(|s| s.surface.index())
-        .collect();
-    let gpu_times: Vec<PassStats> = pass_ms
-        .iter_mut()
-        .map(|(name, v)| PassStats {
-            pass: name,
-            mean_ms: v.iter().sum::<f64>() / v.len().max(1) as f64,
-            max_ms: v.iter().copied().fold(0.0, f64::max),
-            median_ms: median(v),
-        })
-        .collect();
-    let timestamps_note = if renderer.has_timestamps() {
-        serde_json::Value::Null
-    } else {
-        serde_json::json!(format!(
-            "{} has no GPU timestamp queries: per-pass GPU times are unavailable; CPU times per frame are reported instead",
-            ctx.info.name
-        ))
-    };
-    let mut outputs: Vec<String> = staging.names().to_vec();
-    outputs.push("report.json".into());
-    let report = serde_json::json!({
-        "adapter": {
-            "name": ctx.info.name,
-            "backend": format!("{:?}", ctx.info.backend),
-            "device_type": format!("{:?}", ctx.info.device_type),
-            "driver": format!("{} {}", ctx.info.driver, ctx.info.driver_info),
-            "software": software,
-        },
-        "resolution": [width, height],
-        "supersample": supersample,
-        "frames": frames,
-        "tier": args.tier,
-        "camera": args.camera,
-        "debug_view": args.debug_view,
-        "scene": scene.name(),
-        "clip_seconds": [t0, t1],
-        "simulation_hz": sim_hz,
-        "instances_last_frame": instances_count,
-        "search": renderer.config().search_settings(),
-        "passes": renderer.passes(),
-        "gpu_pass_times_ms": gpu_times,
-        "dice_overflow_last_frame": last_overflow,
-        "gpu_pass_times_note": timestamps_note,
-        "cpu_ms": {
-            "simulation_total": sim_ms,
-            "render_median_per_frame": median(&mut render_ms.clone()),
-            "render_total": render_ms.iter().sum::<f64>(),
-        },
-        "surfaces": surfaces_json,
-        "basic_material_surfaces_last_frame": basic_last,
-        "notes": notes,
-        "outputs": outputs,
-        "mp4": mp4,
-        "wall_seconds": wall.elapsed().as_secs_f64(),
-    });
+    let measured = demo.render_frames(&mut settings, &clip)?;
+    let report = demo.report(&ctx, &settings, &clip, &measured, &wall);
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
-    let report_path = staging.path("report.json");
-    std::fs::write(&report_path, text)
-        .map_err(|e| format!("cannot write {}: {e}", report_path.display()))?;
+    staging.write("report.json", text)?;
     let files = staging.names().len();
     staging.publish()?;
     eprintln!(
-        "snowprint: {} frames of {width}x{height} ({}, camera {}) in {:.0} s on {}: {} files in {}",
-        frames,
+        "snowprint: {} frames of {}x{} ({}, camera {}) in {:.0} s on {}: {} files in {}",
+        settings.frames,
+        settings.width,
+        settings.height,
         args.tier,
         args.camera,
         wall.elapsed().as_secs_f64(),
@@ -493,6 +174,387 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Frames, sizes and rates of a run: the arguments, or defaults for the adapter (smaller on a
+/// software one, with a note saying so).
+struct Settings {
+    software: bool,
+    frames: u32,
+    width: u32,
+    height: u32,
+    supersample: u32,
+    sim_hz: u32,
+    notes: Vec<String>,
+}
+
+impl Settings {
+    fn new(ctx: &GpuContext, args: &Args) -> Result<Self, String> {
+        let software = ctx.info.device_type == wgpu::DeviceType::Cpu;
+        let (default_frames, default_size, default_ss) = if software {
+            (60, (800, 450), 1)
+        } else {
+            (240, (1280, 720), 2)
+        };
+        let frames = args.frames.unwrap_or(default_frames);
+        let (width, height) = args.size.unwrap_or(default_size);
+        let supersample = args.supersample.unwrap_or(default_ss);
+        let sim_hz = args.sim_hz.unwrap_or(if software { 30 } else { 60 });
+        if !(1..=1000).contains(&sim_hz) {
+            return Err(format!(
+                "--sim-hz {sim_hz}: give 1 to 1000 steps per second"
+            ));
+        }
+        let mut notes = Vec::new();
+        if software && (args.frames.is_none() || args.size.is_none() || args.supersample.is_none())
+        {
+            let note = format!(
+                "{} is a software adapter: defaults scaled down to {frames} frames of {width}x{height}, no supersampling, 30 simulation steps per second (a GPU gets 240 frames of 1280x720, 2x2 supersampled, 60 steps per second); pass --frames/--size/--supersample/--sim-hz to change",
+                ctx.info.name
+            );
+            eprintln!("snowprint: {note}");
+            notes.push(note);
+        }
+        Ok(Self {
+            software,
+            frames,
+            width,
+            height,
+            supersample,
+            sim_hz,
+            notes,
+        })
+    }
+
+    fn render_config(&self, args: &Args) -> RenderConfig {
+        let mut config = RenderConfig::new(self.width, self.height, args.tier);
+        config.supersample = self.supersample;
+        config.debug_view = args.debug_view;
+        if self.software {
+            config.snowflakes = 3000;
+        } else {
+            config.shadow_map_size = 4096;
+        }
+        config
+    }
+}
+
+/// The seconds of action the frames show: the camera's clip, or `--from`/`--to` within the
+/// scene's action; one moment a frame.
+struct Clip {
+    t0: f32,
+    t1: f32,
+    times: Vec<f32>,
+}
+
+impl Clip {
+    fn new(scene: &dyn DemoScene, args: &Args, frames: u32) -> Result<Self, String> {
+        if !scene.cameras().contains(&args.camera.as_str()) {
+            return Err(format!(
+                "unknown camera {:?}; this demo has {}",
+                args.camera,
+                scene.cameras().join(", ")
+            ));
+        }
+        let (mut t0, mut t1) = scene.span(&args.camera);
+        if let Some(f) = args.from {
+            t0 = f;
+        }
+        if let Some(t) = args.to {
+            t1 = t;
+        }
+        let (_, end) = scene.span(&args.camera);
+        let end = end.max(
+            scene
+                .cameras()
+                .iter()
+                .map(|c| scene.span(c).1)
+                .fold(0.0, f32::max),
+        );
+        if t1 > end {
+            return Err(format!(
+                "--to {}: the action of this demo ends at {end} s; give --to at most {end}",
+                if t1 >= 1e6 {
+                    format!("{t1:e}")
+                } else {
+                    t1.to_string()
+                }
+            ));
+        }
+        if !(t0.is_finite() && t1.is_finite() && t0 >= 0.0 && t1 >= t0) {
+            return Err(format!(
+                "--from {t0} / --to {t1}: give 0 <= from <= to seconds"
+            ));
+        }
+        let times: Vec<f32> = (0..frames)
+            .map(|k| {
+                if frames == 1 {
+                    t1
+                } else {
+                    t0 + (t1 - t0) * k as f32 / (frames - 1) as f32
+                }
+            })
+            .collect();
+        Ok(Self { t0, t1, times })
+    }
+}
+
+/// What the frames measured, for the report.
+struct Measured {
+    sim_ms: f64,
+    render_ms: Vec<f64>,
+    pass_ms: Vec<(&'static str, Vec<f64>)>,
+    first_surfaces: Option<Vec<SurfaceShading>>,
+    last_surfaces: Vec<SurfaceShading>,
+    last_overflow: u32,
+    instances_count: usize,
+    mp4: bool,
+}
+
+/// A run of the rendered demo: the scene, the world it presses, the renderer and the output set.
+struct Demo<'a> {
+    args: &'a Args,
+    scene: &'a dyn DemoScene,
+    world: &'a mut SnowWorld,
+    renderer: &'a mut Renderer,
+    staging: &'a mut OutputSet,
+}
+
+impl Demo<'_> {
+    /// Simulate up to each moment of the clip, render it and write the frame, the GIF, the contact
+    /// sheet and (with ffmpeg) the MP4.
+    fn render_frames(&mut self, settings: &mut Settings, clip: &Clip) -> Result<Measured, String> {
+        let (args, frames) = (self.args, settings.frames);
+        let sim_dt = 1.0 / settings.sim_hz as f32;
+        let sheet_frames = contact_sheet::pick(frames as usize, 6);
+        let mut sheet_images = Vec::new();
+        let gif_path = self.staging.path("demo.gif");
+        let delay_ms = if frames > 1 {
+            ((clip.t1 - clip.t0) / (frames - 1) as f32 * 1000.0).clamp(20.0, 200.0) as u32
+        } else {
+            1000
+        };
+        // The GIF keeps at most 120 frames (every k-th), so that it stays a few megabytes.
+        let gif_every = frames.div_ceil(120) as usize;
+        let mut gif = contact_sheet::GifWriter::create(
+            &gif_path,
+            settings.width,
+            settings.height,
+            delay_ms * gif_every as u32,
+        )?;
+
+        let mut bar = Progress::new(frames as u64, "demo", "frames")?;
+        bar.set_message("simulating");
+
+        let mut sim_t = 0.0f32;
+        let mut m = Measured {
+            sim_ms: 0.0,
+            render_ms: Vec::new(),
+            pass_ms: Vec::new(),
+            first_surfaces: None,
+            last_surfaces: Vec::new(),
+            last_overflow: 0,
+            instances_count: 0,
+            mp4: false,
+        };
+        for (k, &t) in clip.times.iter().enumerate() {
+            bar.set_message("simulating");
+            let start = Instant::now();
+            while sim_t + sim_dt <= t + 1e-4 {
+                self.scene.advance(self.world, sim_t, sim_t + sim_dt)?;
+                sim_t += sim_dt;
+            }
+            m.sim_ms += start.elapsed().as_secs_f64() * 1e3;
+            bar.set_message("rendering");
+            let camera = self
+                .scene
+                .camera(&args.camera, t)
+                .ok_or_else(|| format!("camera {:?} has no view at {t} s", args.camera))?;
+            let instances = self.scene.instances(t);
+            m.instances_count = instances.len();
+            let frame = RenderFrame {
+                camera,
+                time: t,
+                surfaces: self.scene.surfaces(),
+                instances: &instances,
+                lights: self.scene.lights(),
+                environment: self.scene.environment(),
+                snowfall: !args.no_snowfall,
+            };
+            let out = self
+                .renderer
+                .render(self.world, &frame)
+                .map_err(|e| e.to_string())?;
+            m.render_ms.push(out.cpu_ms);
+            for p in &out.pass_times {
+                match m.pass_ms.iter_mut().find(|(n, _)| *n == p.name) {
+                    Some((_, v)) => v.push(p.gpu_ms),
+                    None => m.pass_ms.push((p.name, vec![p.gpu_ms])),
+                }
+            }
+            if m.first_surfaces.is_none() {
+                m.first_surfaces = Some(out.surfaces.clone());
+            }
+            m.last_surfaces = out.surfaces.clone();
+            m.last_overflow = out.dice_overflow;
+            let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
+                .ok_or("the renderer returned a frame of the wrong size")?;
+            if args.compare_tiers && k + 1 == clip.times.len() {
+                self.compare_tiers(&frame)?;
+            }
+            self.staging
+                .write_with(&format!("frame_{k:04}.png"), |path| image.save(path))?;
+            if k % gif_every == 0 {
+                gif.add(&image)?;
+            }
+            if sheet_frames.contains(&k) {
+                sheet_images.push((k, t, image));
+            }
+            bar.inc(1);
+        }
+        bar.set_message("encoding");
+        gif.finish()?;
+        let sheet = contact_sheet::compose(&sheet_images);
+        self.staging
+            .write_with("contact_sheet.png", |path| sheet.save(path))?;
+        m.mp4 = frames > 1 && self.encode_mp4(delay_ms, &mut settings.notes);
+        bar.finish();
+        Ok(m)
+    }
+
+    /// Render `frame` again in the relief and the tessellated tiers and write them side by side.
+    fn compare_tiers(&mut self, frame: &RenderFrame) -> Result<(), String> {
+        let mut pair = Vec::new();
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            self.renderer.set_tier(tier);
+            let o = self
+                .renderer
+                .render(self.world, frame)
+                .map_err(|e| e.to_string())?;
+            pair.push(
+                image::RgbaImage::from_raw(o.width, o.height, o.rgba8)
+                    .ok_or("the renderer returned a frame of the wrong size")?,
+            );
+        }
+        self.renderer.set_tier(self.args.tier);
+        let sheet = contact_sheet::side_by_side(&pair[0], &pair[1], "relief", "tessellated");
+        self.staging
+            .write_with("compare_tiers.png", |path| sheet.save(path))?;
+        Ok(())
+    }
+
+    /// The frames as `demo.mp4` when ffmpeg is on the PATH; otherwise a note and no file.
+    fn encode_mp4(&mut self, delay_ms: u32, notes: &mut Vec<String>) -> bool {
+        let fps = (1000.0 / delay_ms as f32).round().max(1.0);
+        let dir = self.staging.staging().to_owned();
+        let made = contact_sheet::encode_mp4(&dir, &self.staging.path("demo.mp4"), fps);
+        if !made {
+            let _ = std::fs::remove_file(dir.join("demo.mp4"));
+            self.staging.forget("demo.mp4");
+            notes.push("ffmpeg is not on the PATH (or failed): no demo.mp4".into());
+        }
+        made
+    }
+
+    /// `report.json`: the adapter, the settings, the passes and their times, each surface's
+    /// material, the notes and the outputs.
+    fn report(
+        &self,
+        ctx: &GpuContext,
+        settings: &Settings,
+        clip: &Clip,
+        m: &Measured,
+        wall: &Instant,
+    ) -> serde_json::Value {
+        let (args, world, renderer) = (self.args, &*self.world, &*self.renderer);
+        let surfaces_json: Vec<serde_json::Value> = self
+            .scene
+            .surfaces()
+            .iter()
+            .map(|(id, ground)| {
+                let desc = world.surface(*id).ok();
+                let first = m
+                    .first_surfaces
+                    .as_ref()
+                    .and_then(|v| v.iter().find(|s| s.surface == *id))
+                    .map(|s| s.material);
+                let last = m.last_surfaces.iter().find(|s| s.surface == *id);
+                serde_json::json!({
+                    "index": id.index(),
+                    "name": desc.map(|d| d.name.clone()),
+                    "size_m": desc.map(|d| d.size.to_array()),
+                    "snow_depth_m": desc.map(|d| d.snow_depth),
+                    "heightmap": world.layout(*id).ok().map(|l| [l.width, l.height]),
+                    "ground": ground,
+                    "material_first_frame": first,
+                    "material_last_frame": last.map(|s| s.material),
+                    "deepest_print_last_frame": last.map(|s| s.deepest),
+                    "diced_triangles_last_frame": last.map(|s| s.triangles),
+                })
+            })
+            .collect();
+        let basic_last: Vec<u32> = m
+            .last_surfaces
+            .iter()
+            .filter(|s| s.material == snowprint::render::SnowMaterialKind::Basic)
+            .map(|s| s.surface.index())
+            .collect();
+        let gpu_times: Vec<PassStats> = m
+            .pass_ms
+            .iter()
+            .map(|(name, v)| PassStats {
+                pass: name,
+                mean_ms: v.iter().sum::<f64>() / v.len().max(1) as f64,
+                max_ms: v.iter().copied().fold(0.0, f64::max),
+                median_ms: median(&mut v.clone()),
+            })
+            .collect();
+        let timestamps_note = if renderer.has_timestamps() {
+            serde_json::Value::Null
+        } else {
+            serde_json::json!(format!(
+                "{} has no GPU timestamp queries: per-pass GPU times are unavailable; CPU times per frame are reported instead",
+                ctx.info.name
+            ))
+        };
+        let mut outputs: Vec<String> = self.staging.names().to_vec();
+        outputs.push("report.json".into());
+        serde_json::json!({
+            "adapter": {
+                "name": ctx.info.name,
+                "backend": format!("{:?}", ctx.info.backend),
+                "device_type": format!("{:?}", ctx.info.device_type),
+                "driver": format!("{} {}", ctx.info.driver, ctx.info.driver_info),
+                "software": settings.software,
+            },
+            "resolution": [settings.width, settings.height],
+            "supersample": settings.supersample,
+            "frames": settings.frames,
+            "tier": args.tier,
+            "camera": args.camera,
+            "debug_view": args.debug_view,
+            "scene": self.scene.name(),
+            "clip_seconds": [clip.t0, clip.t1],
+            "simulation_hz": settings.sim_hz,
+            "instances_last_frame": m.instances_count,
+            "search": renderer.config().search_settings(),
+            "passes": renderer.passes(),
+            "gpu_pass_times_ms": gpu_times,
+            "dice_overflow_last_frame": m.last_overflow,
+            "gpu_pass_times_note": timestamps_note,
+            "cpu_ms": {
+                "simulation_total": m.sim_ms,
+                "render_median_per_frame": median(&mut m.render_ms.clone()),
+                "render_total": m.render_ms.iter().sum::<f64>(),
+            },
+            "surfaces": surfaces_json,
+            "basic_material_surfaces_last_frame": basic_last,
+            "notes": settings.notes,
+            "outputs": outputs,
+            "mp4": m.mp4,
+            "wall_seconds": wall.elapsed().as_secs_f64(),
+        })
+    }
 }
 
 #[cfg(test)]

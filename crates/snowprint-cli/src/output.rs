@@ -110,6 +110,25 @@ impl OutputSet {
         self.staging.join(name)
     }
 
+    /// Write the whole file `name` of the set: `contents` into its staging path. The set is
+    /// published as a whole, so the file needs no temporary name of its own; this is the one place
+    /// where the command's outputs are written, and where a failure is turned into one sentence.
+    pub fn write(&mut self, name: &str, contents: impl AsRef<[u8]>) -> Result<PathBuf, String> {
+        self.write_with(name, |path| std::fs::write(path, contents))
+    }
+
+    /// Write the file `name` of the set with `write`, given its staging path (an encoder that
+    /// writes its own file, such as an image's `save`); [`OutputSet::write`] for plain bytes.
+    pub fn write_with<E: std::fmt::Display>(
+        &mut self,
+        name: &str,
+        write: impl FnOnce(&Path) -> Result<(), E>,
+    ) -> Result<PathBuf, String> {
+        let path = self.path(name);
+        write(&path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        Ok(path)
+    }
+
     /// Drop `name` from the set (a file that turned out not to be made).
     pub fn forget(&mut self, name: &str) {
         self.names.retain(|n| n != name);

@@ -6,7 +6,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use snowprint::TickStats;
-use snowprint::manager::plot;
+use snowprint_demo::plot;
 
 /// Most summaries kept for the plot: up to this many frames each frame is drawn as it was; past
 /// it, neighbours are merged two by two (peaks kept), so the plot never holds more points.

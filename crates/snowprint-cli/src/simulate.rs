@@ -301,10 +301,8 @@ pub fn write_dump(
             "dt": done.dt,
             "png": "16-bit greyscale depression: 0 = untouched, 65535 = pressed to the ground; column 0 = smallest x, row 0 = smallest z, before yaw",
         });
-        let json = set.path(&format!("{}.json", desc.name));
         let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
-        std::fs::write(&json, text + "\n")
-            .map_err(|e| format!("cannot write {}: {e}", json.display()))?;
+        set.write(&format!("{}.json", desc.name), text + "\n")?;
     }
     set.publish()
 }

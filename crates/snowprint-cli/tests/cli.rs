@@ -481,7 +481,7 @@ fn demo_help_lists_the_real_cameras() {
         .expect("a --camera entry");
     let camera = camera.split_whitespace().collect::<Vec<_>>().join(" ");
     let (rooftops, standin) = camera.split_once("stand-in").expect("both scenes");
-    for name in snowprint::demo::DemoWorld::camera_names() {
+    for name in snowprint_demo::DemoWorld::camera_names() {
         assert!(rooftops.contains(name), "{name} missing from {camera}");
     }
     assert!(!rooftops.contains("street"), "{camera}");

@@ -24,7 +24,6 @@
 pub mod accumulate;
 pub mod capture;
 pub mod deformer;
-pub mod demo;
 pub mod error;
 mod extract;
 pub mod gpu;

@@ -34,10 +34,8 @@
 //! See `docs/MANAGER.md` for the priority rule, the starvation bound, the queue bound, the eviction
 //! order and the memory accounting.
 
-pub mod city;
 pub mod pages;
 pub mod planner;
-pub mod plot;
 pub mod quadtree;
 pub mod queue;
 pub mod save;

@@ -11,13 +11,13 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use crate::deformer::Pose;
-use crate::mesh::Mesh;
+use snowprint::deformer::Pose;
+use snowprint::mesh::Mesh;
 
 /// Number of body parts.
 pub const PART_COUNT: usize = 15;
 
-/// A body part. Its index (`as usize`) is its index in [`crate::demo::DemoWorld::part_meshes`].
+/// A body part. Its index (`as usize`) is its index in [`crate::DemoWorld::part_meshes`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Part {
     /// Hips; the root of the tree.

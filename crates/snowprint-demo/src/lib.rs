@@ -1,13 +1,13 @@
 //! The demo world, built in code: snowy flat roofs above a street, and procedural articulated
 //! people who walk, run, fall, slide, make a snow angel and fight on them.
 //!
-//! The module produces geometry, animation and deformers; it renders nothing. A renderer draws
-//! [`DemoWorld::surfaces`] (with the heightmaps of a [`crate::SnowWorld`] fed by
+//! The crate produces geometry, animation and deformers; it renders nothing. A renderer draws
+//! [`DemoWorld::surfaces`] (with the heightmaps of a [`snowprint::SnowWorld`] fed by
 //! [`DemoWorld::deformers_at`]), [`DemoWorld::props`], and every [`PartPose`] of
 //! [`DemoWorld::parts_at`] with the mesh `part_meshes[part]`.
 //!
 //! ```no_run
-//! use snowprint::demo::DemoWorld;
+//! use snowprint_demo::DemoWorld;
 //! use snowprint::{GpuContext, GpuOptions, SnowWorld, WorldConfig};
 //! # fn main() -> snowprint::Result<()> {
 //! let demo = DemoWorld::build();
@@ -34,10 +34,18 @@
 //! ```
 //!
 //! See `docs/DEMO.md` for the world, the skeleton, each animation and the cameras.
+//!
+//! This crate is the demo content of the workspace, not published: the library `snowprint` is
+//! what a game links, and builds without it. Beside the demo world above it holds the city
+//! generator of the surface manager's demo and benchmarks ([`city`]), the SVG plot of the
+//! manager's statistics ([`plot`]) and the worlds the command's rendered demo draws ([`scene`]).
 
 pub mod anim;
 pub mod camera;
+pub mod city;
 pub mod people;
+pub mod plot;
+pub mod scene;
 pub mod skeleton;
 pub mod world;
 
@@ -47,10 +55,10 @@ pub use anim::{Footfall, Motion};
 pub use people::Person;
 pub use skeleton::{BodyPose, PART_COUNT, Part, Side};
 
-use crate::deformer::{Deformer, Pose, Shape};
-use crate::mesh::{Mesh, MeshId};
-use crate::surface::SurfaceDesc;
-use crate::view::{Camera, GroundMaterial};
+use snowprint::deformer::{Deformer, Pose, Shape};
+use snowprint::mesh::{Mesh, MeshId};
+use snowprint::surface::SurfaceDesc;
+use snowprint::view::{Camera, GroundMaterial};
 
 /// A snow surface of the demo and what lies under its snow.
 #[derive(Clone, Debug, PartialEq)]
@@ -143,7 +151,7 @@ impl DemoWorld {
 
     /// One deformer per body part (in [`DemoWorld::parts_at`] order), moving from its pose at
     /// `t - dt` to its pose at `t`. `part_mesh_ids[i]` is the id of `part_meshes[i]` in the
-    /// [`crate::SnowWorld`]; parts without an id are left out.
+    /// [`snowprint::SnowWorld`]; parts without an id are left out.
     pub fn deformers_at(&self, t: f32, dt: f32, part_mesh_ids: &[MeshId]) -> Vec<Deformer> {
         let before = self.parts_at(t - dt);
         let now = self.parts_at(t);
@@ -158,7 +166,7 @@ impl DemoWorld {
     }
 
     /// The deformers of [`DemoWorld::deformers_at`] sorted by surface, ready for
-    /// [`crate::SnowWorld::update`]: for each surface (index into [`DemoWorld::surfaces`]), the
+    /// [`snowprint::SnowWorld::update`]: for each surface (index into [`DemoWorld::surfaces`]), the
     /// parts whose bounding ball reaches into its capture volume (the snow plus `ankle_height`)
     /// and that moved during the frame. A part at rest presses nothing it has not already pressed,
     /// so a lying body stops costing updates; surfaces that replenish keep their resting parts and
@@ -349,10 +357,18 @@ mod tests {
         }
     }
 
+    /// One mesh id a part, as a world would hand them out in order (`MeshId` is opaque outside
+    /// the library; its serialized form is the index).
+    fn part_ids() -> Vec<MeshId> {
+        (0..PART_COUNT)
+            .map(|i| serde_json::from_str(&i.to_string()).expect("a mesh id is its index"))
+            .collect()
+    }
+
     #[test]
     fn part_poses_are_rigid_and_every_part_deforms() {
         let d = DemoWorld::build();
-        let ids: Vec<MeshId> = (0..PART_COUNT as u32).map(MeshId).collect();
+        let ids = part_ids();
         for t in frames(&d) {
             let parts = d.parts_at(t);
             assert_eq!(parts.len(), d.people.len() * PART_COUNT);
@@ -375,7 +391,7 @@ mod tests {
     #[test]
     fn surface_deformers_hold_everything_that_moves_in_the_snow() {
         let d = DemoWorld::build();
-        let ids: Vec<MeshId> = (0..PART_COUNT as u32).map(MeshId).collect();
+        let ids = part_ids();
         let ankle = 0.25;
         let dt = 1.0 / HZ;
         for t in frames(&d).skip(1) {

@@ -11,10 +11,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{ManagedDeformer, ZoneId};
-use crate::deformer::{Deformer, Pose, Shape};
-use crate::surface::SurfaceDesc;
-use crate::view::{Camera, GroundMaterial};
+use snowprint::deformer::{Deformer, Pose, Shape};
+use snowprint::manager::{ManagedDeformer, ZoneId};
+use snowprint::surface::SurfaceDesc;
+use snowprint::view::{Camera, GroundMaterial};
 
 /// Metres from one block to the next.
 pub const BLOCK_PITCH: f32 = 30.0;
@@ -276,12 +276,37 @@ pub fn generate(seed: u64, surfaces: usize, walkers: usize) -> City {
     // About 13 surfaces per block.
     let blocks = surfaces.div_ceil(13).max(1);
     let per_row = (blocks as f32).sqrt().ceil() as u32;
+    // One snow depth for all streets, so a walker's feet sink the same on every segment.
+    let street_depth = rng.range(0.12, 0.2);
+    let (out, roofs, blocks_made) = city_blocks(&mut rng, surfaces, per_row, street_depth);
+    let paths = walker_paths(
+        &mut rng,
+        walkers,
+        &out,
+        &roofs,
+        (per_row, blocks_made),
+        street_depth,
+    );
+    City {
+        surfaces: out,
+        walkers: paths,
+        blocks_per_row: per_row,
+    }
+}
+
+/// `surfaces` surfaces, block by block (`per_row` blocks a row): each block's streets, then its
+/// four lots' roofs and penthouses. Returns the surfaces, the indices of the roofs and how many
+/// blocks were started.
+fn city_blocks(
+    rng: &mut XorShift,
+    surfaces: usize,
+    per_row: u32,
+    street_depth: f32,
+) -> (Vec<CitySurface>, Vec<usize>, u32) {
     let zones_per_row = per_row.div_ceil(ZONE_BLOCKS);
     let mut out: Vec<CitySurface> = Vec::with_capacity(surfaces);
     let mut roofs: Vec<usize> = Vec::new();
     let mut block = 0u32;
-    // One snow depth for all streets, so a walker's feet sink the same on every segment.
-    let street_depth = rng.range(0.12, 0.2);
     while out.len() < surfaces {
         let (bx, bz) = (block % per_row, block / per_row);
         block += 1;
@@ -379,7 +404,20 @@ pub fn generate(seed: u64, surfaces: usize, walkers: usize) -> City {
             }
         }
     }
-    let blocks_made = block;
+    (out, roofs, block)
+}
+
+/// One path a walker: odd walkers around a roof's edge, the others (the player first, round the
+/// middle block) around a block's streets, or back and forth along a street in a city too small
+/// for a loop.
+fn walker_paths(
+    rng: &mut XorShift,
+    walkers: usize,
+    out: &[CitySurface],
+    roofs: &[usize],
+    (per_row, blocks_made): (u32, u32),
+    street_depth: f32,
+) -> Vec<WalkerPath> {
     let mut paths = Vec::with_capacity(walkers);
     // A block can be walked around when its east and south neighbours exist (their bands close
     // the loop). Streets of a block come first, so an existing block has all its bands.
@@ -435,11 +473,7 @@ pub fn generate(seed: u64, surfaces: usize, walkers: usize) -> City {
         path.player = w == 0;
         paths.push(path);
     }
-    City {
-        surfaces: out,
-        walkers: paths,
-        blocks_per_row: per_row,
-    }
+    paths
 }
 
 #[cfg(test)]

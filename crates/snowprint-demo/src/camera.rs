@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use super::DemoWorld;
-use crate::view::Camera;
+use snowprint::view::Camera;
 
 /// Names accepted by [`DemoWorld::camera`].
 pub const NAMES: [&str; 8] = [

@@ -10,14 +10,14 @@ use std::collections::VecDeque;
 use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
-use snowprint::demo::anim::Action;
-use snowprint::demo::skeleton::dims;
-use snowprint::demo::world::surface;
-use snowprint::demo::{DemoWorld, Part, Person};
 use snowprint::{
     CaptureConfig, Heightmap, MeshId, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
     SurfaceUpdate, WorldConfig,
 };
+use snowprint_demo::anim::Action;
+use snowprint_demo::skeleton::dims;
+use snowprint_demo::world::surface;
+use snowprint_demo::{DemoWorld, Part, Person};
 
 const DT: f32 = 1.0 / 30.0;
 /// A texel counts as pressed from this fraction of the snow depth.
@@ -48,7 +48,7 @@ fn simulate(demo: &DemoWorld, surfaces: &[SurfaceDesc], t0: f32, t1: f32) -> Vec
     let probe = DemoWorld {
         surfaces: surfaces
             .iter()
-            .map(|d| snowprint::demo::DemoSurface {
+            .map(|d| snowprint_demo::DemoSurface {
                 desc: d.clone(),
                 ground: Default::default(),
             })
@@ -321,7 +321,7 @@ fn slide_leaves_one_long_trench() {
     let slide = slider.slide().expect("the slider slides");
     let desc = &run.demo.surfaces[surface::YARD_ROOF].desc;
     let map = &run.maps[surface::YARD_ROOF];
-    let dir = snowprint::demo::anim::forward_of(slide.yaw);
+    let dir = snowprint_demo::anim::forward_of(slide.yaw);
     let start = Vec3::new(slide.start.x, desc.center.y, slide.start.y);
     let middle = start + dir * (0.5 * slide.length());
     let found = blobs(map);
@@ -374,7 +374,7 @@ fn fall_leaves_a_body_sized_imprint() {
         area >= lo && area <= hi,
         "imprint {area} m², a body covers {lo}..{hi}"
     );
-    let fall_dir = -snowprint::demo::anim::forward_of(topple.yaw);
+    let fall_dir = -snowprint_demo::anim::forward_of(topple.yaw);
     let length = body.extent(desc, map, fall_dir);
     assert!(
         (0.85 * dims::HEIGHT..=1.3 * dims::HEIGHT).contains(&length),

@@ -16,7 +16,8 @@ use std::time::Instant;
 
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use snowprint::manager::{CameraView, Lookup, ManagedDeformer, ManagerConfig, Planner, city};
+use snowprint::manager::{CameraView, Lookup, ManagedDeformer, ManagerConfig, Planner};
+use snowprint_demo::city;
 
 const SURFACES: usize = 10_000;
 const WALKERS: usize = 500;

@@ -1,4 +1,4 @@
-//! The library's demo world (`snowprint::demo::DemoWorld`) as a [`DemoScene`] for the renderer:
+//! The demo world ([`crate::DemoWorld`]) as a [`DemoScene`] for the renderer:
 //! its surfaces go into the `SnowWorld`, its props and body-part meshes into the `Renderer`, and
 //! each step feeds the snow with the demo's per-surface deformers (`DemoWorld::surface_deformers`
 //! and `SnowWorld::update`, so a body at rest costs nothing). The demo world draws nothing and has
@@ -6,8 +6,8 @@
 //! its shape (buildings get brick facades with windows, parapets concrete, the rest gathers snow on
 //! top) and adds sodium street lamps along the street.
 
+use crate::DemoWorld;
 use glam::{Mat4, Vec3};
-use snowprint::demo::DemoWorld;
 use snowprint::render::{Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
 use snowprint::{Camera, GroundMaterial, Mesh, MeshId, SnowWorld, SurfaceId, SurfaceUpdate};
 
@@ -181,6 +181,7 @@ impl LibraryDemo {
 
 impl DemoScene for LibraryDemo {
     fn name(&self) -> &str {
+        // The name the report has always given this world (kept for readers of report.json).
         "snowprint::demo (DemoWorld::build)"
     }
 
