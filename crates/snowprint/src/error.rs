@@ -171,15 +171,15 @@ pub enum SnowError {
     /// Heights given to [`crate::PoolFormat::encode`] or `decode` do not match the heightmap's
     /// size.
     #[error(
-        "a {width} x {height} heightmap at {precision} needs {expected} {what}, but {got} were given"
+        "a {width} x {height} heightmap at {bits}-bit precision needs {expected} {what}, but {got} were given"
     )]
     HeightsLength {
         /// Texels along x.
         width: u32,
         /// Texels along z.
         height: u32,
-        /// The pool's precision.
-        precision: crate::pool::Precision,
+        /// The pool's precision, bits a channel (8, 16 or 32).
+        bits: u32,
         /// What was counted (texels a channel, or words).
         what: &'static str,
         /// How many it needs.

@@ -192,7 +192,7 @@ impl PoolFormat {
         Err(crate::SnowError::HeightsLength {
             width,
             height,
-            precision: self.precision,
+            bits: self.precision.bits(),
             what,
             expected,
             got,
