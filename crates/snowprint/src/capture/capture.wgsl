@@ -13,6 +13,8 @@
 // `tile_list` (count cleared to 0): each tile the first time it is flagged, as (record, tile), so
 // the update can be dispatched over the flagged tiles alone.
 
+// import constants
+
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
     frustum_height: f32,    // metres
@@ -44,14 +46,8 @@ struct Primitive {
 @group(0) @binding(3) var<storage, read_write> winding: array<atomic<i32>>;
 @group(0) @binding(4) var<storage, read_write> tiles: array<atomic<u32>>;
 // Words 0-2: indirect dispatch arguments (written by the update's seal pass); 3: entries; from 4:
-// two words an entry, the record and (tile y << 16 | tile x). Must match TILE_LIST_HEADER in
-// accumulate/mod.rs.
+// two words an entry, the record and (tile y << 16 | tile x). TILE_LIST_HEADER is 4.
 @group(0) @binding(5) var<storage, read_write> tile_list: array<atomic<u32>>;
-
-// Side of the update's tiles. Must match FUSED_WORKGROUP in accumulate/mod.rs.
-const TILE: u32 = 16u;
-// `view.record` when the update does not use the list. Must match NO_LIST in capture/mod.rs.
-const NO_LIST: u32 = 0xffffffffu;
 
 // Flag every tile holding a texel within one of this one (the blur's reach).
 fn mark_tiles(frag: vec2<f32>) {
@@ -76,10 +72,9 @@ fn mark_tiles(frag: vec2<f32>) {
     }
 }
 
-// Depths in [0, 1] are stored as ONE_BITS - bits(depth): 0 (the cleared value) means nothing was
+// Depths in [0, 1] are stored as ONE_BITS - bits(depth) (constants.wgsl): 0 (the cleared value) means nothing was
 // captured, and a larger value is a lower point, so atomicMax keeps the lowest. Non-negative
 // floats order like their bit patterns, so the code is exact and monotonic.
-const ONE_BITS: u32 = 0x3f800000u;
 
 fn texel_index(frag: vec2<f32>) -> u32 {
     let cell = vec2<u32>(frag - view.origin);

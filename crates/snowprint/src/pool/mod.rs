@@ -22,9 +22,9 @@ use bytemuck::{Pod, Zeroable};
 
 /// WGSL that reads a surface's heights from a `pool: array<u32>` binding at any precision
 /// (`pool_texel`, `pool_fractions`, `channel_max`), for renderers that sample the pool.
-pub const TEXEL_WGSL: &str = concat!(include_str!("channels.wgsl"), include_str!("texel.wgsl"));
+pub const TEXEL_WGSL: &str = crate::wgsl::libraries::TEXEL;
 /// WGSL of `channel_max(bits)` alone (part of [`TEXEL_WGSL`]).
-pub const CHANNELS_WGSL: &str = include_str!("channels.wgsl");
+pub const CHANNELS_WGSL: &str = crate::wgsl::files::CHANNELS;
 
 /// Alignment of slots in the pool, bytes.
 pub const SLOT_ALIGN: u64 = 256;
@@ -271,12 +271,12 @@ impl SurfaceRecord {
 }
 
 /// `batch` of a record whose surface had nothing to capture this update.
-pub const NO_CAPTURE: u32 = u32::MAX;
+pub const NO_CAPTURE: u32 = crate::wgsl::consts::NO_CAPTURE;
 /// Bit of [`SurfaceRecord::mode`] set when mesh solids were drawn over the surface this update:
 /// only then does the update read the capture's winding buffer.
-pub const MODE_MESHES: u32 = 2;
+pub const MODE_MESHES: u32 = crate::wgsl::consts::MODE_MESHES;
 /// `normals` of a record in a pool that keeps no normals.
-pub const NO_NORMALS: u32 = u32::MAX;
+pub const NO_NORMALS: u32 = crate::wgsl::consts::NO_NORMALS;
 
 /// A slot in the pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,6 +5,8 @@
 // dispatch of its heightfield pass (zero workgroups when basic), and the flag the report reads.
 // Reads: the heightmap pool, the surface list. Writes: the surface state table.
 
+// import texel
+
 // Must match `ClassifyRecord` in src/render/gpu.rs.
 struct ClassifyRecord {
     heights: u32,     // word offset of the heightmap in the pool

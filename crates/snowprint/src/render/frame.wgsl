@@ -1,5 +1,5 @@
 // frame.wgsl: what every pass of the renderer shares: the frame's uniforms (camera, moon, sky,
-// point lights, options), the shadow map, and the lighting model. Prepended to each pass's WGSL.
+// point lights, options), the shadow map, and the lighting model. Imported by each pass's WGSL.
 
 struct PointLight {
     position_radius: vec4<f32>,   // world position, radius of influence (metres)

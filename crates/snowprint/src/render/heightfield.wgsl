@@ -11,6 +11,8 @@
 // CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
 // displaced_fraction}.
 
+// import texel
+
 // Must match `HeightfieldParams` in src/render/gpu.rs.
 struct HeightfieldParams {
     heights: u32,       // word offset of the heightmap in the pool
