@@ -29,7 +29,7 @@ struct CaptureView {
 // Must match `CaptureView` in capture/mod.rs.
 
 struct Primitive {
-    // kind.x: 0 = capsule (a sphere is a capsule with a == b), 1 = box.
+    // kind.x: PRIM_CAPSULE (a sphere is a capsule with a == b) or PRIM_BOX.
     kind: vec4<u32>,
     // capsule: p0 = segment start (xyz) and radius (w), p1 = segment end.
     // box: p0 = centre, p1/p2/p3 = unit axes (xyz) and half extents (w).
@@ -104,7 +104,7 @@ fn vs_prim(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
     let p = prims[ii];
     var lo: vec2<f32>;
     var hi: vec2<f32>;
-    if p.kind.x == 0u {
+    if p.kind.x == PRIM_CAPSULE {
         let r = p.p0.w;
         lo = min(p.p0.xz, p.p1.xz) - vec2<f32>(r);
         hi = max(p.p0.xz, p.p1.xz) + vec2<f32>(r);
@@ -233,7 +233,7 @@ fn fs_prim(in: PrimOut) {
     let p = prims[in.index];
     let c = texel_center(in.clip.xy);
     var iv: vec2<f32>;
-    if p.kind.x == 0u {
+    if p.kind.x == PRIM_CAPSULE {
         iv = capsule_interval(p.p0.xyz, p.p1.xyz, p.p0.w, c.x, c.y);
     } else {
         iv = box_interval(p.p0.xyz, p.p1, p.p2, p.p3, c.x, c.y);

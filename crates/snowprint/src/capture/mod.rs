@@ -90,9 +90,9 @@ pub struct GpuPrimitive {
 }
 
 /// Primitive kind: capsule (a sphere is a capsule of zero length).
-pub const PRIM_CAPSULE: u32 = 0;
+pub const PRIM_CAPSULE: u32 = crate::wgsl::consts::PRIM_CAPSULE;
 /// Primitive kind: oriented box.
-pub const PRIM_BOX: u32 = 1;
+pub const PRIM_BOX: u32 = crate::wgsl::consts::PRIM_BOX;
 
 /// Per-draw uniform of a mesh deformer. Must match `MeshDraw` in `capture.wgsl`.
 #[repr(C)]

@@ -19,7 +19,8 @@ struct ClassifyRecord {
     _pad2: u32,
 }
 
-// Words per surface in the state table. Must match `STATE_WORDS` in src/render/gpu.rs.
+// Words per surface in the state table: STATE_WORDS of wgsl/constants.wgsl, which this module does
+// not import (a test in src/render/gpu.rs checks the two agree).
 const STATE_WORDS: u32 = 16u;
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;

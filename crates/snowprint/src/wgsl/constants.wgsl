@@ -24,3 +24,26 @@ const MODE_DEPTH: u32 = 0u;
 const MODE_MASK: u32 = 1u;
 // Bit of `mode` set when mesh solids were drawn over the surface: only then is `winding` read.
 const MODE_MESHES: u32 = 2u;
+// Primitive kind of a capture primitive (`kind.x`): a capsule (a sphere is a capsule of zero length).
+const PRIM_CAPSULE: u32 = 0u;
+// Primitive kind of a capture primitive: an oriented box.
+const PRIM_BOX: u32 = 1u;
+// Words per surface in the renderer's surface state table (written by classify.wgsl, which keeps
+// its own copy, checked by a test: it does not import this module).
+const STATE_WORDS: u32 = 16u;
+// Word of a surface's state holding the "deformed" flag.
+const STATE_TOUCHED: u32 = 11u;
+// Words of the dicing counters before the per-surface draw arguments.
+const ARGS_BASE: u32 = 8u;
+// Words per surface of the dicing's draw arguments.
+const ARGS_STRIDE: u32 = 8u;
+// Dicing counter of vertices appended.
+const COUNTER_VERTICES: u32 = 0u;
+// Dicing counter of indices appended.
+const COUNTER_INDICES: u32 = 1u;
+// Dicing counter of indices already sealed into draw arguments.
+const COUNTER_SEALED: u32 = 2u;
+// Dicing counter of base triangles dropped because the buffers were full.
+const COUNTER_OVERFLOW: u32 = 3u;
+// Point lights the frame uniform holds.
+const MAX_POINT_LIGHTS: u32 = 8u;

@@ -286,4 +286,12 @@ fn shared_constants() {
         (consts::MODE_DEPTH, consts::MODE_MASK, consts::MODE_MESHES),
         (0, 1, 2)
     );
+    assert_eq!((consts::PRIM_CAPSULE, consts::PRIM_BOX), (0, 1));
+    assert_eq!((consts::STATE_WORDS, consts::STATE_TOUCHED), (16, 11));
+    assert_eq!((consts::ARGS_BASE, consts::ARGS_STRIDE), (8, 8));
+    assert_eq!(consts::COUNTER_VERTICES, 0);
+    assert_eq!(consts::COUNTER_INDICES, 1);
+    assert_eq!(consts::COUNTER_SEALED, 2);
+    assert_eq!(consts::COUNTER_OVERFLOW, 3);
+    assert_eq!(consts::MAX_POINT_LIGHTS, 8);
 }

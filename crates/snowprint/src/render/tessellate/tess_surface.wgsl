@@ -17,9 +17,6 @@
 @group(1) @binding(3) var bank_texture: texture_2d<f32>;
 @group(1) @binding(4) var<storage, read> surface_state: array<u32>;
 
-// Must match STATE_WORDS and STATE_TOUCHED in src/render/gpu.rs.
-const TESS_STATE_WORDS: u32 = 16u;
-const TESS_STATE_TOUCHED: u32 = 11u;
 // Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
 // Must match MACRO_MEAN in src/render/tessellate/cpu.rs.
 const MACRO_MEAN: f32 = 0.025;
@@ -36,7 +33,7 @@ struct TessVarying {
 }
 
 fn tess_touched() -> bool {
-    return surface_state[surface.index * TESS_STATE_WORDS + TESS_STATE_TOUCHED] != 0u;
+    return surface_state[surface.index * STATE_WORDS + STATE_TOUCHED] != 0u;
 }
 
 fn bank_texel(c: vec2<i32>) -> f32 {
