@@ -27,8 +27,9 @@ struct Composed {
 }
 
 impl Composed {
-    /// `path:line` of line `line` (1-based) of the composed source.
-    fn origin(&self, line: u32) -> String {
+    /// `path:line:column` of a location in the composed source.
+    fn origin(&self, at: naga::SourceLocation) -> String {
+        let line = at.line_number;
         let (start, path) = self
             .parts
             .iter()
@@ -36,7 +37,7 @@ impl Composed {
             .find(|(start, _)| *start <= line)
             .copied()
             .unwrap_or((1, "?"));
-        format!("src/{path}:{}", line - start + 1)
+        format!("src/{path}:{}:{}", line - start + 1, at.line_position)
     }
 }
 
@@ -153,7 +154,7 @@ fn compose(name: &str, files: &HashMap<&str, File>) -> Composed {
 fn validate(name: &str, composed: &Composed) -> (naga::Module, naga::valid::ModuleInfo) {
     let src = &composed.source;
     let module = naga::front::wgsl::parse_str(src).unwrap_or_else(|e| {
-        let at = e.location(src).map(|l| composed.origin(l.line_number));
+        let at = e.location(src).map(|l| composed.origin(l));
         panic!(
             "WGSL module `{name}` does not parse: {}: {}\n{}",
             at.unwrap_or_default(),
@@ -167,7 +168,7 @@ fn validate(name: &str, composed: &Composed) -> (naga::Module, naga::valid::Modu
     )
     .validate(&module)
     .unwrap_or_else(|e| {
-        let at = e.location(src).map(|l| composed.origin(l.line_number));
+        let at = e.location(src).map(|l| composed.origin(l));
         panic!(
             "WGSL module `{name}` does not validate: {}: {}\n{}",
             at.unwrap_or_default(),

@@ -295,3 +295,19 @@ fn shared_constants() {
     assert_eq!(consts::COUNTER_OVERFLOW, 3);
     assert_eq!(consts::MAX_POINT_LIGHTS, 8);
 }
+
+/// The update compiles each of its passes with the pool's `PRECISION` override, which wgpu refuses
+/// for a module that does not declare it.
+#[test]
+fn update_passes_declare_precision() {
+    for name in ["blur", "merge", "normals", "fused", "seal"] {
+        let module = naga::front::wgsl::parse_str(get(name).unwrap().source).unwrap();
+        assert!(
+            module
+                .overrides
+                .iter()
+                .any(|(_, o)| o.name.as_deref() == Some("PRECISION")),
+            "{name}"
+        );
+    }
+}
