@@ -54,42 +54,68 @@ fn registry_validates() {
     }
 }
 
-/// Today's hand-written bind-group layouts, transcribed from where pipelines are created
-/// (`accumulate/mod.rs`, `capture/mod.rs`, `render/mod.rs`, `render/tessellate/gpu.rs`), as
-/// (module, group, entries on a device that filters Rgba16Float or not).
-fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroupLayoutEntry>)> {
-    use crate::gpu::resources::{compute_storage, uniform};
-    use wgpu::ShaderStages as S;
-    let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+// Today's hand-written bind-group layouts, transcribed from where pipelines are created
+// (`accumulate/mod.rs`, `capture/mod.rs`, `render/mod.rs`, `render/tessellate/gpu.rs`), as
+// (module, group, entries), with the helpers those files use.
+
+use crate::gpu::resources::{compute_storage, uniform};
+use wgpu::ShaderStages as S;
+
+type Layouts = Vec<(&'static str, u32, Vec<wgpu::BindGroupLayoutEntry>)>;
+
+fn entry(binding: u32, visibility: S, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty,
         count: None,
-    };
-    let buffer = |ty, has_dynamic_offset| wgpu::BindingType::Buffer {
+    }
+}
+
+fn buffer(ty: wgpu::BufferBindingType, has_dynamic_offset: bool) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
         ty,
         has_dynamic_offset,
         min_binding_size: None,
-    };
-    let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
-    let texture = |sample_type, view_dimension| wgpu::BindingType::Texture {
+    }
+}
+
+fn storage(read_only: bool) -> wgpu::BufferBindingType {
+    wgpu::BufferBindingType::Storage { read_only }
+}
+
+fn texture(
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
         sample_type,
         view_dimension,
         multisampled: false,
-    };
-    let float = |filterable| wgpu::TextureSampleType::Float { filterable };
-    let d2 = wgpu::TextureViewDimension::D2;
-    let storage_texture = |binding| {
-        entry(
-            binding,
-            S::COMPUTE,
-            wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: wgpu::TextureFormat::Rgba16Float,
-                view_dimension: d2,
-            },
-        )
-    };
+    }
+}
+
+fn float(filterable: bool) -> wgpu::BindingType {
+    texture(
+        wgpu::TextureSampleType::Float { filterable },
+        wgpu::TextureViewDimension::D2,
+    )
+}
+
+fn storage_texture(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    entry(
+        binding,
+        S::COMPUTE,
+        wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: wgpu::TextureFormat::Rgba16Float,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+    )
+}
+
+/// The update's layouts: capture and accumulation.
+fn update_layouts() -> Layouts {
     let vf = S::VERTEX_FRAGMENT;
     let dynamic_uniform = |binding, visibility| {
         entry(
@@ -99,32 +125,7 @@ fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroup
         )
     };
     let fragment_storage = |binding| entry(binding, S::FRAGMENT, buffer(storage(false), false));
-    let frame = vec![
-        uniform(0, vf),
-        entry(
-            1,
-            S::FRAGMENT,
-            texture(
-                wgpu::TextureSampleType::Depth,
-                wgpu::TextureViewDimension::D2Array,
-            ),
-        ),
-        entry(
-            2,
-            S::FRAGMENT,
-            wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-        ),
-        entry(
-            3,
-            S::FRAGMENT,
-            wgpu::BindingType::Sampler(if filterable {
-                wgpu::SamplerBindingType::Filtering
-            } else {
-                wgpu::SamplerBindingType::NonFiltering
-            }),
-        ),
-    ];
-    let c = S::COMPUTE;
+    let cs = compute_storage;
     vec![
         (
             "capture",
@@ -142,77 +143,92 @@ fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroup
         (
             "blur",
             0,
-            vec![
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, true),
-                compute_storage(3, false),
-            ],
+            vec![cs(0, true), cs(1, true), cs(2, true), cs(3, false)],
         ),
-        (
-            "merge",
-            0,
-            vec![
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-            ],
-        ),
+        ("merge", 0, vec![cs(0, true), cs(1, true), cs(2, false)]),
         (
             "fused",
             0,
             vec![
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-                compute_storage(3, true),
-                compute_storage(4, true),
-                compute_storage(5, true),
+                cs(0, true),
+                cs(1, true),
+                cs(2, false),
+                cs(3, true),
+                cs(4, true),
+                cs(5, true),
             ],
         ),
-        ("seal", 0, vec![compute_storage(0, false)]),
-        (
-            "normals",
-            0,
-            vec![compute_storage(0, true), compute_storage(1, false)],
+        ("seal", 0, vec![cs(0, false)]),
+        ("normals", 0, vec![cs(0, true), cs(1, false)]),
+    ]
+}
+
+/// The renderer's layouts on a device that filters Rgba16Float or not.
+fn render_layouts(filterable: bool) -> Layouts {
+    let vf = S::VERTEX_FRAGMENT;
+    let c = S::COMPUTE;
+    let linear = if filterable {
+        wgpu::SamplerBindingType::Filtering
+    } else {
+        wgpu::SamplerBindingType::NonFiltering
+    };
+    let frame = vec![
+        uniform(0, vf),
+        entry(
+            1,
+            S::FRAGMENT,
+            texture(
+                wgpu::TextureSampleType::Depth,
+                wgpu::TextureViewDimension::D2Array,
+            ),
         ),
-        ("surface", 0, frame.clone()),
-        ("sky", 0, frame.clone()),
-        ("snowfall", 0, frame.clone()),
-        ("tonemap", 0, frame.clone()),
-        ("mesh", 0, frame.clone()),
-        ("tess_surface", 0, frame),
+        entry(
+            2,
+            S::FRAGMENT,
+            wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+        ),
+        entry(3, S::FRAGMENT, wgpu::BindingType::Sampler(linear)),
+    ];
+    let depth = texture(
+        wgpu::TextureSampleType::Depth,
+        wgpu::TextureViewDimension::D2,
+    );
+    let cs = compute_storage;
+    let mut layouts: Layouts = [
+        "surface",
+        "sky",
+        "snowfall",
+        "tonemap",
+        "mesh",
+        "tess_surface",
+    ]
+    .into_iter()
+    .map(|name| (name, 0, frame.clone()))
+    .collect();
+    layouts.extend([
         (
             "surface",
             1,
             vec![
                 uniform(0, vf),
-                entry(1, S::FRAGMENT, texture(float(filterable), d2)),
-                entry(2, S::FRAGMENT, texture(float(filterable), d2)),
+                entry(1, S::FRAGMENT, float(filterable)),
+                entry(2, S::FRAGMENT, float(filterable)),
             ],
         ),
         (
             "tonemap",
             1,
             vec![
-                entry(0, S::FRAGMENT, texture(float(false), d2)),
-                entry(1, S::FRAGMENT, texture(wgpu::TextureSampleType::Depth, d2)),
+                entry(0, S::FRAGMENT, float(false)),
+                entry(1, S::FRAGMENT, depth),
             ],
         ),
-        (
-            "classify",
-            0,
-            vec![
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-            ],
-        ),
+        ("classify", 0, vec![cs(0, true), cs(1, true), cs(2, false)]),
         (
             "heightfield",
             0,
             vec![
-                compute_storage(0, true),
+                cs(0, true),
                 uniform(1, c),
                 storage_texture(2),
                 storage_texture(3),
@@ -223,9 +239,9 @@ fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroup
             0,
             vec![
                 uniform(0, c),
-                entry(1, c, texture(float(false), d2)),
-                entry(2, c, texture(float(false), d2)),
-                entry(3, c, texture(float(false), d2)),
+                entry(1, c, float(false)),
+                entry(2, c, float(false)),
+                entry(3, c, float(false)),
                 storage_texture(4),
             ],
         ),
@@ -234,13 +250,13 @@ fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroup
             0,
             vec![
                 uniform(0, c),
-                compute_storage(1, true),
-                entry(2, c, texture(float(false), d2)),
-                entry(3, c, texture(float(false), d2)),
-                compute_storage(4, true),
-                compute_storage(5, false),
-                compute_storage(6, false),
-                compute_storage(7, false),
+                cs(1, true),
+                entry(2, c, float(false)),
+                entry(3, c, float(false)),
+                cs(4, true),
+                cs(5, false),
+                cs(6, false),
+                cs(7, false),
             ],
         ),
         (
@@ -248,13 +264,14 @@ fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroup
             1,
             vec![
                 uniform(0, vf),
-                entry(1, vf, texture(float(filterable), d2)),
-                entry(2, vf, texture(float(filterable), d2)),
-                entry(3, vf, texture(float(false), d2)),
+                entry(1, vf, float(filterable)),
+                entry(2, vf, float(filterable)),
+                entry(3, vf, float(false)),
                 entry(4, vf, buffer(storage(true), false)),
             ],
         ),
-    ]
+    ]);
+    layouts
 }
 
 /// The layouts reflected from the modules (with `OVERRIDES`) are the hand-written ones, on devices
@@ -262,7 +279,10 @@ fn hand_written(filterable: bool) -> Vec<(&'static str, u32, Vec<wgpu::BindGroup
 #[test]
 fn reflected_layouts_match_hand_written() {
     for filterable in [true, false] {
-        for (name, group, expected) in hand_written(filterable) {
+        for (name, group, expected) in update_layouts()
+            .into_iter()
+            .chain(render_layouts(filterable))
+        {
             let reflected = get(name).unwrap().layout_entries_for(group, filterable);
             assert_eq!(
                 reflected, expected,
