@@ -187,39 +187,57 @@ fn write_module(
     module: &naga::Module,
     info: &naga::valid::ModuleInfo,
 ) {
+    let stage_bits = |stage| match stage {
+        naga::ShaderStage::Vertex => 1,
+        naga::ShaderStage::Fragment => 2,
+        naga::ShaderStage::Compute => 4,
+        other => panic!("WGSL module `{name}`: stage {other:?} is not reflected"),
+    };
+    assert!(
+        module.entry_points.len() <= 64,
+        "WGSL module `{name}`: over 64 entry points"
+    );
     let mut bindings = Vec::new();
     for (handle, var) in module.global_variables.iter() {
         let Some(binding) = &var.binding else {
             continue;
         };
-        let mut stages = 0u32;
+        let (mut stages, mut users) = (0u32, 0u64);
         for (i, ep) in module.entry_points.iter().enumerate() {
-            if info.get_entry_point(i)[handle].is_empty() {
-                continue;
+            if !info.get_entry_point(i)[handle].is_empty() {
+                stages |= stage_bits(ep.stage);
+                users |= 1 << i;
             }
-            stages |= match ep.stage {
-                naga::ShaderStage::Vertex => 1,
-                naga::ShaderStage::Fragment => 2,
-                naga::ShaderStage::Compute => 4,
-                other => panic!("WGSL module `{name}`: stage {other:?} is not reflected"),
-            };
         }
         let kind = binding_kind(name, module, var);
-        bindings.push(format!(
-            "        Binding {{ group: {}, binding: {}, name: {:?}, stages: {stages}, kind: {kind} }},\n",
+        let line = format!(
+            "        Binding {{ group: {}, binding: {}, name: {:?}, stages: {stages}, entry_points: {users:#x}, kind: {kind} }},\n",
             binding.group,
             binding.binding,
             var.name.as_deref().unwrap_or("")
-        ));
+        );
+        bindings.push(((binding.group, binding.binding), line));
     }
     bindings.sort();
+    let bindings: String = bindings.into_iter().map(|(_, line)| line).collect();
+    let entry_points: String = module
+        .entry_points
+        .iter()
+        .map(|ep| {
+            format!(
+                "        EntryPoint {{ name: {:?}, stages: {} }},\n",
+                ep.name,
+                stage_bits(ep.stage)
+            )
+        })
+        .collect();
     let _ = writeln!(
         out,
         "/// Entry module `{name}` (src/wgsl/table.rs), composed and validated by build.rs.\n\
-         pub const {}: ShaderModule = ShaderModule {{\n    name: {name:?},\n    source: include_str!({:?}),\n    bindings: &[\n{}    ],\n}};\n",
+         pub const {}: ShaderModule = ShaderModule {{\n    name: {name:?},\n    source: include_str!({:?}),\n    \
+         entry_points: &[\n{entry_points}    ],\n    bindings: &[\n{bindings}    ],\n}};\n",
         name.to_uppercase(),
         file.display().to_string(),
-        bindings.concat()
     );
 }
 

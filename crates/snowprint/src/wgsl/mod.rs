@@ -79,8 +79,19 @@ pub struct Binding {
     /// Bits of the stages whose entry points use it: 1 vertex, 2 fragment, 4 compute (as
     /// [`wgpu::ShaderStages`]).
     pub stages: u32,
+    /// Bit `i` set when entry point `i` of the module ([`ShaderModule::entry_points`]) uses it.
+    pub entry_points: u64,
     /// How it is bound.
     pub kind: BindingKind,
+}
+
+/// An entry point of a module.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EntryPoint {
+    /// Its WGSL name.
+    pub name: &'static str,
+    /// Its stage, as [`wgpu::ShaderStages`] bits.
+    pub stages: u32,
 }
 
 /// What reflection cannot tell about a binding, by (module, variable name).
@@ -171,6 +182,8 @@ pub struct ShaderModule {
     pub name: &'static str,
     /// The composed WGSL, as validated.
     pub source: &'static str,
+    /// Its entry points, in declaration order.
+    pub entry_points: &'static [EntryPoint],
     /// Its bindings, by group then binding.
     pub bindings: &'static [Binding],
 }
@@ -207,72 +220,110 @@ impl ShaderModule {
             .iter()
             .filter(|b| b.group == group)
             .map(|b| {
-                let overrides = self.overrides(b.name);
-                let filtering = !overrides.contains(&Override::NotFiltering)
-                    && (filterable_rgba16f
-                        || !overrides.contains(&Override::FilterableIfSupported));
-                let dynamic = overrides.contains(&Override::DynamicOffset);
-                let stages = overrides
+                let stages = self
+                    .overrides(b.name)
                     .iter()
                     .find_map(|o| match o {
                         Override::Stages(s) => Some(*s),
                         _ => None,
                     })
                     .unwrap_or(b.stages);
-                let ty = match b.kind {
-                    BindingKind::Uniform => wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: dynamic,
-                        min_binding_size: None,
-                    },
-                    BindingKind::Storage { read_only } => wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only },
-                        has_dynamic_offset: dynamic,
-                        min_binding_size: None,
-                    },
-                    BindingKind::Texture {
-                        sample,
-                        dimension,
-                        multisampled,
-                    } => wgpu::BindingType::Texture {
-                        sample_type: match sample {
-                            TextureSample::Float => wgpu::TextureSampleType::Float {
-                                filterable: filtering,
-                            },
-                            TextureSample::Depth => wgpu::TextureSampleType::Depth,
-                            TextureSample::Sint => wgpu::TextureSampleType::Sint,
-                            TextureSample::Uint => wgpu::TextureSampleType::Uint,
-                        },
-                        view_dimension: dimension,
-                        multisampled,
-                    },
-                    BindingKind::StorageTexture {
-                        access,
-                        format,
-                        dimension,
-                    } => wgpu::BindingType::StorageTexture {
-                        access,
-                        format,
-                        view_dimension: dimension,
-                    },
-                    BindingKind::Sampler { comparison: true } => {
-                        wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
-                    }
-                    BindingKind::Sampler { comparison: false } if filtering => {
-                        wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)
-                    }
-                    BindingKind::Sampler { comparison: false } => {
-                        wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering)
-                    }
-                };
-                wgpu::BindGroupLayoutEntry {
-                    binding: b.binding,
-                    visibility: wgpu::ShaderStages::from_bits_truncate(stages),
-                    ty,
-                    count: None,
-                }
+                self.layout_entry(b, stages, filterable_rgba16f)
             })
             .collect()
+    }
+
+    /// The layout entries of group `group` that only the named entry points need, visible to their
+    /// stages (e.g. the shadow pass's group 0, which `vs_shadow` reads alone). [`OVERRIDES`]
+    /// apply, except their stages.
+    pub fn layout_entries_of(
+        &self,
+        entry_points: &[&str],
+        group: u32,
+        filterable_rgba16f: bool,
+    ) -> Vec<wgpu::BindGroupLayoutEntry> {
+        let chosen: Vec<_> = self
+            .entry_points
+            .iter()
+            .enumerate()
+            .filter(|(_, ep)| entry_points.contains(&ep.name))
+            .collect();
+        self.bindings
+            .iter()
+            .filter(|b| b.group == group)
+            .filter_map(|b| {
+                let stages = chosen
+                    .iter()
+                    .filter(|(i, _)| b.entry_points & (1 << i) != 0)
+                    .fold(0, |s, (_, ep)| s | ep.stages);
+                (stages != 0).then(|| self.layout_entry(b, stages, filterable_rgba16f))
+            })
+            .collect()
+    }
+
+    /// The layout entry of binding `b`, visible to `stages`.
+    fn layout_entry(
+        &self,
+        b: &Binding,
+        stages: u32,
+        filterable_rgba16f: bool,
+    ) -> wgpu::BindGroupLayoutEntry {
+        let overrides = self.overrides(b.name);
+        let filtering = !overrides.contains(&Override::NotFiltering)
+            && (filterable_rgba16f || !overrides.contains(&Override::FilterableIfSupported));
+        let dynamic = overrides.contains(&Override::DynamicOffset);
+        let ty = match b.kind {
+            BindingKind::Uniform => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: dynamic,
+                min_binding_size: None,
+            },
+            BindingKind::Storage { read_only } => wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: dynamic,
+                min_binding_size: None,
+            },
+            BindingKind::Texture {
+                sample,
+                dimension,
+                multisampled,
+            } => wgpu::BindingType::Texture {
+                sample_type: match sample {
+                    TextureSample::Float => wgpu::TextureSampleType::Float {
+                        filterable: filtering,
+                    },
+                    TextureSample::Depth => wgpu::TextureSampleType::Depth,
+                    TextureSample::Sint => wgpu::TextureSampleType::Sint,
+                    TextureSample::Uint => wgpu::TextureSampleType::Uint,
+                },
+                view_dimension: dimension,
+                multisampled,
+            },
+            BindingKind::StorageTexture {
+                access,
+                format,
+                dimension,
+            } => wgpu::BindingType::StorageTexture {
+                access,
+                format,
+                view_dimension: dimension,
+            },
+            BindingKind::Sampler { comparison: true } => {
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
+            }
+            BindingKind::Sampler { comparison: false } if filtering => {
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)
+            }
+            BindingKind::Sampler { comparison: false } => {
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering)
+            }
+        };
+        wgpu::BindGroupLayoutEntry {
+            binding: b.binding,
+            visibility: wgpu::ShaderStages::from_bits_truncate(stages),
+            ty,
+            count: None,
+        }
     }
 }
 

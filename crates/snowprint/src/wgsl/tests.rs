@@ -292,6 +292,28 @@ fn reflected_layouts_match_hand_written() {
     }
 }
 
+/// The shadow passes' group 0 is the frame uniform alone, seen by the vertex stage: what their
+/// vertex entry points use (`render/mod.rs` and `render/tessellate/gpu.rs` write it by hand).
+#[test]
+fn shadow_layouts_from_their_entry_points() {
+    let expected = vec![uniform(0, S::VERTEX)];
+    for (module, entry) in [("mesh", "vs_shadow"), ("tess_surface", "vs_tess_shadow")] {
+        for filterable in [true, false] {
+            let reflected = get(module)
+                .unwrap()
+                .layout_entries_of(&[entry], 0, filterable);
+            assert_eq!(reflected, expected, "{module}::{entry}");
+        }
+    }
+    // The snow pass's own entry points need the whole frame group, as shared.
+    let surface = get("surface").unwrap();
+    let names: Vec<_> = surface.entry_points.iter().map(|e| e.name).collect();
+    assert_eq!(
+        surface.layout_entries_of(&names, 1, true),
+        surface.layout_entries(1)
+    );
+}
+
 /// The constants reflected from constants.wgsl are the values the Rust code used before.
 #[test]
 fn shared_constants() {
