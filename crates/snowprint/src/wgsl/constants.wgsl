@@ -47,3 +47,14 @@ const COUNTER_SEALED: u32 = 2u;
 const COUNTER_OVERFLOW: u32 = 3u;
 // Point lights the frame uniform holds.
 const MAX_POINT_LIGHTS: u32 = 8u;
+// Softness of the moon's shadow over the snow: penumbra width per metre from the occluder (the
+// heightfield pass and its CPU reference, render::cpu::light_visibility).
+const PENUMBRA_SLOPE: f32 = 0.12;
+// Penumbra width at the occluder, metres.
+const PENUMBRA_BASE: f32 = 0.01;
+// Most taps of the light visibility along the moon's direction.
+const LIGHT_TAPS: u32 = 16u;
+// Directions of the horizon search of the snow's ambient occlusion.
+const AO_DIRECTIONS: u32 = 8u;
+// Least receptivity of a texel to banks (at the bottom of trails), so that no pushed snow is lost.
+const RECEPTIVITY_FLOOR: f32 = 0.001;

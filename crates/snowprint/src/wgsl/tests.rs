@@ -336,6 +336,12 @@ fn shared_constants() {
     assert_eq!(consts::COUNTER_SEALED, 2);
     assert_eq!(consts::COUNTER_OVERFLOW, 3);
     assert_eq!(consts::MAX_POINT_LIGHTS, 8);
+    assert_eq!(
+        (consts::PENUMBRA_SLOPE, consts::PENUMBRA_BASE),
+        (0.12, 0.01)
+    );
+    assert_eq!((consts::LIGHT_TAPS, consts::AO_DIRECTIONS), (16, 8));
+    assert_eq!(consts::RECEPTIVITY_FLOOR, 0.001);
 }
 
 /// The update compiles each of its passes with the pool's `PRECISION` override, which wgpu refuses
