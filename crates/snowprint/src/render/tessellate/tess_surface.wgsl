@@ -18,7 +18,6 @@
 @group(1) @binding(4) var<storage, read> surface_state: array<u32>;
 
 // Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
-// Must match MACRO_MEAN in src/render/tessellate/cpu.rs.
 const MACRO_MEAN: f32 = 0.025;
 
 struct TessVertex {
