@@ -35,6 +35,7 @@ pub mod render;
 pub mod scene;
 pub mod surface;
 pub mod view;
+pub mod wgsl;
 pub mod world;
 
 pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};

@@ -1,6 +1,8 @@
 // Shared layout of the per-surface record read by every compute pass of the update.
 // Must match `SurfaceRecord` in src/pool/mod.rs (checked by a test that parses this file with naga).
 
+// import constants
+
 struct SurfaceRecord {
     // Word (u32) offsets into the pool buffer.
     heights: u32,         // the heights region (see pool/texel.wgsl), updated in place
@@ -20,13 +22,6 @@ struct SurfaceRecord {
     texel_z: f32,         // metres
     tiles: u32,           // first of the surface's 16x16 tile flags (set where the capture wrote)
 }
-
-const NO_CAPTURE: u32 = 0xffffffffu;
-const MODE_DEPTH: u32 = 0u;
-const MODE_MASK: u32 = 1u;
-// Bit of `mode` set when mesh solids were drawn over the surface: only then is `winding` read.
-const MODE_MESHES: u32 = 2u;
-const NO_NORMALS: u32 = 0xffffffffu;
 
 // Bits a channel of the pool's heightmaps (8, 16 or 32): set when the world compiles its passes.
 override PRECISION: u32 = 16u;

@@ -5,12 +5,14 @@
 // Writes: `scratch` (one f32 per texel of each captured surface).
 // CPU reference: accumulate::cpu::blur. Maths: maths.wgsl, capture_read.wgsl.
 
+// import maths, capture_read
+
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
 @group(0) @binding(2) var<storage, read> winding: array<i32>;
 @group(0) @binding(3) var<storage, read_write> scratch: array<f32>;
 
-@compute @workgroup_size(8, 8, 1)
+@compute @workgroup_size(WORKGROUP, WORKGROUP, 1)
 fn blur(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = records[gid.z];
     if rec.batch == NO_CAPTURE || gid.x >= rec.width || gid.y >= rec.height {

@@ -1,5 +1,7 @@
 // Reading the capture, shared by blur.wgsl and fused.wgsl (which bind `capture` and `winding`).
 
+// import maths
+
 // Depression of the captured texel (x, y) of a surface, clamped to its edges. Where a mesh solid
 // contains the ground point (winding > 0), the texel is pressed to the ground.
 fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {

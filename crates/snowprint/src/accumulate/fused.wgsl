@@ -12,6 +12,8 @@
 // Writes: the same heights regions.
 // CPU reference: accumulate::cpu::blur then merge_channels. Maths: maths.wgsl, capture_read.wgsl.
 
+// import maths, capture_read, texel_write
+
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
 @group(0) @binding(2) var<storage, read_write> pool: array<u32>;
@@ -19,12 +21,12 @@
 @group(0) @binding(4) var<storage, read> tiles: array<u32>;
 @group(0) @binding(5) var<storage, read> tile_list: array<u32>;
 
-const SIDE: i32 = 16;
+const SIDE: i32 = i32(TILE);
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
 var<workgroup> depressions: array<f32, 324>;   // DEP * DEP
 var<workgroup> blurred: array<f32, 256>;       // SIDE * SIDE
 
-@compute @workgroup_size(16, 16, 1)
+@compute @workgroup_size(TILE, TILE, 1)
 fn fused(
     @builtin(local_invocation_index) lid: u32,
     @builtin(local_invocation_id) local: vec3<u32>,
@@ -48,7 +50,7 @@ fn fused(
     update_tile(rec, wid.xy, has_capture, lid, local.xy);
 }
 
-@compute @workgroup_size(16, 16, 1)
+@compute @workgroup_size(TILE, TILE, 1)
 fn fused_listed(
     @builtin(local_invocation_index) lid: u32,
     @builtin(local_invocation_id) local: vec3<u32>,

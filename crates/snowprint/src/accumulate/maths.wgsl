@@ -2,8 +2,7 @@
 // separate passes (blur.wgsl, merge.wgsl, normals.wgsl) and the fused one (fused.wgsl) so that they
 // cannot drift apart. CPU reference: accumulate::cpu.
 
-// Must match `ONE_BITS` in capture.wgsl: a stored capture value v is the depth bitcast(ONE_BITS - v).
-const ONE_BITS: u32 = 0x3f800000u;
+// import shared, channels
 
 // Tap offsets in texels: a rotated grid, so each bilinear tap mixes four texels and the four taps
 // together spread over one texel in every direction (kernel in 64ths: corners 3, edges 10,

@@ -6,6 +6,8 @@
 // One invocation per unit (two texels along x at 8 bits, one otherwise).
 // CPU reference: accumulate::cpu::merge_channels. Maths: maths.wgsl.
 
+// import maths, texel_write
+
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> scratch: array<f32>;
 @group(0) @binding(2) var<storage, read_write> pool: array<u32>;
@@ -23,7 +25,7 @@ fn merged(rec: SurfaceRecord, x: u32, y: u32) -> vec2<u32> {
     return merge_channels(old, blurred, has_capture, rec.replenish_units);
 }
 
-@compute @workgroup_size(8, 8, 1)
+@compute @workgroup_size(WORKGROUP, WORKGROUP, 1)
 fn merge(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = records[gid.z];
     let x = gid.x * unit_texels(PRECISION);

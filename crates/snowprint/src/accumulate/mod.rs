@@ -21,48 +21,34 @@ pub use encode::{AccumulateBuffers, AccumulatePlan, encode};
 use crate::gpu::resources::compute_storage;
 use crate::pool::Precision;
 
+use crate::wgsl::{ShaderModule, files};
+
 /// Record layout shared by every pass.
-pub const SHARED: &str = include_str!("../shared.wgsl");
-/// Stage 1 (without the shared prelude).
-pub const BLUR_SHADER: &str = include_str!("blur.wgsl");
-/// Stage 2 (without the shared prelude).
-pub const MERGE_SHADER: &str = include_str!("merge.wgsl");
-/// Normals (without the shared prelude).
-pub const NORMALS_SHADER: &str = include_str!("normals.wgsl");
-/// Blur and merge in one pass (without the shared prelude).
-pub const FUSED_SHADER: &str = include_str!("fused.wgsl");
-/// The indirect arguments of the listed fused pass (without the shared prelude).
-pub const SEAL_SHADER: &str = include_str!("seal.wgsl");
+pub const SHARED: &str = files::SHARED;
+/// Stage 1 (without its imports).
+pub const BLUR_SHADER: &str = files::BLUR;
+/// Stage 2 (without its imports).
+pub const MERGE_SHADER: &str = files::MERGE;
+/// Normals (without its imports).
+pub const NORMALS_SHADER: &str = files::NORMALS;
+/// Blur and merge in one pass (without its imports).
+pub const FUSED_SHADER: &str = files::FUSED;
+/// The indirect arguments of the listed fused pass (without its imports).
+pub const SEAL_SHADER: &str = files::SEAL;
 pub use crate::pool::TILE_LIST_HEADER;
 /// The arithmetic shared by every stage.
-pub const MATHS: &str = include_str!("maths.wgsl");
+pub const MATHS: &str = files::MATHS;
 /// Reading the capture buffer (for the passes that bind it).
-pub const CAPTURE_READ: &str = include_str!("capture_read.wgsl");
+pub const CAPTURE_READ: &str = files::CAPTURE_READ;
 /// Reading heights from the pool at any precision.
-pub const TEXEL_READ: &str = include_str!("../pool/texel.wgsl");
+pub const TEXEL_READ: &str = files::TEXEL;
 /// Writing heights to the pool at any precision.
-pub const TEXEL_WRITE: &str = include_str!("../pool/texel_write.wgsl");
+pub const TEXEL_WRITE: &str = files::TEXEL_WRITE;
 
 /// Workgroup side of the separate accumulation passes.
-pub const WORKGROUP: u32 = 8;
+pub const WORKGROUP: u32 = crate::wgsl::consts::WORKGROUP;
 /// Workgroup side of the fused pass: one of the pool's update tiles ([`crate::pool::TILE_SIDE`]).
 pub const FUSED_WORKGROUP: u32 = crate::pool::TILE_SIDE;
-
-/// The shader source of a stage with the shared prelude, as compiled.
-pub fn with_prelude(stage: &str) -> String {
-    let capture = if stage.contains("var<storage, read> capture") {
-        CAPTURE_READ
-    } else {
-        ""
-    };
-    let pool = if stage.contains("var<storage, read_write> pool") {
-        format!("{TEXEL_READ}\n{TEXEL_WRITE}")
-    } else {
-        String::new()
-    };
-    let channels = crate::pool::CHANNELS_WGSL;
-    format!("{SHARED}\n{channels}\n{MATHS}\n{capture}\n{pool}\n{stage}")
-}
 
 /// The three compute pipelines and their layouts.
 pub struct AccumulatePipelines {
@@ -130,10 +116,10 @@ impl AccumulatePipelines {
             entries: &[compute_storage(0, true), compute_storage(1, false)],
         });
         let constants = [("PRECISION", precision.bits() as f64)];
-        let make = |name: &str, src: &str, layout: &wgpu::BindGroupLayout| {
+        let make = |name: &str, shader: &ShaderModule, layout: &wgpu::BindGroupLayout| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(name),
-                source: wgpu::ShaderSource::Wgsl(with_prelude(src).into()),
+                source: wgpu::ShaderSource::Wgsl(shader.source.into()),
             });
             let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(name),
@@ -154,12 +140,12 @@ impl AccumulatePipelines {
             })
         };
         Self {
-            blur: make("blur", BLUR_SHADER, &blur_layout),
-            merge: make("merge", MERGE_SHADER, &merge_layout),
-            normals: make("normals", NORMALS_SHADER, &normals_layout),
-            fused: make("fused", FUSED_SHADER, &fused_layout),
-            fused_listed: make("fused_listed", FUSED_SHADER, &fused_layout),
-            seal: make("seal_tiles", SEAL_SHADER, &seal_layout),
+            blur: make("blur", &crate::wgsl::BLUR, &blur_layout),
+            merge: make("merge", &crate::wgsl::MERGE, &merge_layout),
+            normals: make("normals", &crate::wgsl::NORMALS, &normals_layout),
+            fused: make("fused", &crate::wgsl::FUSED, &fused_layout),
+            fused_listed: make("fused_listed", &crate::wgsl::FUSED, &fused_layout),
+            seal: make("seal_tiles", &crate::wgsl::SEAL, &seal_layout),
             seal_layout,
             blur_layout,
             merge_layout,
@@ -171,21 +157,21 @@ impl AccumulatePipelines {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
-    /// Every shader parses and validates with naga, so a broken shader fails `cargo test`.
+    /// Every shader parses and validates with naga, so a broken shader fails `cargo test` (build.rs
+    /// already fails the build on one: see `crate::wgsl`).
     #[test]
     fn shaders_validate() {
-        for (name, src) in [
-            ("blur", with_prelude(BLUR_SHADER)),
-            ("merge", with_prelude(MERGE_SHADER)),
-            ("normals", with_prelude(NORMALS_SHADER)),
-            ("fused", with_prelude(FUSED_SHADER)),
-            ("seal", with_prelude(SEAL_SHADER)),
-            ("capture", crate::capture::SHADER.to_owned()),
+        for (name, shader) in [
+            ("blur", &crate::wgsl::BLUR),
+            ("merge", &crate::wgsl::MERGE),
+            ("normals", &crate::wgsl::NORMALS),
+            ("fused", &crate::wgsl::FUSED),
+            ("seal", &crate::wgsl::SEAL),
+            ("capture", &crate::wgsl::CAPTURE),
         ] {
-            let module = naga::front::wgsl::parse_str(&src)
-                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+            let src = shader.source;
+            let module = naga::front::wgsl::parse_str(src)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
             naga::valid::Validator::new(
                 naga::valid::ValidationFlags::all(),
                 naga::valid::Capabilities::all(),
@@ -198,8 +184,7 @@ mod tests {
     /// The Rust record and the WGSL record have the same size and field offsets.
     #[test]
     fn record_layout_matches_wgsl() {
-        let src = with_prelude(MERGE_SHADER);
-        let module = naga::front::wgsl::parse_str(&src).unwrap();
+        let module = naga::front::wgsl::parse_str(crate::wgsl::MERGE.source).unwrap();
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).unwrap();
         let (handle, ty) = module

@@ -5,6 +5,8 @@
 // follows from unit length).
 // CPU reference: accumulate::cpu::normals. Maths: maths.wgsl.
 
+// import maths, texel_write
+
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read_write> pool: array<u32>;
 
@@ -14,7 +16,7 @@ fn height_at(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     return snow_height(rec, pool_texel(PRECISION, rec.heights, rec.width, rec.height, cx, cy).x);
 }
 
-@compute @workgroup_size(8, 8, 1)
+@compute @workgroup_size(WORKGROUP, WORKGROUP, 1)
 fn normals(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = records[gid.z];
     if rec.normals == NO_NORMALS || gid.x >= rec.width || gid.y >= rec.height {

@@ -1,6 +1,9 @@
 // The indirect dispatch of `fused_listed` (fused.wgsl): one workgroup per entry of the capture's
 // tile list, in rows of 65535 (the largest dispatch along one axis).
 // Reads: the list's entry count (word 3). Writes: the dispatch arguments (words 0-2).
+// Imports shared.wgsl only for PRECISION, which the update sets on every one of its passes.
+
+// import shared
 
 @group(0) @binding(0) var<storage, read_write> tile_list: array<u32>;
 

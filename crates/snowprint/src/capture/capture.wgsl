@@ -13,6 +13,8 @@
 // `tile_list` (count cleared to 0): each tile the first time it is flagged, as (record, tile), so
 // the update can be dispatched over the flagged tiles alone.
 
+// import constants
+
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
     frustum_height: f32,    // metres
@@ -27,7 +29,7 @@ struct CaptureView {
 // Must match `CaptureView` in capture/mod.rs.
 
 struct Primitive {
-    // kind.x: 0 = capsule (a sphere is a capsule with a == b), 1 = box.
+    // kind.x: PRIM_CAPSULE (a sphere is a capsule with a == b) or PRIM_BOX.
     kind: vec4<u32>,
     // capsule: p0 = segment start (xyz) and radius (w), p1 = segment end.
     // box: p0 = centre, p1/p2/p3 = unit axes (xyz) and half extents (w).
@@ -44,14 +46,8 @@ struct Primitive {
 @group(0) @binding(3) var<storage, read_write> winding: array<atomic<i32>>;
 @group(0) @binding(4) var<storage, read_write> tiles: array<atomic<u32>>;
 // Words 0-2: indirect dispatch arguments (written by the update's seal pass); 3: entries; from 4:
-// two words an entry, the record and (tile y << 16 | tile x). Must match TILE_LIST_HEADER in
-// accumulate/mod.rs.
+// two words an entry, the record and (tile y << 16 | tile x). TILE_LIST_HEADER is 4.
 @group(0) @binding(5) var<storage, read_write> tile_list: array<atomic<u32>>;
-
-// Side of the update's tiles. Must match FUSED_WORKGROUP in accumulate/mod.rs.
-const TILE: u32 = 16u;
-// `view.record` when the update does not use the list. Must match NO_LIST in capture/mod.rs.
-const NO_LIST: u32 = 0xffffffffu;
 
 // Flag every tile holding a texel within one of this one (the blur's reach).
 fn mark_tiles(frag: vec2<f32>) {
@@ -76,10 +72,9 @@ fn mark_tiles(frag: vec2<f32>) {
     }
 }
 
-// Depths in [0, 1] are stored as ONE_BITS - bits(depth): 0 (the cleared value) means nothing was
+// Depths in [0, 1] are stored as ONE_BITS - bits(depth) (constants.wgsl): 0 (the cleared value) means nothing was
 // captured, and a larger value is a lower point, so atomicMax keeps the lowest. Non-negative
 // floats order like their bit patterns, so the code is exact and monotonic.
-const ONE_BITS: u32 = 0x3f800000u;
 
 fn texel_index(frag: vec2<f32>) -> u32 {
     let cell = vec2<u32>(frag - view.origin);
@@ -109,7 +104,7 @@ fn vs_prim(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
     let p = prims[ii];
     var lo: vec2<f32>;
     var hi: vec2<f32>;
-    if p.kind.x == 0u {
+    if p.kind.x == PRIM_CAPSULE {
         let r = p.p0.w;
         lo = min(p.p0.xz, p.p1.xz) - vec2<f32>(r);
         hi = max(p.p0.xz, p.p1.xz) + vec2<f32>(r);
@@ -238,7 +233,7 @@ fn fs_prim(in: PrimOut) {
     let p = prims[in.index];
     let c = texel_center(in.clip.xy);
     var iv: vec2<f32>;
-    if p.kind.x == 0u {
+    if p.kind.x == PRIM_CAPSULE {
         iv = capsule_interval(p.p0.xyz, p.p1.xyz, p.p0.w, c.x, c.y);
     } else {
         iv = box_interval(p.p0.xyz, p.p1, p.p2, p.p3, c.x, c.y);

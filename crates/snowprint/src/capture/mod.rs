@@ -57,16 +57,15 @@ impl Default for CaptureConfig {
 }
 
 /// WGSL of the capture pass.
-pub const SHADER: &str = include_str!("capture.wgsl");
+pub const SHADER: &str = crate::wgsl::CAPTURE.source;
 
 /// Format of the render target that places each surface's viewport. The capture itself goes to a
 /// storage buffer (atomic max of an encoded depth), so this target is never cleared, read or written:
 /// the smallest depth format keeps its memory small.
 pub const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
 
-/// Code of depth 1.0, the top of the frustum. Must match `ONE_BITS` in `capture.wgsl` and
-/// `blur.wgsl`.
-pub const ONE_BITS: u32 = 0x3f80_0000;
+/// Code of depth 1.0, the top of the frustum.
+pub const ONE_BITS: u32 = crate::wgsl::consts::ONE_BITS;
 
 /// Encode a depth in [0, 1] as the capture stores it: 0 means nothing was captured, larger values are
 /// lower points (so an atomic max keeps the lowest).
@@ -83,7 +82,7 @@ pub fn decode_depth(code: u32) -> f32 {
 pub const MAX_SUBSTEPS: u32 = 32;
 
 /// `record` of a [`CaptureView`] whose flagged tiles are not listed (the update runs its grid).
-pub const NO_LIST: u32 = u32::MAX;
+pub const NO_LIST: u32 = crate::wgsl::consts::NO_LIST;
 
 /// Uniform block of one surface's capture. Must match `CaptureView` in `capture.wgsl`.
 #[repr(C)]
@@ -126,9 +125,9 @@ pub struct GpuPrimitive {
 }
 
 /// Primitive kind: capsule (a sphere is a capsule of zero length).
-pub const PRIM_CAPSULE: u32 = 0;
+pub const PRIM_CAPSULE: u32 = crate::wgsl::consts::PRIM_CAPSULE;
 /// Primitive kind: oriented box.
-pub const PRIM_BOX: u32 = 1;
+pub const PRIM_BOX: u32 = crate::wgsl::consts::PRIM_BOX;
 
 /// Per-draw uniform of a mesh deformer. Must match `MeshDraw` in `capture.wgsl`.
 #[repr(C)]

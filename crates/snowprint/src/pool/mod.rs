@@ -22,16 +22,16 @@ use bytemuck::{Pod, Zeroable};
 
 /// WGSL that reads a surface's heights from a `pool: array<u32>` binding at any precision
 /// (`pool_texel`, `pool_fractions`, `channel_max`), for renderers that sample the pool.
-pub const TEXEL_WGSL: &str = concat!(include_str!("channels.wgsl"), include_str!("texel.wgsl"));
+pub const TEXEL_WGSL: &str = crate::wgsl::libraries::TEXEL;
 /// WGSL of `channel_max(bits)` alone (part of [`TEXEL_WGSL`]).
-pub const CHANNELS_WGSL: &str = include_str!("channels.wgsl");
+pub const CHANNELS_WGSL: &str = crate::wgsl::files::CHANNELS;
 
 /// Side of the update's tiles, texels: the fused pass's workgroup, and the unit in which the
-/// capture flags what it wrote. Must match `SIDE` in `fused.wgsl`.
-pub const TILE_SIDE: u32 = 16;
-/// Words before the entries of the capture's tile list: the dispatch arguments and the count.
-/// Must match `capture.wgsl`, `fused.wgsl` and `seal.wgsl`.
-pub const TILE_LIST_HEADER: u64 = 4;
+/// capture flags what it wrote (`TILE` of `wgsl/constants.wgsl`).
+pub const TILE_SIDE: u32 = crate::wgsl::consts::TILE;
+/// Words before the entries of the capture's tile list: the dispatch arguments and the count
+/// (`TILE_LIST_HEADER` of `wgsl/constants.wgsl`).
+pub const TILE_LIST_HEADER: u64 = crate::wgsl::consts::TILE_LIST_HEADER as u64;
 
 /// Alignment of slots in the pool, bytes.
 pub const SLOT_ALIGN: u64 = 256;
@@ -277,12 +277,12 @@ impl SurfaceRecord {
 }
 
 /// `batch` of a record whose surface had nothing to capture this update.
-pub const NO_CAPTURE: u32 = u32::MAX;
+pub const NO_CAPTURE: u32 = crate::wgsl::consts::NO_CAPTURE;
 /// Bit of [`SurfaceRecord::mode`] set when mesh solids were drawn over the surface this update:
 /// only then does the update read the capture's winding buffer.
-pub const MODE_MESHES: u32 = 2;
+pub const MODE_MESHES: u32 = crate::wgsl::consts::MODE_MESHES;
 /// `normals` of a record in a pool that keeps no normals.
-pub const NO_NORMALS: u32 = u32::MAX;
+pub const NO_NORMALS: u32 = crate::wgsl::consts::NO_NORMALS;
 
 /// A slot in the pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,7 +5,9 @@
 //            (depression in the low byte, displaced in the high byte), the even texel low.
 //   16 bits: a word a texel, depression low 16 bits, displaced high 16.
 //   32 bits: two planes of width x height words: depressions, then displaced.
-// CPU reference: pool::PoolFormat::{encode, decode}. Needs channels.wgsl.
+// CPU reference: pool::PoolFormat::{encode, decode}.
+
+// import channels
 
 // (depression, displaced) of texel (x, y) of the heights region at word `base`.
 fn pool_texel(bits: u32, base: u32, width: u32, height: u32, x: u32, y: u32) -> vec2<u32> {

@@ -2,6 +2,8 @@
 // bind `pool` read_write. A *unit* is what one invocation writes without racing its neighbours:
 // two texels along x at 8 bits (one word), one texel otherwise.
 
+// import texel
+
 // Texels a unit covers.
 fn unit_texels(bits: u32) -> u32 {
     return select(1u, 2u, bits == 8u);

@@ -219,12 +219,12 @@ pub fn sobel_normal(
 }
 
 /// Width of the soft shadow's penumbra per metre travelled towards the light, and at the start.
-/// Must match `PENUMBRA_SLOPE` and `PENUMBRA_BASE` in `heightfield.wgsl`.
-pub const PENUMBRA_SLOPE: f32 = 0.12;
+/// Penumbra width per metre from the occluder.
+pub const PENUMBRA_SLOPE: f32 = crate::wgsl::consts::PENUMBRA_SLOPE;
 /// See [`PENUMBRA_SLOPE`].
-pub const PENUMBRA_BASE: f32 = 0.01;
-/// Most taps of [`light_visibility`] (must match `LIGHT_TAPS` in `heightfield.wgsl`).
-pub const LIGHT_TAPS: u32 = 16;
+pub const PENUMBRA_BASE: f32 = crate::wgsl::consts::PENUMBRA_BASE;
+/// Most taps of [`light_visibility`].
+pub const LIGHT_TAPS: u32 = crate::wgsl::consts::LIGHT_TAPS;
 
 /// How much of a light in local direction `light` (unit, pointing to the light) reaches the snow
 /// at local `(x, z)`: march from the snow there up to the top of the slab, a tap per texel crossed
@@ -262,8 +262,8 @@ pub fn light_visibility(
     visible
 }
 
-/// Directions of the horizon search of [`horizon_ao`] (must match `AO_DIRS` in `heightfield.wgsl`).
-pub const AO_DIRECTIONS: usize = 8;
+/// Directions of the horizon search of [`horizon_ao`].
+pub const AO_DIRECTIONS: usize = crate::wgsl::consts::AO_DIRECTIONS as usize;
 /// Radii of the horizon search, metres (must match `AO_RADII` in `heightfield.wgsl`): prints are
 /// 10-30 cm across, so the occluders that matter lie within 30 cm.
 pub const AO_RADII: [f32; 4] = [0.04, 0.09, 0.16, 0.28];

@@ -4,9 +4,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Per-surface words in the surface state table written by `classify.wgsl`. Must match
-/// `STATE_WORDS` there.
-pub const STATE_WORDS: u64 = 16;
+/// Per-surface words in the surface state table written by `classify.wgsl`.
+pub const STATE_WORDS: u64 = crate::wgsl::consts::STATE_WORDS as u64;
 /// Offset (in words) of the basic material's indirect draw arguments.
 pub const STATE_BASIC_DRAW: u64 = 0;
 /// Offset of the deformable material's indirect draw arguments.
@@ -14,15 +13,15 @@ pub const STATE_DEFORMABLE_DRAW: u64 = 4;
 /// Offset of the heightfield pass's indirect dispatch arguments.
 pub const STATE_HEIGHTFIELD_DISPATCH: u64 = 8;
 /// Offset of the "deformed" flag.
-pub const STATE_TOUCHED: u64 = 11;
+pub const STATE_TOUCHED: u64 = crate::wgsl::consts::STATE_TOUCHED as u64;
 /// Offset of the deepest depression (an f32 fraction of the snow depth, as bits).
 pub const STATE_DEEPEST: u64 = 12;
 /// Vertices of a surface's box: five faces of two triangles (no bottom).
 pub const BOX_VERTICES: u32 = 30;
 /// Alignment of uniform blocks addressed by offset.
 pub const UNIFORM_STRIDE: u64 = crate::gpu::resources::UNIFORM_STRIDE;
-/// Point lights the frame uniform holds. Must match `MAX_POINT_LIGHTS` in `frame.wgsl`.
-pub const MAX_POINT_LIGHTS: usize = 8;
+/// Point lights the frame uniform holds.
+pub const MAX_POINT_LIGHTS: usize = crate::wgsl::consts::MAX_POINT_LIGHTS as usize;
 
 /// One point light. Must match `PointLight` in `frame.wgsl`.
 #[repr(C)]

@@ -1,91 +1,89 @@
-//! The renderer's WGSL, one file per pass, and how each pass's module is put together. A pass's
-//! module is its own file after the modules it imports (`frame.wgsl` for the shared uniforms and
-//! lighting, `snow.wgsl` for the material); WGSL lets declarations come in any order, so plain
-//! concatenation is the import.
+//! The renderer's WGSL, one file per pass. A pass's module is its own file after the modules it
+//! imports (`frame.wgsl` for the shared uniforms and lighting, `snow.wgsl` for the material), as
+//! composed and validated by the shader registry ([`crate::wgsl`]).
 
 /// Shared frame uniforms, shadow map and lighting.
-pub const FRAME: &str = include_str!("frame/frame.wgsl");
+pub const FRAME: &str = crate::wgsl::files::FRAME;
 /// The snow material (basic and deformable), importable by other renderers: see its header.
-pub const SNOW: &str = include_str!("snow/snow.wgsl");
+pub const SNOW: &str = crate::wgsl::files::SNOW;
 /// The snow pass: surface boxes, relief mapping, frag depth.
-pub const SURFACE: &str = include_str!("snow/surface.wgsl");
+pub const SURFACE: &str = crate::wgsl::files::SURFACE;
 /// Opaque meshes and the shadow map.
-pub const MESH: &str = include_str!("opaque/mesh.wgsl");
+pub const MESH: &str = crate::wgsl::files::MESH;
 /// The night sky.
-pub const SKY: &str = include_str!("sky/sky.wgsl");
+pub const SKY: &str = crate::wgsl::files::SKY;
 /// Falling snow.
-pub const SNOWFALL: &str = include_str!("snowfall/snowfall.wgsl");
+pub const SNOWFALL: &str = crate::wgsl::files::SNOWFALL;
 /// Resolve and tonemap.
-pub const TONEMAP: &str = include_str!("tonemap/tonemap.wgsl");
+pub const TONEMAP: &str = crate::wgsl::files::TONEMAP;
 /// Per-surface material choice and indirect arguments.
-pub const CLASSIFY: &str = include_str!("classify/classify.wgsl");
+pub const CLASSIFY: &str = crate::wgsl::files::CLASSIFY;
 /// Heightmap to filtered shading texture (depression, normal, occlusion).
-pub const HEIGHTFIELD: &str = include_str!("heightfield/heightfield.wgsl");
+pub const HEIGHTFIELD: &str = crate::wgsl::files::HEIGHTFIELD;
 
 /// Module of the classify pass (reads the pool through `pool/texel.wgsl`).
 pub fn classify() -> String {
-    join(&[crate::pool::TEXEL_WGSL, CLASSIFY])
+    crate::wgsl::CLASSIFY.wgsl()
 }
 
 /// Module of the heightfield pass (reads the pool through `pool/texel.wgsl`).
 pub fn heightfield() -> String {
-    join(&[crate::pool::TEXEL_WGSL, HEIGHTFIELD])
+    crate::wgsl::HEIGHTFIELD.wgsl()
 }
 
 /// Snow banks from the displaced channel (tessellated tier).
-pub const BANKS: &str = include_str!("tessellate/banks/banks.wgsl");
+pub const BANKS: &str = crate::wgsl::BANKS.source;
 /// Dicing of the snow surfaces' meshes (tessellated tier).
-pub const DICE: &str = include_str!("tessellate/dice/dice.wgsl");
+pub const DICE: &str = crate::wgsl::DICE.source;
 /// The tessellated tier's snow: displacement, shading, shadow.
-pub const TESS_SURFACE: &str = include_str!("tessellate/snow_shadow/tess_surface.wgsl");
-
-fn join(parts: &[&str]) -> String {
-    parts.join("\n")
-}
+pub const TESS_SURFACE: &str = crate::wgsl::files::TESS_SURFACE;
 
 /// Module of the snow pass.
 pub fn surface() -> String {
-    join(&[FRAME, SNOW, SURFACE])
+    crate::wgsl::SURFACE.wgsl()
 }
 
 /// Module of the tessellated tier's snow and snow shadow passes (it reuses the snow pass's
 /// bindings and heightfield contract).
 pub fn tess_surface() -> String {
-    join(&[FRAME, SNOW, SURFACE, TESS_SURFACE])
+    crate::wgsl::TESS_SURFACE.wgsl()
 }
 
 /// Module of the shadow and opaque passes.
 pub fn mesh() -> String {
-    join(&[FRAME, SNOW, MESH])
+    crate::wgsl::MESH.wgsl()
 }
 
 /// Module of the sky pass.
 pub fn sky() -> String {
-    join(&[FRAME, SKY])
+    crate::wgsl::SKY.wgsl()
 }
 
 /// Module of the snowfall pass.
 pub fn snowfall() -> String {
-    join(&[FRAME, SNOWFALL])
+    crate::wgsl::SNOWFALL.wgsl()
 }
 
 /// Module of the tonemap pass.
 pub fn tonemap() -> String {
-    join(&[FRAME, TONEMAP])
+    crate::wgsl::TONEMAP.wgsl()
 }
 
 /// Every pass's module, by name (for validation tests).
 pub fn all() -> Vec<(&'static str, String)> {
-    vec![
-        ("surface", surface()),
-        ("mesh", mesh()),
-        ("sky", sky()),
-        ("snowfall", snowfall()),
-        ("tonemap", tonemap()),
-        ("classify", classify()),
-        ("heightfield", heightfield()),
-        ("tess_surface", tess_surface()),
-        ("banks", BANKS.to_owned()),
-        ("dice", DICE.to_owned()),
+    [
+        "surface",
+        "mesh",
+        "sky",
+        "snowfall",
+        "tonemap",
+        "classify",
+        "heightfield",
+        "tess_surface",
+        "banks",
+        "dice",
     ]
+    .into_iter()
+    .filter_map(|name| Some((name, crate::wgsl::get(name)?.wgsl())))
+    .collect()
 }

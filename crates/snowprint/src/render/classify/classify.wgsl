@@ -5,6 +5,8 @@
 // dispatch of its heightfield pass (zero workgroups when basic), and the flag the report reads.
 // Reads: the heightmap pool, the surface list. Writes: the surface state table.
 
+// import texel
+
 // Must match `ClassifyRecord` in src/render/gpu.rs.
 struct ClassifyRecord {
     heights: u32,     // word offset of the heightmap in the pool
@@ -17,7 +19,8 @@ struct ClassifyRecord {
     _pad2: u32,
 }
 
-// Words per surface in the state table. Must match `STATE_WORDS` in src/render/gpu.rs.
+// Words per surface in the state table: STATE_WORDS of wgsl/constants.wgsl, which this module does
+// not import (a test in src/render/gpu.rs checks the two agree).
 const STATE_WORDS: u32 = 16u;
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;

@@ -1,12 +1,12 @@
 // frame.wgsl: what every pass of the renderer shares: the frame's uniforms (camera, moon, sky,
-// point lights, options), the shadow map, and the lighting model. Prepended to each pass's WGSL.
+// point lights, options), the shadow map, and the lighting model. Imported by each pass's WGSL.
+
+// import constants
 
 struct PointLight {
     position_radius: vec4<f32>,   // world position, radius of influence (metres)
     color: vec4<f32>,             // linear colour times intensity at 1 m; w unused
 }
-
-const MAX_POINT_LIGHTS: u32 = 8u;
 
 // Must match `FrameUniform` in src/render/gpu.rs (a test checks the layout with naga).
 struct Frame {

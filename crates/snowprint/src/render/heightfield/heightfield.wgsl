@@ -11,6 +11,8 @@
 // CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
 // displaced_fraction}.
 
+// import texel, constants
+
 // Must match `HeightfieldParams` in src/render/gpu.rs.
 struct HeightfieldParams {
     heights: u32,       // word offset of the heightmap in the pool
@@ -29,13 +31,7 @@ struct HeightfieldParams {
 @group(0) @binding(2) var out_texture: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(3) var out_light: texture_storage_2d<rgba16float, write>;
 
-// Must match PENUMBRA_SLOPE, PENUMBRA_BASE and LIGHT_TAPS in cpu.rs.
-const PENUMBRA_SLOPE: f32 = 0.12;
-const PENUMBRA_BASE: f32 = 0.01;
-const LIGHT_TAPS: u32 = 16u;
-
-// Must match AO_DIRECTIONS and AO_RADII in cpu.rs.
-const AO_DIRS: u32 = 8u;
+// Must match AO_RADII in cpu.rs (PENUMBRA_*, LIGHT_TAPS and AO_DIRECTIONS: constants.wgsl).
 const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
 
 fn depression(c: i32, r: i32) -> f32 {
@@ -133,8 +129,8 @@ fn sobel_normal(c: i32, r: i32) -> vec3<f32> {
 fn horizon_ao(c: i32, r: i32) -> f32 {
     let h0 = height_at(c, r, 0.0, 0.0);
     var sum = 0.0;
-    for (var k = 0u; k < AO_DIRS; k++) {
-        let a = 6.28318530718 * f32(k) / f32(AO_DIRS);
+    for (var k = 0u; k < AO_DIRECTIONS; k++) {
+        let a = 6.28318530718 * f32(k) / f32(AO_DIRECTIONS);
         let sx = cos(a);
         let sz = sin(a);
         var best = 0.0;
@@ -145,7 +141,7 @@ fn horizon_ao(c: i32, r: i32) -> f32 {
         }
         sum += best;
     }
-    return 1.0 - sum / f32(AO_DIRS);
+    return 1.0 - sum / f32(AO_DIRECTIONS);
 }
 
 @compute @workgroup_size(8, 8, 1)

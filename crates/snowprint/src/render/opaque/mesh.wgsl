@@ -1,9 +1,11 @@
 // mesh.wgsl: opaque meshes (rooftops, walls, props, people) and the moon's shadow map.
-// Prepended: frame.wgsl, snow.wgsl (for its noise and the snow colours; the heightfield contract is
-// stubbed below because meshes never trace snow).
+// Imports snow.wgsl for its noise and the snow colours; the heightfield contract is stubbed below
+// because meshes never trace snow.
 // Shadow pass reads: frame uniforms (shadow_near, shadow_far), meshes, instances; writes: the
 // shadow cascades.
 // Opaque pass reads: frame uniforms, shadow map, meshes, instances; writes: scene colour, depth.
+
+// import frame, snow
 
 fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {
     return 0.0;

@@ -1,7 +1,8 @@
 // sky.wgsl: the night sky behind everything, drawn as a fullscreen triangle on the far plane where
 // nothing else was drawn (depth test "less or equal" against the cleared depth of 1).
-// Prepended: frame.wgsl.
 // Reads: frame uniforms, depth (test only). Writes: scene colour.
+
+// import frame
 
 struct SkyVarying {
     @builtin(position) clip: vec4<f32>,

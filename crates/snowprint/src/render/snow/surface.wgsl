@@ -3,9 +3,10 @@
 // deformable material traces its view ray through the heightfield (snow.wgsl) and writes the depth
 // of the point it hits, so characters standing in prints and bodies lying in trenches are hidden
 // and shown correctly.
-// Prepended: frame.wgsl, snow.wgsl.
 // Reads: frame uniforms, shadow map, the surface's heightfield texture (heightfield.wgsl).
 // Writes: scene colour (HDR) and depth.
+
+// import frame, snow
 
 @group(1) @binding(0) var<uniform> surface: SnowSurface;
 @group(1) @binding(1) var heightfield: texture_2d<f32>;

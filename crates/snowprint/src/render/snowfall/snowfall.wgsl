@@ -1,8 +1,9 @@
 // snowfall.wgsl: falling snow. Each flake is a small camera-facing quad whose position is a pure
 // function of its index and the time: flakes are anchored in the world (wrapped in a box that
 // follows the camera), so they do not swim when the camera moves.
-// Prepended: frame.wgsl.
 // Reads: frame uniforms, depth (test only, not written). Writes: scene colour (blended).
+
+// import frame
 
 // The box of flakes around the camera, metres.
 const FLAKE_BOX: vec3<f32> = vec3<f32>(28.0, 16.0, 28.0);

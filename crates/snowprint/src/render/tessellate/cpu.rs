@@ -6,8 +6,8 @@ use glam::Vec2;
 use super::BankSettings;
 
 /// Floor of the receptivity: the bottom of a trail still takes banks when nothing else is within
-/// reach, so that no pushed snow is lost. Must match `RECEPTIVITY_FLOOR` in `banks.wgsl`.
-pub const RECEPTIVITY_FLOOR: f32 = 0.001;
+/// reach, so that no pushed snow is lost.
+pub const RECEPTIVITY_FLOOR: f32 = crate::wgsl::consts::RECEPTIVITY_FLOOR;
 
 /// How much bank snow a texel takes, by its (smoothed) depression: 1 on untouched snow, the floor
 /// at the bottom of trails. Must match `receptivity` in `banks.wgsl`.

@@ -42,17 +42,16 @@ use super::error::{RenderError, RenderResult};
 pub const MAX_LEVEL: u32 = 64;
 /// Most triangles in a surface's base mesh (the dicing dispatch is one workgroup per triangle).
 pub const MAX_BASE_TRIANGLES: usize = 1 << 20;
-/// Words of the dicing counters before the per-surface draw arguments. Must match `ARGS_BASE` in
-/// `dice.wgsl`.
-pub const ARGS_BASE: u64 = 8;
-/// Words per surface of draw arguments. Must match `ARGS_STRIDE` in `dice.wgsl`.
-pub const ARGS_STRIDE: u64 = 8;
-/// Counter of vertices appended. Must match `COUNTER_VERTICES` in `dice.wgsl`.
-pub const COUNTER_VERTICES: u64 = 0;
+/// Words of the dicing counters before the per-surface draw arguments.
+pub const ARGS_BASE: u64 = crate::wgsl::consts::ARGS_BASE as u64;
+/// Words per surface of draw arguments.
+pub const ARGS_STRIDE: u64 = crate::wgsl::consts::ARGS_STRIDE as u64;
+/// Counter of vertices appended.
+pub const COUNTER_VERTICES: u64 = crate::wgsl::consts::COUNTER_VERTICES as u64;
 /// Counter of indices appended.
-pub const COUNTER_INDICES: u64 = 1;
+pub const COUNTER_INDICES: u64 = crate::wgsl::consts::COUNTER_INDICES as u64;
 /// Counter of base triangles dropped because the buffers were full.
-pub const COUNTER_OVERFLOW: u64 = 3;
+pub const COUNTER_OVERFLOW: u64 = crate::wgsl::consts::COUNTER_OVERFLOW as u64;
 /// Bytes of one diced vertex: local position and kind, skirt normal.
 pub const VERTEX_BYTES: u64 = 32;
 

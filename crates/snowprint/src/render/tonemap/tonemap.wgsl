@@ -1,8 +1,9 @@
 // tonemap.wgsl: resolve. Averages the supersampled scene colour down to the output, adds the night
 // haze by distance, applies exposure and a filmic curve, and writes the output (sRGB encoded by
 // the target format, or here when the target is not an sRGB format).
-// Prepended: frame.wgsl.
 // Reads: frame uniforms, scene colour (HDR), scene depth. Writes: the output target.
+
+// import frame
 
 @group(1) @binding(0) var scene_color: texture_2d<f32>;
 @group(1) @binding(1) var scene_depth: texture_depth_2d;

@@ -14,6 +14,8 @@
 // displaced channel in the light texture's .g). Writes: the bank scratch (N) and the bank texture
 // (metres of snow added, .x). CPU reference: render::tessellate::cpu::bank_field.
 
+// import constants
+
 // Must match `BankParams` in src/render/tessellate/mod.rs.
 struct BankParams {
     width: u32,
@@ -29,9 +31,6 @@ struct BankParams {
     _pad1: f32,
     _pad2: f32,
 }
-
-// Must match RECEPTIVITY_FLOOR and receptivity() in cpu.rs.
-const RECEPTIVITY_FLOOR: f32 = 0.001;
 
 @group(0) @binding(0) var<uniform> bank: BankParams;
 @group(0) @binding(1) var shape: texture_2d<f32>;

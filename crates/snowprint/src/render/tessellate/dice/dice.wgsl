@@ -21,6 +21,8 @@
 // Writes: diced vertices, indices, counters and the surface's draw arguments.
 // CPU reference of the topology: render::tessellate::cpu::dice_triangle.
 
+// import constants
+
 // Must match `DiceParams` in src/render/tessellate/mod.rs.
 struct DiceParams {
     local_to_clip: mat4x4<f32>,
@@ -41,16 +43,6 @@ struct BaseTriangle {
     ids: vec4<u32>,          // xyz: vertex ids of a, b, c; w: bit e set when edge e is a border
 }
 
-// Words of the counters buffer. Must match COUNTER_* and ARGS_* in mod.rs.
-const COUNTER_VERTICES: u32 = 0u;
-const COUNTER_INDICES: u32 = 1u;
-const COUNTER_SEALED: u32 = 2u;
-const COUNTER_OVERFLOW: u32 = 3u;
-const ARGS_BASE: u32 = 8u;
-const ARGS_STRIDE: u32 = 8u;
-// Must match STATE_WORDS and STATE_TOUCHED in src/render/gpu.rs.
-const STATE_WORDS: u32 = 16u;
-const STATE_TOUCHED: u32 = 11u;
 // Samples of the heightfield along an edge for its relief.
 const DETAIL_SAMPLES: u32 = 16u;
 

@@ -7,19 +7,17 @@
 // (snow.wgsl) without any search: the heightmap's normal tilted by the banks' slope, RNM detail,
 // the heightmap's AO, and the moon's shadow from the shadow map, which holds this same displaced
 // geometry (vs_tess_shadow), so trails shadow themselves and characters' shadows bend into them.
-// Prepended: frame.wgsl, snow.wgsl, surface.wgsl (its bindings 0-2 of group 1 and heightfield
-// contract are reused).
+// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-2 of group 1 and
+// its heightfield contract are reused.
 // Reads: frame uniforms, shadow map, the surface's heightfield, light and bank textures, the
 // surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade.
+
+// import surface
 
 @group(1) @binding(3) var bank_texture: texture_2d<f32>;
 @group(1) @binding(4) var<storage, read> surface_state: array<u32>;
 
-// Must match STATE_WORDS and STATE_TOUCHED in src/render/gpu.rs.
-const TESS_STATE_WORDS: u32 = 16u;
-const TESS_STATE_TOUCHED: u32 = 11u;
 // Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
-// Must match MACRO_MEAN in src/render/tessellate/cpu.rs.
 const MACRO_MEAN: f32 = 0.025;
 
 struct TessVertex {
@@ -34,7 +32,7 @@ struct TessVarying {
 }
 
 fn tess_touched() -> bool {
-    return surface_state[surface.index * TESS_STATE_WORDS + TESS_STATE_TOUCHED] != 0u;
+    return surface_state[surface.index * STATE_WORDS + STATE_TOUCHED] != 0u;
 }
 
 fn bank_texel(c: vec2<i32>) -> f32 {

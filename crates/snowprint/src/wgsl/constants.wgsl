@@ -1,0 +1,60 @@
+// constants.wgsl: the constants that the Rust code and the WGSL both use, defined here once.
+// build.rs reflects every `const` of this file into `snowprint::wgsl::consts` (the comment lines
+// right above a declaration become its doc); WGSL modules bring them in with `// import constants`.
+// Only scalar literals (u32, i32, f32, bool) belong here.
+
+// Code of depth 1.0, the top of the capture frustum: a stored capture value v is the depth
+// bitcast(ONE_BITS - v), 0 (the cleared value) meaning nothing was captured.
+const ONE_BITS: u32 = 0x3f800000u;
+// Side of the update's tiles, the fused pass's workgroup side.
+const TILE: u32 = 16u;
+// Workgroup side of the separate accumulation passes.
+const WORKGROUP: u32 = 8u;
+// Words before the entries of the capture's tile list: the dispatch arguments and the count.
+const TILE_LIST_HEADER: u32 = 4u;
+// `record` of a capture view whose flagged tiles are not listed (the update runs its grid).
+const NO_LIST: u32 = 0xffffffffu;
+// `batch` of a surface record that nothing touched this update.
+const NO_CAPTURE: u32 = 0xffffffffu;
+// `normals` of a surface record whose pool keeps no normals.
+const NO_NORMALS: u32 = 0xffffffffu;
+// `mode` of a surface record: depth capture.
+const MODE_DEPTH: u32 = 0u;
+// Bit of `mode`: mask capture (else depth).
+const MODE_MASK: u32 = 1u;
+// Bit of `mode` set when mesh solids were drawn over the surface: only then is `winding` read.
+const MODE_MESHES: u32 = 2u;
+// Primitive kind of a capture primitive (`kind.x`): a capsule (a sphere is a capsule of zero length).
+const PRIM_CAPSULE: u32 = 0u;
+// Primitive kind of a capture primitive: an oriented box.
+const PRIM_BOX: u32 = 1u;
+// Words per surface in the renderer's surface state table (written by classify.wgsl, which keeps
+// its own copy, checked by a test: it does not import this module).
+const STATE_WORDS: u32 = 16u;
+// Word of a surface's state holding the "deformed" flag.
+const STATE_TOUCHED: u32 = 11u;
+// Words of the dicing counters before the per-surface draw arguments.
+const ARGS_BASE: u32 = 8u;
+// Words per surface of the dicing's draw arguments.
+const ARGS_STRIDE: u32 = 8u;
+// Dicing counter of vertices appended.
+const COUNTER_VERTICES: u32 = 0u;
+// Dicing counter of indices appended.
+const COUNTER_INDICES: u32 = 1u;
+// Dicing counter of indices already sealed into draw arguments.
+const COUNTER_SEALED: u32 = 2u;
+// Dicing counter of base triangles dropped because the buffers were full.
+const COUNTER_OVERFLOW: u32 = 3u;
+// Point lights the frame uniform holds.
+const MAX_POINT_LIGHTS: u32 = 8u;
+// Softness of the moon's shadow over the snow: penumbra width per metre from the occluder (the
+// heightfield pass and its CPU reference, render::cpu::light_visibility).
+const PENUMBRA_SLOPE: f32 = 0.12;
+// Penumbra width at the occluder, metres.
+const PENUMBRA_BASE: f32 = 0.01;
+// Most taps of the light visibility along the moon's direction.
+const LIGHT_TAPS: u32 = 16u;
+// Directions of the horizon search of the snow's ambient occlusion.
+const AO_DIRECTIONS: u32 = 8u;
+// Least receptivity of a texel to banks (at the bottom of trails), so that no pushed snow is lost.
+const RECEPTIVITY_FLOOR: f32 = 0.001;

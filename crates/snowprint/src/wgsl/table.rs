@@ -1,0 +1,39 @@
+// The shader registry's one table: every WGSL file of the crate, by module name, as a path under
+// `crates/snowprint/src/`. `build.rs` includes this file: it composes every *entry* module (one
+// that a pipeline compiles) from its file and the modules it imports, validates it with naga and
+// writes it to `OUT_DIR`; `src/wgsl/mod.rs` exposes the results. A WGSL file imports another module
+// by name with a line `// import name` (after its header comment); an import brings in the whole
+// module (and what that imports) once, before the importer's own text. Moving a file means editing
+// its row here, nothing else.
+
+/// (module name, path under `src/`, entry module: compiled by a pipeline).
+const WGSL_FILES: &[(&str, &str, bool)] = &[
+    // Constants shared by Rust and WGSL (reflected into `wgsl::consts`).
+    ("constants", "wgsl/constants.wgsl", false),
+    // The update: capture, then the accumulation chain.
+    ("shared", "shared.wgsl", false),
+    ("channels", "pool/channels.wgsl", false),
+    ("texel", "pool/texel.wgsl", false),
+    ("texel_write", "pool/texel_write.wgsl", false),
+    ("maths", "accumulate/maths.wgsl", false),
+    ("capture_read", "accumulate/capture_read.wgsl", false),
+    ("capture", "capture/capture.wgsl", true),
+    ("blur", "accumulate/blur.wgsl", true),
+    ("merge", "accumulate/merge.wgsl", true),
+    ("normals", "accumulate/normals.wgsl", true),
+    ("fused", "accumulate/fused.wgsl", true),
+    ("seal", "accumulate/seal.wgsl", true),
+    // The renderer.
+    ("frame", "render/frame/frame.wgsl", false),
+    ("snow", "render/snow/snow.wgsl", false),
+    ("surface", "render/snow/surface.wgsl", true),
+    ("tess_surface", "render/tessellate/snow_shadow/tess_surface.wgsl", true),
+    ("mesh", "render/opaque/mesh.wgsl", true),
+    ("sky", "render/sky/sky.wgsl", true),
+    ("snowfall", "render/snowfall/snowfall.wgsl", true),
+    ("tonemap", "render/tonemap/tonemap.wgsl", true),
+    ("classify", "render/classify/classify.wgsl", true),
+    ("heightfield", "render/heightfield/heightfield.wgsl", true),
+    ("banks", "render/tessellate/banks/banks.wgsl", true),
+    ("dice", "render/tessellate/dice/dice.wgsl", true),
+];
