@@ -233,6 +233,31 @@ impl ShaderModule {
             .collect()
     }
 
+    /// The bind-group layout of group `group` ([`Self::layout_entries`]), labelled `label`.
+    pub(crate) fn bind_group_layout(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        group: u32,
+    ) -> wgpu::BindGroupLayout {
+        self.bind_group_layout_for(device, label, group, true)
+    }
+
+    /// The bind-group layout of group `group` on a device that filters `Rgba16Float` or not
+    /// ([`Self::layout_entries_for`]), labelled `label`.
+    pub(crate) fn bind_group_layout_for(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        group: u32,
+        filterable_rgba16f: bool,
+    ) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &self.layout_entries_for(group, filterable_rgba16f),
+        })
+    }
+
     /// The layout entries of group `group` that only the named entry points need, visible to their
     /// stages (e.g. the shadow pass's group 0, which `vs_shadow` reads alone). [`OVERRIDES`]
     /// apply, except their stages.
