@@ -5,8 +5,9 @@
 //! entry module's imports (once each, recursively) before its own text, validates the result with
 //! naga (a broken shader fails `cargo build` with the module and the file and line of the error),
 //! and reflects its bindings: group, binding, the stages of the entry points that use it, and the
-//! binding's type. [`ShaderModule::layout_entries`] turns them into bind-group layout entries; what
-//! naga cannot know (whether a float texture or a sampler filters, dynamic offsets) comes from
+//! binding's type. [`ShaderModule::layout_entries`] turns them into bind-group layout entries, from
+//! which every pipeline's layouts are made (a binding is declared once, in WGSL); what naga cannot
+//! know (whether a float texture or a sampler filters, dynamic offsets) comes from
 //! [`OVERRIDES`]. The constants that Rust and WGSL share are defined once, in
 //! `src/wgsl/constants.wgsl`, and reflected into [`consts`].
 //!
