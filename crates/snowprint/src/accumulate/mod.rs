@@ -18,7 +18,6 @@ mod encode;
 
 pub use encode::{AccumulateBuffers, AccumulatePlan, encode};
 
-use crate::gpu::resources::compute_storage;
 use crate::pool::Precision;
 
 use crate::wgsl::{ShaderModule, files};
@@ -79,42 +78,13 @@ pub struct AccumulatePipelines {
 impl AccumulatePipelines {
     /// Compile the passes for heightmaps of `precision`.
     pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
-        let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("blur"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, true),
-                compute_storage(3, false),
-            ],
-        });
-        let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("merge"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-            ],
-        });
-        let fused_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fused"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-                compute_storage(3, true),
-                compute_storage(4, true),
-                compute_storage(5, true),
-            ],
-        });
-        let seal_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("seal"),
-            entries: &[compute_storage(0, false)],
-        });
-        let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("normals"),
-            entries: &[compute_storage(0, true), compute_storage(1, false)],
-        });
+        use crate::wgsl::{BLUR, FUSED, MERGE, NORMALS, SEAL};
+        let blur_layout = BLUR.bind_group_layout(device, "blur", 0);
+        let merge_layout = MERGE.bind_group_layout(device, "merge", 0);
+        // One layout for both fused entry points: the module's group 0 covers what either reads.
+        let fused_layout = FUSED.bind_group_layout(device, "fused", 0);
+        let seal_layout = SEAL.bind_group_layout(device, "seal", 0);
+        let normals_layout = NORMALS.bind_group_layout(device, "normals", 0);
         let constants = [("PRECISION", precision.bits() as f64)];
         let make = |name: &str, shader: &ShaderModule, layout: &wgpu::BindGroupLayout| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -140,12 +110,12 @@ impl AccumulatePipelines {
             })
         };
         Self {
-            blur: make("blur", &crate::wgsl::BLUR, &blur_layout),
-            merge: make("merge", &crate::wgsl::MERGE, &merge_layout),
-            normals: make("normals", &crate::wgsl::NORMALS, &normals_layout),
-            fused: make("fused", &crate::wgsl::FUSED, &fused_layout),
-            fused_listed: make("fused_listed", &crate::wgsl::FUSED, &fused_layout),
-            seal: make("seal_tiles", &crate::wgsl::SEAL, &seal_layout),
+            blur: make("blur", &BLUR, &blur_layout),
+            merge: make("merge", &MERGE, &merge_layout),
+            normals: make("normals", &NORMALS, &normals_layout),
+            fused: make("fused", &FUSED, &fused_layout),
+            fused_listed: make("fused_listed", &FUSED, &fused_layout),
+            seal: make("seal_tiles", &SEAL, &seal_layout),
             seal_layout,
             blur_layout,
             merge_layout,

@@ -38,34 +38,6 @@ impl Growable {
     }
 }
 
-/// A storage buffer binding seen by compute shaders.
-pub(crate) fn compute_storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-/// A uniform buffer binding (no dynamic offset).
-pub(crate) fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 /// Spacing of the per-draw uniform blocks in one buffer, bytes: WebGPU's largest minimum
 /// dynamic-offset alignment, so a block can be chosen by dynamic offset on every device.
 pub(crate) const UNIFORM_STRIDE: u64 = 256;

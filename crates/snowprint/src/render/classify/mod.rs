@@ -9,7 +9,7 @@ use super::graph::PASSES;
 use super::pipeline;
 use super::readback::{Timestamps, compute_writes};
 use super::shaders;
-use crate::gpu::resources::{Growable, bind_group, compute_storage};
+use crate::gpu::resources::{Growable, bind_group};
 
 pub(super) struct ClassifyPass {
     layout: wgpu::BindGroupLayout,
@@ -25,14 +25,7 @@ pub(super) struct ClassifyPass {
 
 impl ClassifyPass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("classify"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-            ],
-        });
+        let layout = crate::wgsl::CLASSIFY.bind_group_layout(device, "classify", 0);
         let module = pipeline::shader(device, "classify.wgsl", shaders::classify());
         let pipeline = pipeline::compute(device, "classify", &module, "classify", &[&layout]);
         use wgpu::BufferUsages as U;

@@ -10,7 +10,7 @@ use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
 use super::inputs::{PointLight, RenderFrame};
 use super::tessellate::SurfaceGeometry;
 use crate::extract::SurfaceView;
-use crate::gpu::resources::{bind_group, uniform};
+use crate::gpu::resources::bind_group;
 use crate::view::GroundMaterial;
 
 /// Near and far planes of the camera, metres.
@@ -60,41 +60,12 @@ pub(super) struct FrameLayouts {
 
 impl FrameLayouts {
     pub fn new(device: &wgpu::Device, filterable: bool) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &[
-                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(if filterable {
-                        wgpu::SamplerBindingType::Filtering
-                    } else {
-                        wgpu::SamplerBindingType::NonFiltering
-                    }),
-                    count: None,
-                },
-            ],
-        });
+        // frame.wgsl's group 0, the same in every module that imports it (OVERRIDES give it the
+        // stages of all of them); the shadow passes' is what their vertex entry points read.
+        let layout = crate::wgsl::SURFACE.bind_group_layout_for(device, "frame", 0, filterable);
         let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow frame"),
-            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
+            entries: &crate::wgsl::MESH.layout_entries_of(&["vs_shadow"], 0, filterable),
         });
         Self {
             layout,

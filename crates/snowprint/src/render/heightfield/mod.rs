@@ -11,12 +11,12 @@ use super::error::{RenderError, RenderResult};
 use super::frame::FrameSurface;
 use super::gpu::{HeightfieldParams, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use super::graph::PASSES;
-use super::pipeline::{self, storage_texture_entry};
+use super::pipeline;
 use super::readback::{Timestamps, compute_writes, f16_to_f32, map_staging};
 use super::shaders;
 use super::targets::HEIGHTFIELD_FORMAT;
 use super::tessellate::SurfaceFields;
-use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::surface::SurfaceId;
 
 /// A deformed surface's shading textures, written by the heightfield pass.
@@ -83,15 +83,7 @@ pub(super) struct HeightfieldPass {
 
 impl HeightfieldPass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("heightfield"),
-            entries: &[
-                compute_storage(0, true),
-                uniform(1, wgpu::ShaderStages::COMPUTE),
-                storage_texture_entry(2),
-                storage_texture_entry(3),
-            ],
-        });
+        let layout = crate::wgsl::HEIGHTFIELD.bind_group_layout(device, "heightfield", 0);
         let module = pipeline::shader(device, "heightfield.wgsl", shaders::heightfield());
         let pipeline = pipeline::compute(device, "heightfield", &module, "heightfield", &[&layout]);
         Self {

@@ -11,13 +11,13 @@ use super::gpu::{
 };
 use super::graph::PASSES;
 use super::heightfield::HeightfieldPass;
-use super::pipeline::{self, texture_entry};
+use super::pipeline;
 use super::readback::{Timestamps, render_span};
 use super::shaders;
 use super::targets::{KEEP, Targets};
 use super::tessellate::dice::DicePass;
 use super::tessellate::snow_shadow::TessSurface;
-use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::view::GroundMaterial;
 
 pub(super) struct SnowPass {
@@ -36,14 +36,8 @@ impl SnowPass {
         frame_layout: &wgpu::BindGroupLayout,
         filterable: bool,
     ) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("snow surface"),
-            entries: &[
-                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                texture_entry(1, wgpu::TextureSampleType::Float { filterable }),
-                texture_entry(2, wgpu::TextureSampleType::Float { filterable }),
-            ],
-        });
+        let layout =
+            crate::wgsl::SURFACE.bind_group_layout_for(device, "snow surface", 1, filterable);
         let module = pipeline::shader(device, "surface.wgsl", shaders::surface());
         let snow = |label, fs, constants| {
             pipeline::Raster {

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 
 use super::graph::PASSES;
-use super::pipeline::{self, texture_entry};
+use super::pipeline;
 use super::readback::{Timestamps, render_writes};
 use super::shaders;
 use super::targets::Targets;
@@ -22,13 +22,7 @@ pub(super) struct TonemapPass {
 
 impl TonemapPass {
     pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tonemap inputs"),
-            entries: &[
-                texture_entry(0, wgpu::TextureSampleType::Float { filterable: false }),
-                texture_entry(1, wgpu::TextureSampleType::Depth),
-            ],
-        });
+        let layout = crate::wgsl::TONEMAP.bind_group_layout(device, "tonemap inputs", 1);
         let module = pipeline::shader(device, "tonemap.wgsl", shaders::tonemap());
         let pipeline_layout = pipeline::layout(device, "tonemap", &[frame_layout, &layout]);
         Self {

@@ -4,8 +4,7 @@
 //! share into the scratch texture, `bank_gather` collects it into the bank heights.
 
 use super::BankParams;
-use super::gpu::texture;
-use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use crate::render::graph::PASSES;
@@ -25,17 +24,7 @@ pub(in crate::render) struct BanksPass {
 
 impl BanksPass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("banks"),
-            entries: &[
-                uniform(0, c),
-                texture(1, c, false),
-                texture(2, c, false),
-                texture(3, c, false),
-                pipeline::storage_texture_entry(4),
-            ],
-        });
+        let layout = crate::wgsl::BANKS.bind_group_layout(device, "banks", 0);
         let module = pipeline::shader(device, "banks.wgsl", shaders::BANKS.to_owned());
         let norm = pipeline::compute(device, "bank norm", &module, "bank_norm", &[&layout]);
         let gather = pipeline::compute(device, "bank gather", &module, "bank_gather", &[&layout]);

@@ -9,9 +9,9 @@ use std::collections::HashMap;
 use glam::Mat4;
 
 use super::VERTEX_BYTES;
-use super::gpu::{counters_bytes, texture};
+use super::gpu::counters_bytes;
 use super::{ARGS_BASE, ARGS_STRIDE, DiceParams, DicedKind, DicedMesh, DicedVertex, SurfaceMesh};
-use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::config::RenderConfig;
 use crate::render::error::RenderResult;
 use crate::render::frame::{FAR, FrameSurface, NEAR};
@@ -48,20 +48,7 @@ pub(in crate::render) struct DicePass {
 
 impl DicePass {
     pub fn new(device: &wgpu::Device) -> Self {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dice"),
-            entries: &[
-                uniform(0, c),
-                compute_storage(1, true),
-                texture(2, c, false),
-                texture(3, c, false),
-                compute_storage(4, true),
-                compute_storage(5, false),
-                compute_storage(6, false),
-                compute_storage(7, false),
-            ],
-        });
+        let layout = crate::wgsl::DICE.bind_group_layout(device, "dice", 0);
         let module = pipeline::shader(device, "dice.wgsl", shaders::DICE.to_owned());
         let dice = pipeline::compute(device, "dice", &module, "dice_surface", &[&layout]);
         let seal = pipeline::compute(device, "dice seal", &module, "seal", &[&layout]);

@@ -5,8 +5,7 @@
 
 use super::VERTEX_BYTES;
 use super::dice::DicePass;
-use super::gpu::texture;
-use crate::gpu::resources::{bind_group, uniform, uniform_block};
+use crate::gpu::resources::{bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::SurfaceUniform;
 use crate::render::heightfield::HeightfieldPass;
@@ -31,26 +30,12 @@ impl TessSurface {
         shadow_layout: &wgpu::BindGroupLayout,
         filterable: bool,
     ) -> Self {
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tessellated snow surface"),
-            entries: &[
-                uniform(0, vf),
-                texture(1, vf, filterable),
-                texture(2, vf, filterable),
-                texture(3, vf, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
+        let layout = crate::wgsl::TESS_SURFACE.bind_group_layout_for(
+            device,
+            "tessellated snow surface",
+            1,
+            filterable,
+        );
         let module = pipeline::shader(device, "tess_surface.wgsl", shaders::tess_surface());
         const VERTEX: [wgpu::VertexAttribute; 2] =
             wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4];
