@@ -29,7 +29,7 @@ impl Heightmap {
         }
     }
 
-    /// Convert channels at `precision` (see [`crate::pool`]) to 16-bit units, rounding to nearest.
+    /// Convert channels at `precision` (see [`crate::Precision`]) to 16-bit units, rounding to nearest.
     pub fn from_channels(
         width: u32,
         height: u32,

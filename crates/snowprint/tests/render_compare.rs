@@ -1,4 +1,4 @@
-//! The snow material's GPU maths against their CPU references (`snowprint::render::cpu`), on the
+//! The snow material's GPU maths against their CPU references (`snowprint::reference::material`), on the
 //! same inputs: the heightfield pass (Sobel normals, horizon AO, moon visibility) on a synthetic
 //! heightmap, and the relief search, POM search and RNM of `snow.wgsl` run in a compute harness on
 //! analytic heightfields.
@@ -6,8 +6,8 @@
 mod common;
 
 use glam::{Vec2, Vec3};
-use snowprint::render::cpu;
-use snowprint::render::gpu::HeightfieldParams;
+use snowprint::low_level::render::HeightfieldParams;
+use snowprint::reference::material as cpu;
 use snowprint::render::shaders;
 use wgpu::util::DeviceExt;
 

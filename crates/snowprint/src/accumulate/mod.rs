@@ -13,7 +13,7 @@
 //!
 //! CPU reference: [`cpu`].
 
-pub mod cpu;
+pub(crate) mod cpu;
 mod encode;
 
 pub use encode::{AccumulateBuffers, AccumulatePlan, encode};

@@ -23,7 +23,7 @@ pub struct ManagerConfig {
     pub player_slots: usize,
     /// Most imprints kept queued on a surface that waits for its update (default 1024, about
     /// 96 bytes each); past it, neighbouring entries merge into covering sweeps (see
-    /// [`super::queue`]). A surface updated in a frame takes its whole queue, however long.
+    /// [`crate::low_level::queue`]). A surface updated in a frame takes its whole queue, however long.
     pub queue_cap: usize,
     /// Bytes the page store may hold (evicted heightmaps, compressed); default unlimited
     /// (`u64::MAX`). A surface is evicted only when the store has room for its whole slot, so a

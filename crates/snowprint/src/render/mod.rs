@@ -31,7 +31,7 @@
 //! the world once, through [`SnowWorld::frame_view`](crate::SnowWorld::frame_view).
 //!
 //! The material is the WGSL module [`SNOW_WGSL`], which another renderer can import (see the
-//! header of `snow.wgsl` and `docs/RENDERING.md`). Its maths have CPU references in [`cpu`].
+//! header of `snow.wgsl` and `docs/RENDERING.md`). Its maths have CPU references in [`crate::reference::material`].
 //!
 //! ```no_run
 //! use glam::{Mat4, Vec3};
@@ -62,12 +62,12 @@
 mod cascades;
 mod classify;
 mod config;
-pub mod cpu;
+pub(crate) mod cpu;
 mod error;
 mod frame;
-pub mod geometry;
-pub mod gpu;
-pub mod graph;
+pub(crate) mod geometry;
+pub(crate) mod gpu;
+pub(crate) mod graph;
 mod heightfield;
 mod inputs;
 mod meshes;
@@ -82,7 +82,7 @@ mod snow;
 mod snowfall;
 mod stats;
 mod targets;
-pub mod tessellate;
+pub(crate) mod tessellate;
 mod tonemap;
 
 use std::collections::HashMap;

@@ -16,7 +16,7 @@
 mod config;
 mod frame;
 mod meshes;
-pub mod plan;
+pub(crate) mod plan;
 mod readback;
 mod snapshot;
 
@@ -380,7 +380,7 @@ impl SnowWorld {
 
     /// Pool placement of a surface's slot, for renderers that read the heightmap on the GPU:
     /// `(heights word offset, normals word offset when kept)`. Valid while the surface lives;
-    /// read the heights with `pool/texel.wgsl` ([`crate::pool::TEXEL_WGSL`]) at
+    /// read the heights with `pool/texel.wgsl` (the pool's `TEXEL_WGSL`) at
     /// [`SnowWorld::pool_format`]'s precision.
     pub fn gpu_offsets(&self, id: SurfaceId) -> Result<(u32, Option<u32>)> {
         let s = self.state(id)?;

@@ -81,7 +81,7 @@ pub struct PlannedUpdate {
     /// Frames the surface waited since it became due.
     pub wait_frames: u64,
     /// Everything that touched it since its last update: swept shapes, one per frame and deformer
-    /// after de-duplication (see [`super::queue`]), in frame order.
+    /// after de-duplication (see [`crate::low_level::queue`]), in frame order.
     pub imprints: Vec<Deformer>,
     /// The frame of each imprint: the update captures each frame's imprints on their own, in
     /// order, as if the surface had been updated in every frame.
