@@ -20,6 +20,23 @@
 //! ```
 //!
 //! See `docs/ARCHITECTURE.md` for the data flow from deformers to heightmaps.
+//!
+//! # What to reach for
+//!
+//! | you want | reach for |
+//! |---|---|
+//! | a GPU device, checked for what the passes need | [`GpuContext`], [`GpuOptions`], [`Capabilities`] |
+//! | snow surfaces stepped by deformers | [`SnowWorld`], [`WorldConfig`], [`SurfaceDesc`], [`Deformer`], [`Shape`], [`Pose`], [`Mesh`] |
+//! | the heightmaps back, or their place in the pool | [`Heightmap`], [`PoolFormat`], [`Precision`], [`FrameView`], [`SurfaceSnapshot`] |
+//! | a city of surfaces paged in and out, saves | [`manager`]: [`SnowManager`], [`ManagerConfig`], [`manager::SaveFile`] |
+//! | scene files (TOML) | [`scene`]: [`scene::Scene`] |
+//! | pictures: the snow material, sky, shadows, falling snow | [`render`]: [`render::Renderer`], [`render::RenderConfig`], [`render::RenderFrame`] |
+//! | the CPU references the GPU passes are tested against | [`reference`](mod@reference) |
+//! | the passes themselves, to drive from an engine or a tool | [`low_level`] |
+//! | errors to match on | [`SnowError`], [`render::RenderError`] (both `#[non_exhaustive]`) |
+//!
+//! The crate re-exports the [`glam`] and [`wgpu`] it is built against, so an engine can name the
+//! same versions.
 
 mod accumulate;
 mod capture;

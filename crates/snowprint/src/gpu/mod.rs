@@ -239,6 +239,6 @@ impl GpuContext {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| SnowError::Readback(e.to_string()))
+            .map_err(SnowError::from)
     }
 }

@@ -82,10 +82,13 @@ impl Default for ManagerConfig {
 impl ManagerConfig {
     /// Check every field, naming the first one that is wrong.
     pub fn validate(&self) -> Result<()> {
-        let bad = |what: &str, value: String, expected: &str| {
-            Err(SnowError::Scene(format!(
-                "manager setting {what} is {value}, but it must be {expected}"
-            )))
+        let bad = |what: &'static str, value: String, expected: &'static str| {
+            Err(SnowError::Config {
+                config: "manager setting",
+                what,
+                value,
+                expected,
+            })
         };
         if self.updates_per_frame == 0 {
             return bad("updates_per_frame", "0".into(), "1 or more");

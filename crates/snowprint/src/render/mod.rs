@@ -363,17 +363,12 @@ impl Renderer {
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        self.device.poll(wgpu::PollType::wait_indefinitely())?;
         rx.recv()
-            .map_err(|e| RenderError::Readback(e.to_string()))?
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+            .map_err(|e| RenderError::Readback(e.to_string()))??;
         let mut rgba8 = Vec::with_capacity((w * h * 4) as usize);
         {
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
+            let data = slice.get_mapped_range()?;
             for row in 0..h as usize {
                 let o = row * self.targets.padded_row as usize;
                 rgba8.extend_from_slice(&data[o..o + w as usize * 4]);

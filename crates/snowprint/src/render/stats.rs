@@ -132,9 +132,7 @@ impl StatsReadback {
         } else {
             wgpu::PollType::Poll
         };
-        device
-            .poll(poll)
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        device.poll(poll)?;
         match self.state.load(Ordering::Acquire) {
             MAP_READY => {}
             MAP_FAILED => {
@@ -146,11 +144,7 @@ impl StatsReadback {
             _ => return Ok(None),
         }
         let report = {
-            let data = self
-                .buffer
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
+            let data = self.buffer.slice(..).get_mapped_range()?;
             self.report(&data, timestamps)
         };
         self.buffer.unmap();

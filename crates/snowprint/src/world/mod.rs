@@ -109,16 +109,20 @@ impl SnowWorld {
         let mut config = config;
         let c = config.capture;
         if !(c.ankle_height.is_finite() && c.ankle_height > 0.0) {
-            return Err(SnowError::Scene(format!(
-                "capture ankle_height {} must be a finite number of metres above 0",
-                c.ankle_height
-            )));
+            return Err(SnowError::Config {
+                config: "capture",
+                what: "ankle_height",
+                value: c.ankle_height.to_string(),
+                expected: "a finite number of metres above 0",
+            });
         }
         if !(c.mask_depth.is_finite() && c.mask_depth > 0.0 && c.mask_depth <= 1.0) {
-            return Err(SnowError::Scene(format!(
-                "capture mask_depth {} must be a fraction in (0, 1]",
-                c.mask_depth
-            )));
+            return Err(SnowError::Config {
+                config: "capture",
+                what: "mask_depth",
+                value: c.mask_depth.to_string(),
+                expected: "a fraction in (0, 1]",
+            });
         }
         let max_pool = gpu
             .caps

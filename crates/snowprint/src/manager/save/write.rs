@@ -119,5 +119,5 @@ impl SnowManager {
 
 /// JSON for the text sections, with the error as the library's.
 pub(super) fn to_json<T: serde::Serialize>(v: &T) -> Result<Vec<u8>> {
-    serde_json::to_vec(v).map_err(|e| SnowError::Scene(format!("save: {e}")))
+    serde_json::to_vec(v).map_err(SnowError::SaveEncode)
 }
