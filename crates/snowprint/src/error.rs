@@ -237,6 +237,10 @@ pub enum SnowError {
         path: std::path::PathBuf,
         /// What is wrong, and what to do.
         reason: String,
+        /// The error underneath, where there is one (the I/O error of a file that cannot be read,
+        /// the library's error of a save whose parts do not fit together).
+        #[source]
+        source: Option<Box<dyn std::error::Error + Send + Sync>>,
     },
     /// Heights given to [`crate::PoolFormat::encode`] or `decode` do not match the heightmap's
     /// size.

@@ -62,9 +62,9 @@ pub enum RenderError {
     #[error("GPU readback failed: {0}")]
     MapRange(#[from] wgpu::MapRangeError),
     /// The GPU refused a pipeline or a frame (a driver that cannot compile a shader, a limit
-    /// exceeded); wgpu's message is kept.
+    /// exceeded); wgpu's error is kept as the source.
     #[error("the GPU refused the renderer's work: {0}")]
-    Gpu(String),
+    Gpu(#[from] wgpu::Error),
 }
 
 /// Result of the renderer.

@@ -220,7 +220,7 @@ impl Renderer {
             config,
         };
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(RenderError::Gpu(e));
         }
         Ok(renderer)
     }
@@ -354,7 +354,7 @@ impl Renderer {
         self.copy_stats(&mut encoder, surfaces);
         self.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(RenderError::Gpu(e));
         }
         self.stats.start_map();
 
@@ -419,7 +419,7 @@ impl Renderer {
         }
         self.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(RenderError::Gpu(e));
         }
         if copied {
             self.stats.start_map();

@@ -18,14 +18,17 @@ impl SnowManager {
         let bytes = std::fs::read(path).map_err(|e| SnowError::SaveFile {
             path: path.to_owned(),
             reason: format!("it cannot be read: {e}"),
+            source: Some(Box::new(e)),
         })?;
         let file = SaveFile::parse(&bytes).map_err(|reason| SnowError::SaveFile {
             path: path.to_owned(),
             reason,
+            source: None,
         })?;
         Self::from_save(gpu, file).map_err(|e| SnowError::SaveFile {
             path: path.to_owned(),
             reason: one_line(&e.to_string()),
+            source: Some(Box::new(e)),
         })
     }
 

@@ -109,9 +109,12 @@ impl SnowManager {
             f.sync_all()?;
             std::fs::rename(&tmp, path)
         };
-        write().map_err(|e| {
+        write().map_err(|source| {
             let _ = std::fs::remove_file(&tmp);
-            out(e.to_string())
+            SnowError::WriteFile {
+                path: path.to_owned(),
+                source,
+            }
         })?;
         Ok(bytes.len() as u64)
     }
