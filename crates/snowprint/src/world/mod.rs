@@ -22,7 +22,7 @@ mod snapshot;
 
 pub use crate::capture::{CaptureConfig, CaptureMode};
 pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
-pub use plan::FramePlan;
+pub(crate) use plan::FramePlan;
 pub use snapshot::SurfaceSnapshot;
 
 use crate::accumulate::AccumulatePipelines;

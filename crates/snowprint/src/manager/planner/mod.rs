@@ -48,7 +48,7 @@ use crate::surface::SurfaceDesc;
 
 /// Margin, metres, added to every touch test so that the planner's answer is a superset of the
 /// world's own culling (float rounding between the two can never hide a touch).
-pub const TOUCH_MARGIN: f32 = 1e-3;
+pub(crate) const TOUCH_MARGIN: f32 = 1e-3;
 
 /// How the planner finds which surfaces a box overlaps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

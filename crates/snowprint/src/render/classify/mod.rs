@@ -24,7 +24,7 @@ pub(super) struct ClassifyPass {
 }
 
 impl ClassifyPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("classify"),
             entries: &[
@@ -57,7 +57,7 @@ impl ClassifyPass {
     }
 
     /// Upload the surfaces' records and make room for their state.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -97,7 +97,12 @@ impl ClassifyPass {
         });
     }
 
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, ts: Option<&Timestamps>, slot: usize) {
+    pub(super) fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+    ) {
         let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(PASSES[slot].name),
             timestamp_writes: compute_writes(ts, slot),

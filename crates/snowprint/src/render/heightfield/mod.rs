@@ -82,7 +82,7 @@ pub(super) struct HeightfieldPass {
 }
 
 impl HeightfieldPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("heightfield"),
             entries: &[
@@ -109,13 +109,13 @@ impl HeightfieldPass {
     }
 
     /// A surface's textures (after [`HeightfieldPass::prepare`] of a frame that drew it).
-    pub fn texture(&self, id: SurfaceId) -> Option<&HeightfieldTexture> {
+    pub(super) fn texture(&self, id: SurfaceId) -> Option<&HeightfieldTexture> {
         self.textures.get(&id)
     }
 
     /// Upload each surface's parameters (with the moon in its frame), make its textures at its
     /// heightmap's size, and bind them.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -182,7 +182,7 @@ impl HeightfieldPass {
     }
 
     /// One indirect dispatch per surface, its arguments written by `classify` in `state`.
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
@@ -205,7 +205,7 @@ impl HeightfieldPass {
 
     /// A surface's smoothed depression, displaced channel and bank heights as the latest frame's
     /// passes wrote them.
-    pub fn read_fields(
+    pub(super) fn read_fields(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,

@@ -18,7 +18,7 @@ pub(super) struct OpaquePass {
 }
 
 impl OpaquePass {
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         mesh_module: &wgpu::ShaderModule,
         frame_layout: &wgpu::BindGroupLayout,
@@ -42,7 +42,7 @@ impl OpaquePass {
     }
 
     /// Clear colour and depth, then draw every instance.
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -11,7 +11,7 @@ pub(super) struct SkyPass {
 }
 
 impl SkyPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
         let module = pipeline::shader(device, "sky.wgsl", shaders::sky());
         let pipeline = pipeline::Raster {
             label: "sky",
@@ -29,7 +29,7 @@ impl SkyPass {
         Self { pipeline }
     }
 
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

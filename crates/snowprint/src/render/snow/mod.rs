@@ -31,7 +31,7 @@ pub(super) struct SnowPass {
 }
 
 impl SnowPass {
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
         filterable: bool,
@@ -82,7 +82,7 @@ impl SnowPass {
 
     /// Upload each surface's uniform (transform, grid, ground, search and look) and bind it with
     /// its heightfield textures.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -162,7 +162,7 @@ impl SnowPass {
 
     /// The relief-mapped surfaces (indirect draws of both materials), then the diced ones.
     #[allow(clippy::too_many_arguments)]
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -11,7 +11,7 @@ pub(super) struct SnowfallPass {
 }
 
 impl SnowfallPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
         let module = pipeline::shader(device, "snowfall.wgsl", shaders::snowfall());
         let blended = [Some(wgpu::ColorTargetState {
             format: super::targets::HDR_FORMAT,
@@ -35,7 +35,7 @@ impl SnowfallPass {
     }
 
     /// Draw `flakes` flakes (the frame uniform's count).
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

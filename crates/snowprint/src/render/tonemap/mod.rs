@@ -21,7 +21,7 @@ pub(super) struct TonemapPass {
 }
 
 impl TonemapPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap inputs"),
             entries: &[
@@ -87,7 +87,7 @@ impl TonemapPass {
     }
 
     /// Bind the scene's colour and depth, and pick the pipeline of the output's format.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         targets: &Targets,
@@ -107,7 +107,7 @@ impl TonemapPass {
         self.current = Some((pipeline, inputs));
     }
 
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -24,7 +24,7 @@ pub(in crate::render) struct BanksPass {
 }
 
 impl BanksPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("banks"),
@@ -55,7 +55,7 @@ impl BanksPass {
 
     /// Upload each diced surface's bank parameters and bind its heightfield textures (nothing
     /// outside the tessellated tier, `active` false).
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -127,7 +127,7 @@ impl BanksPass {
     }
 
     /// Both bank passes run over the deformed surfaces only (the heightfield's dispatch).
-    pub fn encode(
+    pub(crate) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -25,7 +25,7 @@ pub(in crate::render) struct TessSurface {
 }
 
 impl TessSurface {
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
         shadow_layout: &wgpu::BindGroupLayout,
@@ -94,7 +94,7 @@ impl TessSurface {
 
     /// Bind each diced surface's uniform (in the snow pass's `surfaces` buffer), textures and
     /// state.
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         surfaces: &[FrameSurface<'_>],
@@ -128,7 +128,7 @@ impl TessSurface {
     }
 
     /// The `snow_shadow` pass: the displaced snow into both cascades, over the meshes' shadows.
-    pub fn encode_shadow(
+    pub(crate) fn encode_shadow(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
@@ -153,7 +153,12 @@ impl TessSurface {
     }
 
     /// The tessellated snow into the scene (within the `snow` pass).
-    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, frame: &wgpu::BindGroup, dice: &DicePass) {
+    pub(crate) fn draw(
+        &self,
+        p: &mut wgpu::RenderPass<'_>,
+        frame: &wgpu::BindGroup,
+        dice: &DicePass,
+    ) {
         if dice.any() {
             p.set_pipeline(&self.draw);
             p.set_bind_group(0, frame, &[]);
