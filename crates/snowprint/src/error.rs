@@ -80,6 +80,9 @@ pub enum SnowError {
         path: PathBuf,
         /// Why it could not be used.
         reason: String,
+        /// The I/O error, when the file or its folder could not be opened or read.
+        #[source]
+        source: Option<std::io::Error>,
     },
     /// A mesh file names a buffer or image it may not read: outside the folder it may read from,
     /// an absolute path, a URI with a scheme other than `data:`, or a malformed `data:` URI.
