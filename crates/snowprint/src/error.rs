@@ -275,6 +275,13 @@ mod tests {
     use crate::{Heightmap, ManagerConfig};
 
     #[test]
+    fn errors_cross_threads() {
+        fn send_sync<T: Send + Sync + 'static>() {}
+        send_sync::<SnowError>();
+        send_sync::<crate::render::RenderError>();
+    }
+
+    #[test]
     fn a_bad_setting_is_matchable_without_parsing_text() {
         let bad = ManagerConfig {
             updates_per_frame: 0,
