@@ -55,10 +55,10 @@ pub use anim::{Footfall, Motion};
 pub use people::Person;
 pub use skeleton::{BodyPose, PART_COUNT, Part, Side};
 
-use snowprint::deformer::{Deformer, Pose, Shape};
-use snowprint::mesh::{Mesh, MeshId};
-use snowprint::surface::SurfaceDesc;
-use snowprint::view::{Camera, GroundMaterial};
+use snowprint::SurfaceDesc;
+use snowprint::{Camera, GroundMaterial};
+use snowprint::{Deformer, Pose, Shape};
+use snowprint::{Mesh, MeshId};
 
 /// A snow surface of the demo and what lies under its snow.
 #[derive(Clone, Debug, PartialEq)]

@@ -13,36 +13,16 @@
 //!
 //! CPU reference: [`cpu`].
 
-pub mod cpu;
+pub(crate) mod cpu;
 mod encode;
 
 pub use encode::{AccumulateBuffers, AccumulatePlan, encode};
 
 use crate::pool::Precision;
 
-use crate::wgsl::{ShaderModule, files};
+use crate::wgsl::ShaderModule;
 
-/// Record layout shared by every pass.
-pub const SHARED: &str = files::SHARED;
-/// Stage 1 (without its imports).
-pub const BLUR_SHADER: &str = files::BLUR;
-/// Stage 2 (without its imports).
-pub const MERGE_SHADER: &str = files::MERGE;
-/// Normals (without its imports).
-pub const NORMALS_SHADER: &str = files::NORMALS;
-/// Blur and merge in one pass (without its imports).
-pub const FUSED_SHADER: &str = files::FUSED;
-/// The indirect arguments of the listed fused pass (without its imports).
-pub const SEAL_SHADER: &str = files::SEAL;
 pub use crate::pool::TILE_LIST_HEADER;
-/// The arithmetic shared by every stage.
-pub const MATHS: &str = files::MATHS;
-/// Reading the capture buffer (for the passes that bind it).
-pub const CAPTURE_READ: &str = files::CAPTURE_READ;
-/// Reading heights from the pool at any precision.
-pub const TEXEL_READ: &str = files::TEXEL;
-/// Writing heights to the pool at any precision.
-pub const TEXEL_WRITE: &str = files::TEXEL_WRITE;
 
 /// Workgroup side of the separate accumulation passes.
 pub const WORKGROUP: u32 = crate::wgsl::consts::WORKGROUP;

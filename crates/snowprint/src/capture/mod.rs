@@ -14,7 +14,7 @@
 //!
 //! CPU reference: [`cpu`].
 
-pub mod cpu;
+pub(crate) mod cpu;
 mod encode;
 
 pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode};

@@ -5,9 +5,9 @@
 //! `SNOWPRINT_ADAPTER` environment variable. Optional features (timestamp queries) are requested only
 //! where the adapter has them; where one is missing the library falls back and says so with a warning.
 
-pub mod readback;
+pub(crate) mod readback;
 pub(crate) mod resources;
-pub mod timestamps;
+pub(crate) mod timestamps;
 
 use crate::error::{Result, SnowError};
 
@@ -239,6 +239,6 @@ impl GpuContext {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| SnowError::Readback(e.to_string()))
+            .map_err(SnowError::from)
     }
 }

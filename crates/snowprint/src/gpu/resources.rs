@@ -11,7 +11,7 @@ pub(crate) struct Growable {
 
 impl Growable {
     /// A buffer of at least `size` bytes (16 at least, so that it can always be bound).
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         label: &'static str,
         usage: wgpu::BufferUsages,
@@ -31,7 +31,7 @@ impl Growable {
     }
 
     /// Make sure the buffer holds at least `size` bytes.
-    pub fn ensure(&mut self, device: &wgpu::Device, size: u64) {
+    pub(crate) fn ensure(&mut self, device: &wgpu::Device, size: u64) {
         if self.buffer.size() < size {
             *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
         }

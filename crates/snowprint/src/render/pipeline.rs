@@ -59,7 +59,7 @@ pub(super) struct Raster<'a> {
 }
 
 impl Raster<'_> {
-    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(super) fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(self.label),
             layout: Some(&layout(device, self.label, self.groups)),

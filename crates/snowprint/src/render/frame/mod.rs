@@ -31,7 +31,7 @@ pub(super) struct FrameSurface<'a> {
 
 impl FrameSurface<'_> {
     /// Sides of a heightmap texel, metres.
-    pub fn texel(&self) -> Vec2 {
+    pub(super) fn texel(&self) -> Vec2 {
         let (desc, layout) = (self.view.desc, self.view.layout);
         Vec2::new(
             desc.size.x / layout.width as f32,
@@ -59,7 +59,7 @@ pub(super) struct FrameLayouts {
 }
 
 impl FrameLayouts {
-    pub fn new(device: &wgpu::Device, filterable: bool) -> Self {
+    pub(super) fn new(device: &wgpu::Device, filterable: bool) -> Self {
         // frame.wgsl's group 0, the same in every module that imports it (OVERRIDES give it the
         // stages of all of them); the shadow passes' is what their vertex entry points read.
         let layout = crate::wgsl::SURFACE.bind_group_layout_for(device, "frame", 0, filterable);
@@ -76,7 +76,7 @@ impl FrameLayouts {
 
 impl FrameResources {
     /// The uniform buffer, samplers and bind groups over the moon's shadow map `shadow_view`.
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         layouts: FrameLayouts,
         shadow_view: &wgpu::TextureView,
@@ -133,7 +133,7 @@ impl FrameResources {
     }
 
     /// Upload the frame's uniform.
-    pub fn prepare(&self, queue: &wgpu::Queue, uniform: &FrameUniform) {
+    pub(super) fn prepare(&self, queue: &wgpu::Queue, uniform: &FrameUniform) {
         queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(uniform));
     }
 }

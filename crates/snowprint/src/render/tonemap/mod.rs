@@ -7,7 +7,6 @@ use std::collections::HashMap;
 use super::graph::PASSES;
 use super::pipeline;
 use super::readback::{Timestamps, render_writes};
-use super::shaders;
 use super::targets::Targets;
 use crate::gpu::resources::bind_group;
 
@@ -21,9 +20,9 @@ pub(super) struct TonemapPass {
 }
 
 impl TonemapPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
         let layout = crate::wgsl::TONEMAP.bind_group_layout(device, "tonemap inputs", 1);
-        let module = pipeline::shader(device, "tonemap.wgsl", shaders::tonemap());
+        let module = pipeline::shader(device, "tonemap.wgsl", crate::wgsl::TONEMAP.wgsl());
         let pipeline_layout = pipeline::layout(device, "tonemap", &[frame_layout, &layout]);
         Self {
             layout,
@@ -81,7 +80,7 @@ impl TonemapPass {
     }
 
     /// Bind the scene's colour and depth, and pick the pipeline of the output's format.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         targets: &Targets,
@@ -101,7 +100,7 @@ impl TonemapPass {
         self.current = Some((pipeline, inputs));
     }
 
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

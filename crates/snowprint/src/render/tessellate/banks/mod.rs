@@ -9,8 +9,8 @@ use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
+use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_writes};
-use crate::render::{pipeline, shaders};
 
 pub(in crate::render) struct BanksPass {
     layout: wgpu::BindGroupLayout,
@@ -23,9 +23,9 @@ pub(in crate::render) struct BanksPass {
 }
 
 impl BanksPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
         let layout = crate::wgsl::BANKS.bind_group_layout(device, "banks", 0);
-        let module = pipeline::shader(device, "banks.wgsl", shaders::BANKS.to_owned());
+        let module = pipeline::shader(device, "banks.wgsl", crate::wgsl::BANKS.wgsl());
         let norm = pipeline::compute(device, "bank norm", &module, "bank_norm", &[&layout]);
         let gather = pipeline::compute(device, "bank gather", &module, "bank_gather", &[&layout]);
         Self {
@@ -44,7 +44,7 @@ impl BanksPass {
 
     /// Upload each diced surface's bank parameters and bind its heightfield textures (nothing
     /// outside the tessellated tier, `active` false).
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -116,7 +116,7 @@ impl BanksPass {
     }
 
     /// Both bank passes run over the deformed surfaces only (the heightfield's dispatch).
-    pub fn encode(
+    pub(crate) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -9,9 +9,9 @@ use crate::gpu::resources::{bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::SurfaceUniform;
 use crate::render::heightfield::HeightfieldPass;
+use crate::render::pipeline;
 use crate::render::readback::Timestamps;
 use crate::render::shadow::ShadowPass;
-use crate::render::{pipeline, shaders};
 
 pub(in crate::render) struct TessSurface {
     layout: wgpu::BindGroupLayout,
@@ -24,7 +24,7 @@ pub(in crate::render) struct TessSurface {
 }
 
 impl TessSurface {
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
         shadow_layout: &wgpu::BindGroupLayout,
@@ -36,7 +36,11 @@ impl TessSurface {
             1,
             filterable,
         );
-        let module = pipeline::shader(device, "tess_surface.wgsl", shaders::tess_surface());
+        let module = pipeline::shader(
+            device,
+            "tess_surface.wgsl",
+            crate::wgsl::TESS_SURFACE.wgsl(),
+        );
         const VERTEX: [wgpu::VertexAttribute; 2] =
             wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4];
         let buffers = [Some(wgpu::VertexBufferLayout {
@@ -79,7 +83,7 @@ impl TessSurface {
 
     /// Bind each diced surface's uniform (in the snow pass's `surfaces` buffer), textures and
     /// state.
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         surfaces: &[FrameSurface<'_>],
@@ -113,7 +117,7 @@ impl TessSurface {
     }
 
     /// The `snow_shadow` pass: the displaced snow into both cascades, over the meshes' shadows.
-    pub fn encode_shadow(
+    pub(crate) fn encode_shadow(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
@@ -138,7 +142,12 @@ impl TessSurface {
     }
 
     /// The tessellated snow into the scene (within the `snow` pass).
-    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, frame: &wgpu::BindGroup, dice: &DicePass) {
+    pub(crate) fn draw(
+        &self,
+        p: &mut wgpu::RenderPass<'_>,
+        frame: &wgpu::BindGroup,
+        dice: &DicePass,
+    ) {
         if dice.any() {
             p.set_pipeline(&self.draw);
             p.set_bind_group(0, frame, &[]);
