@@ -54,3 +54,4 @@ pub use world::{
     CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, SnowWorld, StageTimes,
     SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
+pub use world::{Footstep, ProbeSample, ProbeStatus, ProbeTicket};
