@@ -6,7 +6,7 @@ mod common;
 
 use glam::{Quat, Vec2, Vec3};
 use snowprint::{
-    CaptureConfig, Deformer, Footstep, PoolFormat, Pose, Precision, ProbeSample, ProbeStatus,
+    CaptureConfig, Deformer, Footstep, Mesh, PoolFormat, Pose, Precision, ProbeSample, ProbeStatus,
     ProbeTicket, Shape, SnowError, SnowWorld, SurfaceDesc, SurfaceId, WorldConfig,
 };
 
@@ -328,4 +328,31 @@ fn a_footstep_when_a_capsule_foot_comes_down() {
     );
     w.step(DT, &[beside]).unwrap();
     assert!(w.footsteps().is_empty());
+    // A boot mesh, a 0.1 x 0.06 x 0.2 m block, comes down flat from 0.05 m above the top to
+    // 0.07 m below it: a footstep under its centre, 0.07 m deep.
+    let boot = w
+        .add_mesh("boot", &Mesh::cuboid(Vec3::new(0.05, 0.03, 0.1)))
+        .unwrap();
+    let (from, to) = (
+        at(&desc, -0.5, 0.3, 0.25 + 0.03),
+        at(&desc, -0.5, 0.3, 0.13 + 0.03),
+    );
+    let stamp = Deformer::moving(
+        Shape::Mesh(boot),
+        Pose::at(from.into()),
+        Pose::at(to.into()),
+    );
+    w.step(DT, &[stamp]).unwrap();
+    let s = w.footsteps()[0];
+    assert_eq!((s.deformer, s.surface), (0, yard));
+    assert!(
+        (s.point - (to - Vec3::Y * 0.03)).length() < 1e-5,
+        "{:?}",
+        s.point
+    );
+    assert!((s.depth_m - 0.07).abs() < 1e-5, "{}", s.depth_m);
+    assert!((s.speed - 0.12 / DT).abs() < 1e-2, "{}", s.speed);
+    // Once removed, the mesh is refused by the update as before; nothing of it is kept.
+    w.remove_mesh(boot).unwrap();
+    assert!(w.step(DT, &[stamp]).is_err());
 }

@@ -1,6 +1,10 @@
 //! Footstep events: a deformer whose lowest point passes from above a surface's snow top to below
-//! it during an update, over that surface. Computed on the CPU from the analytic shapes the capture
-//! draws (sphere, capsule, box) and their `previous` and current poses; for sound and effects.
+//! it during an update, over that surface. Computed on the CPU from the shapes the capture draws
+//! (sphere, capsule, box, and meshes from a CPU copy of their vertices kept by the world) and their
+//! `previous` and current poses; for sound and effects.
+//!
+//! A mesh posed with [`crate::SnowWorld::pose_mesh`] is judged with its vertices as last posed at
+//! both poses (the capture, too, draws meshes at their current pose only).
 //!
 //! The snow top is the fresh snow top (ground + [`SurfaceDesc::snow_depth`]): a foot that comes down
 //! into an older print lands when it passes that height, and its depth is measured from it.
@@ -9,6 +13,7 @@ use glam::{Vec2, Vec3};
 
 use super::SurfaceUpdate;
 use crate::deformer::{Pose, Shape};
+use crate::mesh::MeshId;
 use crate::surface::{SurfaceDesc, SurfaceId};
 
 /// A deformer landing on a surface during one update (see [`crate::SnowWorld::footsteps`]).
@@ -27,9 +32,13 @@ pub struct Footstep {
     pub speed: f32,
 }
 
-/// The lowest point of an analytic shape at `pose` (the middle of the lowest edge or face when one
-/// is level); `None` for meshes, whose vertices the world keeps on the GPU only.
-pub fn lowest_point(shape: &Shape, pose: &Pose) -> Option<Vec3> {
+/// The lowest point of a shape at `pose` (the middle of the lowest edge or face when one is
+/// level); a mesh's from its vertices as `mesh_vertices` gives them (`None` when it gives none).
+pub fn lowest_point<'a>(
+    shape: &Shape,
+    pose: &Pose,
+    mesh_vertices: impl Fn(MeshId) -> Option<&'a [Vec3]>,
+) -> Option<Vec3> {
     let down = Vec3::NEG_Y;
     match *shape {
         Shape::Sphere { radius } => Some(pose.position + down * radius),
@@ -50,23 +59,31 @@ pub fn lowest_point(shape: &Shape, pose: &Pose) -> Option<Vec3> {
             Some(end + down * radius)
         }
         Shape::Box { half_extents } => {
-            let corners = (0..8).map(|i| {
+            let corners: [Vec3; 8] = std::array::from_fn(|i| {
                 let sign = Vec3::new(
                     if i & 1 == 0 { -1.0 } else { 1.0 },
                     if i & 2 == 0 { -1.0 } else { 1.0 },
                     if i & 4 == 0 { -1.0 } else { 1.0 },
                 );
-                pose.position + pose.rotation * (half_extents * sign)
+                half_extents * sign
             });
-            let low = corners.clone().map(|c| c.y).fold(f32::INFINITY, f32::min);
-            let tie = 1e-6 * (1.0 + half_extents.max_element());
-            let (sum, n) = corners
-                .filter(|c| c.y <= low + tie)
-                .fold((Vec3::ZERO, 0.0), |(s, n), c| (s + c, n + 1.0));
-            Some(Vec3::new(sum.x / n, low, sum.z / n))
+            lowest_vertex(&corners, pose)
         }
-        Shape::Mesh(_) => None,
+        Shape::Mesh(id) => lowest_vertex(mesh_vertices(id)?, pose),
     }
+}
+
+/// The lowest of `vertices` (in the shape's frame) at `pose`; several within a millionth of the
+/// shape's size of the lowest are averaged (a level edge or face). `None` for no vertices.
+fn lowest_vertex(vertices: &[Vec3], pose: &Pose) -> Option<Vec3> {
+    let placed = vertices.iter().map(|&v| pose.position + pose.rotation * v);
+    let low = placed.clone().map(|c| c.y).fold(f32::INFINITY, f32::min);
+    let size = vertices.iter().map(|v| v.length()).fold(0.0, f32::max);
+    let tie = 1e-6 * (1.0 + size);
+    let (sum, n) = placed
+        .filter(|c| c.y <= low + tie)
+        .fold((Vec3::ZERO, 0.0), |(s, n), c| (s + c, n + 1.0));
+    (n > 0.0).then(|| Vec3::new(sum.x / n, low, sum.z / n))
 }
 
 /// Whether a world point lies over a surface's rectangle (its yawed local frame).
@@ -77,17 +94,22 @@ pub fn over_surface(desc: &SurfaceDesc, point: Vec3) -> bool {
 }
 
 /// The footstep of one deformer over one surface, if it landed there during `elapsed` seconds.
-pub fn landing(
+pub fn landing<'a>(
     desc: &SurfaceDesc,
     shape: &Shape,
     previous: &Pose,
     pose: &Pose,
     elapsed: f32,
+    mesh_vertices: impl Fn(MeshId) -> Option<&'a [Vec3]> + Copy,
 ) -> Option<(Vec3, f32, f32)> {
-    let before = lowest_point(shape, previous)?;
-    let now = lowest_point(shape, pose)?;
+    // The current pose first: a deformer above the snow or beside the surface needs no more.
+    let now = lowest_point(shape, pose, mesh_vertices)?;
     let top = desc.center.y + desc.snow_depth;
-    if !(before.y > top && now.y < top && over_surface(desc, now)) {
+    if !(now.y < top && over_surface(desc, now)) {
+        return None;
+    }
+    let before = lowest_point(shape, previous, mesh_vertices)?;
+    if before.y <= top {
         return None;
     }
     let depth = (top - now.y).min(desc.snow_depth);
@@ -100,10 +122,12 @@ pub fn landing(
 }
 
 /// Every footstep of an update, in the order of its surfaces and their deformers. Deformers without
-/// a `previous` pose (at rest) and meshes never land. `desc` looks up a live surface.
-pub fn footsteps<'a>(
+/// a `previous` pose (at rest) never land. `desc` looks up a live surface, `mesh_vertices` a mesh's
+/// vertices.
+pub fn footsteps<'a, 'm>(
     updates: &[SurfaceUpdate<'_>],
     desc: impl Fn(SurfaceId) -> Option<&'a SurfaceDesc>,
+    mesh_vertices: impl Fn(MeshId) -> Option<&'m [Vec3]> + Copy,
     out: &mut Vec<Footstep>,
 ) {
     out.clear();
@@ -113,9 +137,14 @@ pub fn footsteps<'a>(
             let Some(previous) = deformer.previous.as_ref() else {
                 continue;
             };
-            if let Some((point, depth_m, speed)) =
-                landing(d, &deformer.shape, previous, &deformer.pose, u.elapsed)
-            {
+            if let Some((point, depth_m, speed)) = landing(
+                d,
+                &deformer.shape,
+                previous,
+                &deformer.pose,
+                u.elapsed,
+                mesh_vertices,
+            ) {
                 out.push(Footstep {
                     deformer: i,
                     surface: u.surface,
@@ -133,24 +162,30 @@ mod tests {
     use super::*;
     use glam::Quat;
 
+    /// No mesh has vertices.
+    const NO_MESH: fn(MeshId) -> Option<&'static [Vec3]> = |_| None;
+
     #[test]
     fn lowest_points_by_hand() {
         let at = Pose::at([1.0, 2.0, 3.0]);
         let sphere = Shape::Sphere { radius: 0.5 };
-        assert_eq!(lowest_point(&sphere, &at), Some(Vec3::new(1.0, 1.5, 3.0)));
+        assert_eq!(
+            lowest_point(&sphere, &at, NO_MESH),
+            Some(Vec3::new(1.0, 1.5, 3.0))
+        );
         let capsule = Shape::Capsule {
             radius: 0.1,
             half_height: 0.4,
         };
         // Upright: the lower cap's bottom.
-        let p = lowest_point(&capsule, &at).unwrap();
+        let p = lowest_point(&capsule, &at, NO_MESH).unwrap();
         assert!((p - Vec3::new(1.0, 1.5, 3.0)).length() < 1e-6, "{p}");
         // Tilted 90 degrees about z: lying along x, the lowest point is under the middle.
         let lying = Pose {
             rotation: Quat::from_rotation_z(std::f32::consts::FRAC_PI_2),
             ..at
         };
-        let p = lowest_point(&capsule, &lying).unwrap();
+        let p = lowest_point(&capsule, &lying, NO_MESH).unwrap();
         assert!((p - Vec3::new(1.0, 1.9, 3.0)).length() < 1e-5, "{p}");
         // A box turned 45 degrees about x stands on an edge, 0.2 * sqrt(2) below its centre.
         let block = Shape::Box {
@@ -160,15 +195,18 @@ mod tests {
             rotation: Quat::from_rotation_x(std::f32::consts::FRAC_PI_4),
             ..at
         };
-        let p = lowest_point(&block, &edge).unwrap();
+        let p = lowest_point(&block, &edge, NO_MESH).unwrap();
         assert!(
             (p - Vec3::new(1.0, 2.0 - 0.2 * 2f32.sqrt(), 3.0)).length() < 1e-5,
             "{p}"
         );
-        assert_eq!(
-            lowest_point(&Shape::Mesh(crate::mesh::MeshId(0)), &at),
-            None
-        );
+        // A mesh: from its vertices, as the box it is; none when the world has none for it.
+        let cube = crate::mesh::Mesh::cuboid(Vec3::splat(0.2));
+        let vertices = |_| Some(cube.positions.as_slice());
+        let mesh = Shape::Mesh(MeshId(0));
+        let p = lowest_point(&mesh, &edge, vertices).unwrap();
+        assert!((p - lowest_point(&block, &edge, NO_MESH).unwrap()).length() < 1e-6);
+        assert_eq!(lowest_point(&mesh, &at, NO_MESH), None);
     }
 
     #[test]
@@ -182,6 +220,7 @@ mod tests {
             &Pose::at([0.5, 1.5, 0.2]),
             &Pose::at([0.5, 1.3, 0.2]),
             0.1,
+            NO_MESH,
         )
         .unwrap();
         assert!((point - Vec3::new(0.5, 1.2, 0.2)).length() < 1e-6);
@@ -193,19 +232,21 @@ mod tests {
             &Pose::at([0.0, 1.5, 0.0]),
             &Pose::at([0.0, 0.5, 0.0]),
             0.1,
+            NO_MESH,
         );
         assert!((deep.unwrap().1 - 0.3).abs() < 1e-6);
         // Resting, rising, or outside the rectangle: nothing.
         let low = Pose::at([0.0, 1.3, 0.0]);
-        assert!(landing(&desc, &foot, &low, &low, 0.1).is_none());
-        assert!(landing(&desc, &foot, &low, &Pose::at([0.0, 1.6, 0.0]), 0.1).is_none());
+        assert!(landing(&desc, &foot, &low, &low, 0.1, NO_MESH).is_none());
+        assert!(landing(&desc, &foot, &low, &Pose::at([0.0, 1.6, 0.0]), 0.1, NO_MESH).is_none());
         assert!(
             landing(
                 &desc,
                 &foot,
                 &Pose::at([1.5, 1.5, 0.0]),
                 &Pose::at([1.5, 1.3, 0.0]),
-                0.1
+                0.1,
+                NO_MESH
             )
             .is_none()
         );

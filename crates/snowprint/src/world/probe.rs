@@ -162,6 +162,9 @@ pub(super) struct Probes {
     pub(super) frame: u64,
     /// The footsteps of the last update.
     pub(super) footsteps: Vec<Footstep>,
+    /// A CPU copy of each mesh deformer's vertices (as last posed), by mesh index: footsteps
+    /// find a mesh's lowest point from them.
+    mesh_vertices: Vec<Option<Vec<Vec3>>>,
 }
 
 impl Probes {
@@ -212,6 +215,24 @@ impl Probes {
             cache: HashMap::new(),
             frame: 0,
             footsteps: Vec::new(),
+            mesh_vertices: Vec::new(),
+        }
+    }
+
+    /// Keep a copy of mesh `index`'s vertices (registered or posed).
+    pub(super) fn keep_mesh(&mut self, index: usize, vertices: &[Vec3]) {
+        if self.mesh_vertices.len() <= index {
+            self.mesh_vertices.resize(index + 1, None);
+        }
+        let kept = self.mesh_vertices[index].get_or_insert_with(Vec::new);
+        kept.clear();
+        kept.extend_from_slice(vertices);
+    }
+
+    /// Drop the copy of a removed mesh's vertices.
+    pub(super) fn forget_mesh(&mut self, index: usize) {
+        if let Some(kept) = self.mesh_vertices.get_mut(index) {
+            *kept = None;
         }
     }
 
@@ -592,9 +613,11 @@ impl SnowWorld {
     pub(super) fn probes_after_update(&mut self, updates: &[super::SurfaceUpdate<'_>]) {
         self.probes.frame += 1;
         let mut steps = std::mem::take(&mut self.probes.footsteps);
+        let meshes = &self.probes.mesh_vertices;
         super::footstep::footsteps(
             updates,
             |id| self.state(id).ok().map(|s| &s.desc),
+            |m| meshes.get(m.0 as usize)?.as_deref(),
             &mut steps,
         );
         self.probes.footsteps = steps;
