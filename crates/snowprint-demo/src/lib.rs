@@ -47,6 +47,7 @@ pub mod people;
 pub mod plot;
 pub mod scene;
 pub mod skeleton;
+pub mod trudge;
 pub mod world;
 
 use glam::Mat4;

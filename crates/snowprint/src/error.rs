@@ -264,6 +264,45 @@ pub enum SnowError {
         /// How many were given.
         got: usize,
     },
+    /// Every staging buffer of the probe ring holds a batch not yet read back; nothing asked
+    /// before was dropped.
+    #[error(
+        "all {ring} probe batches are in flight ({in_flight} not yet read back): probe again after the next update or SnowWorld::poll_probes"
+    )]
+    ProbeRingFull {
+        /// Batches in flight.
+        in_flight: usize,
+        /// Batches the ring holds.
+        ring: usize,
+    },
+    /// More points were probed between two updates than one batch holds.
+    #[error(
+        "{asked} more probe points would exceed the {max} one batch holds ({queued} already queued): probe fewer, or call SnowWorld::poll_probes to send the queued ones"
+    )]
+    TooManyProbePoints {
+        /// Points in the refused request.
+        asked: usize,
+        /// Points already queued for the next batch.
+        queued: usize,
+        /// Most points a batch holds.
+        max: usize,
+    },
+    /// A probed point is not finite.
+    #[error("probe point #{index} is {value}, but it must be finite")]
+    InvalidProbePoint {
+        /// Its index in the slice given.
+        index: usize,
+        /// The point, printed.
+        value: String,
+    },
+    /// A probe ticket that this world does not know.
+    #[error(
+        "probe ticket {ticket} is unknown: never given by this world, already answered, or forgotten after more newer answers were left unread than the world keeps"
+    )]
+    UnknownProbe {
+        /// The ticket's number.
+        ticket: u64,
+    },
 }
 
 /// Result alias of the library.

@@ -78,6 +78,10 @@ pub use world::{
     CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, SnowWorld, StageTimes,
     SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
+pub use world::{
+    Footstep, MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus,
+    ProbeTicket,
+};
 
 /// CPU references of the GPU passes: the same maths on the same inputs and layouts, written for
 /// clarity, against which the tests compare the GPU's results texel by texel.

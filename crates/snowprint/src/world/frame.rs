@@ -39,6 +39,7 @@ impl SnowWorld {
     pub fn update(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<FrameStats> {
         let start = Instant::now();
         self.validate(updates)?;
+        self.probes_before_update();
         let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
         self.plan_into(&mut plan, updates);
         let mut stats = plan.stats();
@@ -53,6 +54,9 @@ impl SnowWorld {
             self.record_and_submit(&plan, start, &mut stats)
         };
         self.scratch_cpu.plan = plan;
+        if result.is_ok() {
+            self.probes_after_update(updates);
+        }
         result.map(|()| stats)
     }
 

@@ -14,15 +14,21 @@
 //! (`snapshot.rs`) and readbacks (`readback.rs`).
 
 mod config;
+mod footstep;
 mod frame;
 mod meshes;
 pub(crate) mod plan;
+mod probe;
 mod readback;
 mod snapshot;
 
 pub use crate::capture::{CaptureConfig, CaptureMode};
 pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
+pub use footstep::Footstep;
 pub(crate) use plan::FramePlan;
+pub use probe::{
+    MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus, ProbeTicket,
+};
 pub use snapshot::SurfaceSnapshot;
 
 use crate::accumulate::AccumulatePipelines;
@@ -91,6 +97,8 @@ pub struct SnowWorld {
     scratch_cpu: FrameScratch,
     profiling: bool,
     timestamps: Option<Timestamps>,
+    /// Gameplay probes, their ring and cache, and the last update's footsteps.
+    probes: probe::Probes,
 }
 
 impl std::fmt::Debug for SnowWorld {
@@ -160,6 +168,7 @@ impl SnowWorld {
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
             acc: AccumulatePipelines::new(&device, config.format.precision),
+            probes: probe::Probes::new(&device),
             records: Growable::new(
                 &device,
                 "surface records",
