@@ -48,6 +48,7 @@ pub use manager::{
 };
 pub use mesh::{Mesh, MeshId};
 pub use pool::{PoolFormat, Precision};
+pub use render::gpu::SurfaceUniform;
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{

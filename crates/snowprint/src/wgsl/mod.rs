@@ -355,6 +355,9 @@ impl ShaderModule {
 
 include!(concat!(env!("OUT_DIR"), "/wgsl_registry.rs"));
 
+mod engine;
+pub use engine::{ImportOptions, engine_module, material_module};
+
 /// Every entry module, by name (for tests and tools).
 pub fn all() -> &'static [&'static ShaderModule] {
     ALL
