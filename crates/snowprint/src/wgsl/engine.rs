@@ -94,7 +94,7 @@ mod tests {
             .iter()
             .find(|(_, v)| v.name.as_deref() == Some("snowprint_pool"))
             .expect("snowprint_pool");
-        pool.binding.clone().expect("bound")
+        pool.binding.expect("bound")
     }
 
     /// The engine module validates with the pool wherever the importer puts it, declares nothing
