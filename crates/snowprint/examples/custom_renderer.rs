@@ -254,6 +254,18 @@ fn draw(
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..6, 0..1);
     }
+    read_back(gpu, encoder, &targets, width, height)
+}
+
+/// Copy both targets to the CPU after `encoder`'s commands (waits for the GPU).
+fn read_back(
+    gpu: &GpuContext,
+    mut encoder: wgpu::CommandEncoder,
+    targets: &[wgpu::Texture],
+    width: u32,
+    height: u32,
+) -> Result<Image, String> {
+    let device = &gpu.device;
     // Rows of a texture copy are padded to 256 bytes.
     let row = (width * 4).div_ceil(256) * 256;
     let staging = device.create_buffer(&wgpu::BufferDescriptor {
