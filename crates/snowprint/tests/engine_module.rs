@@ -148,10 +148,21 @@ fn read_on_gpu(world: &SnowWorld, id: SurfaceId) -> (Vec<[f32; 4]>, Vec<[f32; 4]
         pass.dispatch_workgroups(surface.width.div_ceil(8), surface.height.div_ceil(8), 1);
     }
     gpu.queue.submit([encoder.finish()]);
+    // Read back through a staging buffer, as an engine would (no library readback helper).
     let read = |b: &wgpu::Buffer| -> Vec<[f32; 4]> {
-        let bytes =
-            snowprint::gpu::readback::download(device, &gpu.queue, b, 0, texels * 16).unwrap();
-        bytemuck::cast_slice(&bytes).to_vec()
+        let staging = buffer(
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            texels * 16,
+        );
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(b, 0, &staging, 0, texels * 16);
+        gpu.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("poll");
+        bytemuck::cast_slice(&slice.get_mapped_range().expect("mapped")).to_vec()
     };
     (read(&out), read(&normals))
 }
