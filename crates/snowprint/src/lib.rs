@@ -72,6 +72,7 @@ pub use mesh::{
     Mesh, MeshId,
 };
 pub use pool::{PoolFormat, Precision};
+pub use render::gpu::SurfaceUniform;
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{

@@ -71,7 +71,9 @@ pub struct FrameUniform {
     pub lights: [PointLightRaw; MAX_POINT_LIGHTS],
 }
 
-/// One snow surface. Must match `SnowSurface` in `snow.wgsl`.
+/// One snow surface: where it lies, where its texels are in the pool, and the renderer's
+/// material settings. Must match `SnowSurface` in `snow.wgsl` and `snowprint_Surface` in
+/// `wgsl/engine.wgsl` ([`crate::wgsl::engine_module`]); fill it with [`Self::for_surface`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SurfaceUniform {
@@ -97,6 +99,75 @@ pub struct SurfaceUniform {
     pub look: [f32; 4],
     /// Pattern offset (xy), switched-off terms (z, `SnowLook::switch_bits`), macro wave strength (w).
     pub pattern: [f32; 4],
+    /// Word offset of the heights region in the pool buffer.
+    pub heights: u32,
+    /// Words a row of the heights region (a plane's, at 32 bits: [`crate::PoolFormat::row_words`]).
+    pub row_words: u32,
+    /// Bits a channel of the pool: 8, 16 or 32.
+    pub bits: u32,
+    /// A channel pressed to the ground ([`crate::Precision::channel_max`]), as a float.
+    pub channel_max: f32,
+    /// Texels along local x.
+    pub width: u32,
+    /// Texels along local z.
+    pub height: u32,
+    /// Texel side along local x, metres.
+    pub texel_x: f32,
+    /// Texel side along local z, metres.
+    pub texel_z: f32,
+}
+
+impl SurfaceUniform {
+    /// Surface `id` of a frame's view ([`crate::SnowWorld::frame_view`]): its transforms, size,
+    /// snow depth and texel sides, where its heights lie in the pool and at what precision, and the
+    /// default renderer's material settings (ground tiles, the relief tier's search, the default
+    /// look). Fails with [`crate::SnowError::StaleHandle`] for a surface the view does not hold.
+    pub fn for_surface(view: &crate::FrameView<'_>, id: crate::SurfaceId) -> crate::Result<Self> {
+        let surface = view.surface(id)?;
+        Ok(Self::for_view(surface))
+    }
+
+    /// [`Self::for_surface`] from one surface of a view.
+    pub fn for_view(surface: &crate::SurfaceView<'_>) -> Self {
+        let (desc, layout) = (surface.desc, surface.layout);
+        let texel_x = desc.size.x / layout.width as f32;
+        let texel_z = desc.size.y / layout.height as f32;
+        let local_to_world = desc.local_to_world();
+        let config = crate::render::RenderConfig::new(1, 1, crate::render::Tier::Relief);
+        let search = config.search_settings();
+        let look = config.look;
+        Self {
+            local_to_world: local_to_world.to_cols_array_2d(),
+            world_to_local: local_to_world.inverse().to_cols_array_2d(),
+            half_size: (desc.size * 0.5).to_array(),
+            snow_depth: desc.snow_depth,
+            texel: texel_x.max(texel_z),
+            grid: [layout.width as f32, layout.height as f32],
+            ground: 0,
+            index: surface.id.index(),
+            search: [
+                search.taps_per_texel,
+                search.min_taps as f32,
+                search.max_taps as f32,
+                search.refine_taps as f32,
+            ],
+            look: [
+                look.ground_from,
+                look.ground_full,
+                look.occlusion,
+                search.shadow_taps as f32,
+            ],
+            pattern: [desc.center.x, desc.center.z, look.switch_bits() as f32, 1.0],
+            heights: surface.heights,
+            row_words: crate::PoolFormat::new(surface.precision).row_words(layout.width),
+            bits: surface.precision.bits(),
+            channel_max: surface.precision.channel_max() as f32,
+            width: layout.width,
+            height: layout.height,
+            texel_x,
+            texel_z,
+        }
+    }
 }
 
 /// One surface for the classify pass. Must match `ClassifyRecord` in `classify.wgsl`.
@@ -301,6 +372,55 @@ mod tests {
                 .unwrap_or_else(|| panic!("no member {name}"));
             assert_eq!(m.1 as usize, offset, "{name}");
         }
+    }
+
+    /// `SurfaceUniform` has the layout of the engine module's `snowprint_Surface` and of the
+    /// material's `SnowSurface`, member by member (the pool's fields included).
+    #[test]
+    fn surface_uniform_matches_engine_module() {
+        let engine = crate::wgsl::engine_module(&Default::default());
+        let material = crate::wgsl::material_module(&Default::default());
+        macro_rules! offsets {
+            ($($f:ident),*) => { [$((stringify!($f), std::mem::offset_of!(SurfaceUniform, $f))),*] };
+        }
+        let offsets = offsets!(
+            local_to_world,
+            world_to_local,
+            half_size,
+            snow_depth,
+            texel,
+            grid,
+            ground,
+            index,
+            search,
+            look,
+            pattern,
+            heights,
+            row_words,
+            bits,
+            channel_max,
+            width,
+            height,
+            texel_x,
+            texel_z
+        );
+        for (source, name) in [
+            (&engine, "snowprint_Surface"),
+            (&material, "SnowSurface"),
+            (&crate::wgsl::SURFACE.wgsl(), "SnowSurface"),
+        ] {
+            let (size, members) = layout(source, name);
+            assert_eq!(
+                size as usize,
+                std::mem::size_of::<SurfaceUniform>(),
+                "{name}"
+            );
+            assert_eq!(members.len(), offsets.len(), "{name}");
+            for ((field, offset), (member, at)) in offsets.iter().zip(&members) {
+                assert_eq!((*field, *offset), (member.as_str(), *at as usize), "{name}");
+            }
+        }
+        assert!(std::mem::size_of::<SurfaceUniform>() as u64 <= UNIFORM_STRIDE);
     }
 
     #[test]

@@ -9,7 +9,9 @@
 //! which every pipeline's layouts are made (a binding is declared once, in WGSL); what naga cannot
 //! know (whether a float texture or a sampler filters, dynamic offsets) comes from
 //! [`OVERRIDES`]. The constants that Rust and WGSL share are defined once, in
-//! `src/wgsl/constants.wgsl`, and reflected into [`consts`].
+//! `src/wgsl/constants.wgsl`, and reflected into [`consts`]. An engine's own shaders import the
+//! pool and the material through [`engine_module`] and [`material_module`] (prefixed names, the
+//! pool at a binding of the importer's choice).
 //!
 //! The resolver is a few lines of `build.rs`, not the `wesl` crate (what Bevy's `bevy_shader`
 //! uses): `wesl` 0.4.0 (the last release that builds with rustc 1.95; 0.4.4 needs 1.97.1) adds about
@@ -354,6 +356,9 @@ impl ShaderModule {
 }
 
 include!(concat!(env!("OUT_DIR"), "/wgsl_registry.rs"));
+
+mod engine;
+pub use engine::{ImportOptions, engine_module, material_module};
 
 /// Every entry module, by name (for tests and tools).
 pub fn all() -> &'static [&'static ShaderModule] {

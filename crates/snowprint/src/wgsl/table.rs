@@ -38,4 +38,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("heightfield", "render/heightfield/heightfield.wgsl", true),
     ("banks", "render/tessellate/banks/banks.wgsl", true),
     ("dice", "render/tessellate/dice/dice.wgsl", true),
+    // For engines' own shaders: the pool read by prefixed functions, and the material on it.
+    ("engine", "wgsl/engine.wgsl", false),
+    ("engine_material", "wgsl/engine_material.wgsl", false),
 ];

@@ -121,6 +121,8 @@ impl SnowPass {
                     look.switch_bits() as f32,
                     surface.geometry.macro_waves,
                 ],
+                // Where the texels lie in the pool (read by engines' shaders, not this pass).
+                ..SurfaceUniform::for_view(surface.view)
             };
             bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
                 .copy_from_slice(bytemuck::bytes_of(&u));

@@ -1,36 +1,45 @@
 // snow.wgsl: the snow material of the talk ("Stage 3 - Shading"), as a WGSL module a renderer can
 // import. It declares no bindings and no entry points.
 //
-// How to import it: put this file's text into your shader module (WGSL declarations may come in any
-// order) and define the heightfield contract, two functions that read one surface's heightmap:
+// How to import it, the short way: `snowprint::wgsl::material_module(&ImportOptions { .. })` is
+// this file with the engine module (wgsl/engine.wgsl) and the heightfield contract below filled
+// from the pool; bind the pool where the options say and fill `SnowSurface` with
+// `SurfaceUniform::for_surface`. The long way: put this file's text into your shader module (WGSL
+// declarations may come in any order) and define the heightfield contract yourself, three
+// functions that read one surface's heightmap:
 //
 //   // Fraction of the snow depth pressed down at `uv` (0 = untouched, 1 = ground), filtered.
 //   // Called by the relief search, several times per pixel: make it one texture tap.
 //   fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32
-//   // (depression, normal.x, normal.z, ambient occlusion) at `uv`, as smooth as you can afford
-//   // (the renderer uses a 4-tap bicubic B-spline). Called once per pixel, at the hit.
+//   // (depression, normal.x, normal.z, ambient occlusion) at `uv`, normal in the surface's local
+//   // frame, as smooth as you can afford (the renderer uses a 4-tap bicubic B-spline). Called
+//   // once per pixel, at the hit.
 //   fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32>
 //   // How much of the moon reaches the snow at `uv` past the walls of the prints (1 = all), or
 //   // 1.0 if you have no such term. Called once per pixel.
 //   fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32
 //
 // UVs run 0..1 across the surface: u along local +x, v along local +z (texel column 0 / row 0 at the
-// smallest x / z, as the heightmap pool stores them). The snowprint renderer fills both from a
-// texture that `heightfield.wgsl` derives from the pool each frame.
+// smallest x / z, as the heightmap pool stores them). The snowprint renderer fills all three from
+// textures that `heightfield.wgsl` derives from the pool each frame.
 //
 // Then, per pixel of the box drawn for a surface (top face at y = snow_depth, sides down to y = 0,
-// in the surface's local frame):
-//   let hit = snow_trace(s, local_position, local_view_direction, tier);   // relief mapping or POM
+// in the surface's local frame; `tier` SNOW_TIER_RELIEF or SNOW_TIER_POM, `light_local` the unit
+// direction towards the light in the local frame, `pixel` the pixel's footprint in metres):
+//   let hit = snow_trace(s, local_position, local_view_direction, tier, light_local);
 //   if hit.found == 0u { discard; }
-//   let m = snow_deformable(s, hit, snow_heightfield(s, snow_uv(s, hit.position.xz)), sky_tint);
-//   ... light m.albedo, m.roughness, m.normal (local frame), m.ao with your own lights ...
-// or, for a surface nothing has pressed yet, the cheaper `snow_basic(s, local_position, face_normal,
-// sky_tint)`.
+//   let hf = snow_heightfield(s, snow_uv(s, hit.position.xz));
+//   let m = snow_deformable(s, hit, hf, face_normal, sky_tint, pixel);
+//   ... light m.albedo, m.roughness, m.normal (local frame), m.ao with your own lights, times
+//   hit.shadow ...
+// or, for a surface nothing has pressed yet, the cheaper `snow_basic(s, local_position,
+// face_normal, sky_tint, pixel)`. Nothing here needs derivatives, so compute shaders may call it
+// too (a `discard` is a fragment shader's; a compute shader tests `hit.found` instead).
 //
 // The maths have CPU references in src/render/cpu.rs, in the same form: keep them in step.
 
-// One snow surface as the material sees it. Must match `SurfaceUniform` in src/render/gpu.rs (a
-// test checks the layout with naga).
+// One snow surface as the material sees it. Must match `SurfaceUniform` in src/render/gpu.rs and
+// `snowprint_Surface` in src/wgsl/engine.wgsl (tests check both layouts with naga).
 struct SnowSurface {
     local_to_world: mat4x4<f32>,
     world_to_local: mat4x4<f32>,
@@ -43,6 +52,15 @@ struct SnowSurface {
     search: vec4<f32>,      // x: linear taps per texel crossed, y: min taps, z: max taps, w: binary refinement taps
     look: vec4<f32>,        // x: depression where the ground starts to show, y: where it shows fully, z: AO strength, w: POM self-shadow taps
     pattern: vec4<f32>,     // xy: offset of the procedural patterns (metres), z: switches (SNOW_NO_*), w: macro wave strength
+    // Where the heights lie in the pool (read by wgsl/engine.wgsl; the renderer reads textures).
+    heights: u32,           // word offset of the heights region
+    row_words: u32,         // words a row
+    bits: u32,              // bits a channel
+    channel_max: f32,       // a channel pressed to the ground
+    width: u32,             // texels along x
+    height: u32,            // texels along z
+    texel_x: f32,           // texel side along x, metres
+    texel_z: f32,           // texel side along z, metres
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
