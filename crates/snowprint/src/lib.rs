@@ -41,7 +41,7 @@ pub mod world;
 pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};
 pub use error::{Result, SnowError};
 pub use extract::{FrameView, SurfaceView};
-pub use gpu::{Capabilities, GpuContext, GpuOptions};
+pub use gpu::{Capabilities, GpuContext, GpuOptions, required_features, required_limits};
 pub use heightmap::Heightmap;
 pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
@@ -51,6 +51,6 @@ pub use pool::{PoolFormat, Precision};
 pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
-    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, SnowWorld, StageTimes,
-    SurfaceSnapshot, SurfaceUpdate, WorldConfig,
+    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, PendingFrame, SnowWorld,
+    StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
