@@ -29,6 +29,9 @@ struct Slot {
     frame: u64,
 }
 
+/// A measured frame's number, and each measured pass's stage and GPU milliseconds in order.
+pub(crate) type MeasuredFrame = (u64, Vec<(&'static str, f64)>);
+
 /// A query set and a ring of readback buffers.
 pub(crate) struct TimestampRing {
     timestamps: Timestamps,
@@ -115,10 +118,7 @@ impl TimestampRing {
 
     /// The oldest measured frame whose times have arrived: its number and each measured pass's
     /// stage and GPU milliseconds. Checks without waiting (`PollType::Poll`).
-    pub fn poll(
-        &mut self,
-        device: &wgpu::Device,
-    ) -> Result<Option<(u64, Vec<(&'static str, f64)>)>> {
+    pub fn poll(&mut self, device: &wgpu::Device) -> Result<Option<MeasuredFrame>> {
         let busy = |s: &Slot| matches!(s.state.load(Ordering::Acquire), MAPPING | READY | FAILED);
         if !self.slots.iter().any(busy) {
             return Ok(None);

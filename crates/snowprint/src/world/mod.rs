@@ -9,9 +9,10 @@
 //! The update is a plan, then an encode (`frame.rs`): validate the updates, build the pure
 //! [`FramePlan`] on the CPU ([`plan`]: culling, sweeping, replenishment, atlas packing, records and
 //! buffer sizes), upload its tables, record it with [`crate::capture::encode`] and
-//! [`crate::accumulate::encode`], submit, and keep the plan's replenishment carries. The rest of
-//! the world is its surfaces and pool slots (here), mesh deformers (`meshes.rs`), snapshots
-//! (`snapshot.rs`) and readbacks (`readback.rs`).
+//! [`crate::accumulate::encode`] into an encoder (the caller's, with
+//! [`SnowWorld::encode_update`]), and once it is submitted keep the plan's replenishment carries
+//! ([`SnowWorld::submitted`]). The rest of the world is its surfaces and pool slots (here), mesh
+//! deformers (`meshes.rs`), snapshots (`snapshot.rs`) and readbacks (`readback.rs`).
 
 mod config;
 mod frame;
