@@ -4,7 +4,9 @@
 
 use glam::Vec3;
 use snowprint::gpu::readback::download;
-use snowprint::render::{Environment, RenderConfig, RenderError, RenderFrame, Renderer, Tier};
+use snowprint::render::{
+    Environment, OUTPUT_FORMAT, RenderConfig, RenderError, RenderFrame, Renderer, Tier,
+};
 use snowprint::{
     Camera, Capabilities, Deformer, GpuContext, GroundMaterial, Pose, Shape, SnowError, SnowWorld,
     SurfaceDesc, WorldConfig, required_features, required_limits,
@@ -320,4 +322,94 @@ fn the_per_frame_path_has_no_blocking_wait() {
             }
         }
     }
+}
+
+#[test]
+fn the_renderer_records_into_the_callers_encoder() {
+    let gpu = engine_gpu(false);
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let mut world = SnowWorld::new(&gpu, WorldConfig::default()).unwrap();
+    let id = roof(&mut world);
+    world.step(1.0 / 30.0, &[foot()]).unwrap();
+    let (w, h) = (48u32, 32u32);
+    let mut config = RenderConfig::new(w, h, Tier::Relief);
+    config.snowflakes = 100;
+    let mut renderer = Renderer::new(&gpu, config).unwrap();
+    let surfaces = [(id, GroundMaterial::Concrete)];
+    let target = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("engine swapchain stand-in"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: OUTPUT_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = target.create_view(&Default::default());
+    let row = 256u32;
+    let pixels = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("engine readback"),
+        size: (row * h) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+
+    let mut encoder = device.create_command_encoder(&Default::default());
+    // The engine's pass before: it clears the target to a colour the snow frame covers.
+    drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("engine pass before"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::RED),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    }));
+    // A world frame with nothing to do, and the snow frame, in the engine's encoder.
+    let snow = world.encode_step(&mut encoder, 0.0, &[]).unwrap();
+    let pending = renderer
+        .encode_to_view(
+            &mut encoder,
+            &world,
+            &frame(&surfaces),
+            &view,
+            OUTPUT_FORMAT,
+        )
+        .unwrap();
+    // The engine's pass after: it copies what the snow frame drew.
+    encoder.copy_texture_to_buffer(
+        target.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &pixels,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        target.size(),
+    );
+    queue.submit([encoder.finish()]);
+    world.submitted(snow).unwrap();
+    let _ = renderer.submitted(pending);
+
+    let padded = download(device, queue, &pixels, 0, (row * h) as u64).unwrap();
+    let drawn: Vec<u8> = padded
+        .chunks(row as usize)
+        .flat_map(|r| r[..4 * w as usize].to_vec())
+        .collect();
+    let offscreen = renderer.render(&world, &frame(&surfaces)).unwrap();
+    assert_eq!(
+        drawn, offscreen.rgba8,
+        "the frame recorded into the engine's encoder is the offscreen frame"
+    );
 }
