@@ -415,7 +415,7 @@ pub fn run(gpu_options: &GpuOptions, args: &Args) -> Result<(), String> {
             "fits": fits,
         },
         "precision_error_vs_32_bit": errors,
-        "adapter": snowprint::gpu::describe(&gpu.info),
+        "adapter": snowprint::low_level::gpu::describe(&gpu.info),
         "timestamps": timestamps,
         "frames": args.frames,
         "warmup": args.warmup,
@@ -500,7 +500,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
     let timestamps = gpu.caps.timestamps;
     println!(
         "adapter: {}\ntimestamps: {}\n",
-        snowprint::gpu::describe(&gpu.info),
+        snowprint::low_level::gpu::describe(&gpu.info),
         if timestamps {
             "per-pass GPU timestamps"
         } else {

@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
+use snowprint::manager::SaveFile;
 use snowprint::manager::UNLIMITED;
-use snowprint::manager::save::SaveFile;
 
 /// Arguments of `snowprint inspect`.
 #[derive(clap::Args, Debug)]

@@ -151,7 +151,9 @@ pub fn frame_error(scene: &Scene, frame: u32, dt: f32, e: &snowprint::SnowError)
             }
             d.map(|d| format!(" (deformer {:?}, {file}:{})", d.name, d.line))
         }
-        snowprint::SnowError::Scene(m) if m.starts_with("camera") => scene
+        snowprint::SnowError::Config {
+            config: "camera", ..
+        } => scene
             .camera
             .as_ref()
             .map(|c| format!(" ([camera], {file}:{})", c.line)),
@@ -338,9 +340,12 @@ mod tests {
 
     #[test]
     fn a_failed_frame_names_the_camera_line_and_nothing_for_other_errors() {
-        let e = snowprint::SnowError::Scene(
-            "camera target is [0, 0, 0], but it must be different from the eye".into(),
-        );
+        let e = snowprint::SnowError::Config {
+            config: "camera",
+            what: "target",
+            value: "[0, 0, 0]".into(),
+            expected: "different from the eye",
+        };
         assert!(
             frame_error(&scene(), 2, 0.5, &e)
                 .contains("failed ([camera], s.toml:3): camera target")

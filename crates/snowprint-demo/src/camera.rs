@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use super::DemoWorld;
-use snowprint::view::Camera;
+use snowprint::Camera;
 
 /// Names accepted by [`DemoWorld::camera`].
 pub const NAMES: [&str; 8] = [

@@ -11,10 +11,10 @@
 
 use glam::{Vec2, Vec3};
 
-use snowprint::deformer::{Deformer, Pose, Shape};
+use snowprint::SurfaceDesc;
 use snowprint::manager::{ManagedDeformer, ZoneId};
-use snowprint::surface::SurfaceDesc;
-use snowprint::view::{Camera, GroundMaterial};
+use snowprint::{Camera, GroundMaterial};
+use snowprint::{Deformer, Pose, Shape};
 
 /// Metres from one block to the next.
 pub const BLOCK_PITCH: f32 = 30.0;

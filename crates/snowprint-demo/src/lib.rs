@@ -47,6 +47,7 @@ pub mod people;
 pub mod plot;
 pub mod scene;
 pub mod skeleton;
+pub mod trudge;
 pub mod world;
 
 use glam::Mat4;
@@ -55,10 +56,10 @@ pub use anim::{Footfall, Motion};
 pub use people::Person;
 pub use skeleton::{BodyPose, PART_COUNT, Part, Side};
 
-use snowprint::deformer::{Deformer, Pose, Shape};
-use snowprint::mesh::{Mesh, MeshId};
-use snowprint::surface::SurfaceDesc;
-use snowprint::view::{Camera, GroundMaterial};
+use snowprint::SurfaceDesc;
+use snowprint::{Camera, GroundMaterial};
+use snowprint::{Deformer, Pose, Shape};
+use snowprint::{Mesh, MeshId};
 
 /// A snow surface of the demo and what lies under its snow.
 #[derive(Clone, Debug, PartialEq)]

@@ -7,7 +7,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use snowprint::TickStats;
-use snowprint::error::{Result, SnowError};
+use snowprint::{Result, SnowError};
 
 const WIDTH: u32 = 960;
 const HEIGHT: u32 = 530;

@@ -11,8 +11,8 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use snowprint::deformer::Pose;
-use snowprint::mesh::Mesh;
+use snowprint::Mesh;
+use snowprint::Pose;
 
 /// Number of body parts.
 pub const PART_COUNT: usize = 15;

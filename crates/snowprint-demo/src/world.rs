@@ -4,9 +4,9 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use super::{DemoSurface, Prop};
-use snowprint::mesh::Mesh;
-use snowprint::surface::SurfaceDesc;
-use snowprint::view::GroundMaterial;
+use snowprint::GroundMaterial;
+use snowprint::Mesh;
+use snowprint::SurfaceDesc;
 
 /// Height of a parapet above its roof's ground, metres.
 pub const PARAPET_HEIGHT: f32 = 0.6;

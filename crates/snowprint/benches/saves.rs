@@ -8,8 +8,8 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use snowprint::manager::pages::Page;
-use snowprint::manager::save::SaveFile;
+use snowprint::low_level::pages::Page;
+use snowprint::manager::SaveFile;
 use snowprint::manager::{ManagedDeformer, ManagerConfig, SnowManager, UNLIMITED, ZoneId};
 use snowprint::{
     Deformer, GpuContext, GpuOptions, PoolFormat, Pose, Shape, SnowWorld, SurfaceDesc, WorldConfig,

@@ -3,7 +3,12 @@
 use std::path::PathBuf;
 
 /// Everything the library can report instead of panicking.
+///
+/// Variants that come from wgpu, I/O or an encoder keep that error as their
+/// [`source`](std::error::Error::source); new variants may be added in any release, so a `match`
+/// needs a `_` arm.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SnowError {
     /// No GPU adapter could be found at all.
     #[error(
@@ -101,6 +106,9 @@ pub enum SnowError {
         path: PathBuf,
         /// Why it could not be used.
         reason: String,
+        /// The I/O error, when the file or its folder could not be opened or read.
+        #[source]
+        source: Option<std::io::Error>,
     },
     /// A mesh file names a buffer or image it may not read: outside the folder it may read from,
     /// an absolute path, a URI with a scheme other than `data:`, or a malformed `data:` URI.
@@ -142,16 +150,74 @@ pub enum SnowError {
         /// The pool's budget.
         budget: u64,
     },
-    /// The GPU did not finish or a readback failed.
+    /// The GPU did not finish or a readback failed, for a reason other than those below.
     #[error("GPU readback failed: {0}")]
     Readback(String),
-    /// Writing an output file failed.
+    /// Waiting for the GPU failed (the device was lost, or the wait timed out).
+    #[error("GPU readback failed: {0}")]
+    Poll(#[from] wgpu::PollError),
+    /// A buffer could not be mapped for reading.
+    #[error("GPU readback failed: {0}")]
+    BufferMap(#[from] wgpu::BufferAsyncError),
+    /// A mapped buffer's range could not be viewed.
+    #[error("GPU readback failed: {0}")]
+    MapRange(#[from] wgpu::MapRangeError),
+    /// Writing an output file failed for a reason of the library's (the I/O errors are
+    /// [`SnowError::WriteFile`]).
     #[error("could not write {}: {reason}", path.display())]
     Output {
         /// The file.
         path: PathBuf,
         /// Why.
         reason: String,
+    },
+    /// Writing a file failed.
+    #[error("could not write {}: {source}", path.display())]
+    WriteFile {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Reading a file failed.
+    #[error("could not read {}: {source}", path.display())]
+    ReadFile {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A PNG file could not be decoded.
+    #[error("could not read {}: {source}", path.display())]
+    PngDecode {
+        /// The file.
+        path: PathBuf,
+        /// The decoder's error.
+        source: png::DecodingError,
+    },
+    /// A PNG that decodes but is not what was asked for (a heightmap is 16-bit greyscale).
+    #[error("could not read {}: {reason}", path.display())]
+    PngFormat {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// Encoding a PNG failed.
+    #[error("PNG encoding failed: {0}")]
+    PngEncode(#[from] png::EncodingError),
+    /// A setting of a configuration ([`WorldConfig`](crate::WorldConfig)'s capture, a
+    /// [`ManagerConfig`](crate::ManagerConfig), a [`CameraView`](crate::CameraView)) is not usable.
+    #[error("{config} {what} is {value}, but it must be {expected}")]
+    Config {
+        /// Which configuration: `capture`, `manager setting` or `camera`.
+        config: &'static str,
+        /// Which field.
+        what: &'static str,
+        /// The offending value, printed.
+        value: String,
+        /// What would be accepted.
+        expected: &'static str,
     },
     /// A time step is not usable.
     #[error("time step {dt} s is not usable: it must be a finite number of seconds, 0 or more")]
@@ -175,9 +241,16 @@ pub enum SnowError {
         /// The surface's index.
         index: u32,
     },
-    /// A scene file is not valid.
+    /// A scene file is not valid: one sentence `<file>:<line>: <what is wrong>; <what to do>`.
     #[error("{0}")]
     Scene(String),
+    /// The contents of a save do not fit together (a planner state, a heightmap section, a pool
+    /// larger than this device allows); the file itself read well.
+    #[error("{0}")]
+    SaveContent(String),
+    /// A save's text sections could not be encoded.
+    #[error("save: {0}")]
+    SaveEncode(#[source] serde_json::Error),
     /// A surface snapshot that does not fit the world it is restored into.
     #[error("the snapshot of surface {name:?} cannot be restored: {reason}")]
     Snapshot {
@@ -193,6 +266,10 @@ pub enum SnowError {
         path: std::path::PathBuf,
         /// What is wrong, and what to do.
         reason: String,
+        /// The error underneath, where there is one (the I/O error of a file that cannot be read,
+        /// the library's error of a save whose parts do not fit together).
+        #[source]
+        source: Option<Box<dyn std::error::Error + Send + Sync>>,
     },
     /// Heights given to [`crate::PoolFormat::encode`] or `decode` do not match the heightmap's
     /// size.
@@ -213,7 +290,98 @@ pub enum SnowError {
         /// How many were given.
         got: usize,
     },
+    /// Every staging buffer of the probe ring holds a batch not yet read back; nothing asked
+    /// before was dropped.
+    #[error(
+        "all {ring} probe batches are in flight ({in_flight} not yet read back): probe again after the next update or SnowWorld::poll_probes"
+    )]
+    ProbeRingFull {
+        /// Batches in flight.
+        in_flight: usize,
+        /// Batches the ring holds.
+        ring: usize,
+    },
+    /// More points were probed between two updates than one batch holds.
+    #[error(
+        "{asked} more probe points would exceed the {max} one batch holds ({queued} already queued): probe fewer, or call SnowWorld::poll_probes to send the queued ones"
+    )]
+    TooManyProbePoints {
+        /// Points in the refused request.
+        asked: usize,
+        /// Points already queued for the next batch.
+        queued: usize,
+        /// Most points a batch holds.
+        max: usize,
+    },
+    /// A probed point is not finite.
+    #[error("probe point #{index} is {value}, but it must be finite")]
+    InvalidProbePoint {
+        /// Its index in the slice given.
+        index: usize,
+        /// The point, printed.
+        value: String,
+    },
+    /// A probe ticket that this world does not know.
+    #[error(
+        "probe ticket {ticket} is unknown: never given by this world, already answered, or forgotten after more newer answers were left unread than the world keeps"
+    )]
+    UnknownProbe {
+        /// The ticket's number.
+        ticket: u64,
+    },
 }
 
 /// Result alias of the library.
 pub type Result<T, E = SnowError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::SnowError;
+    use crate::{Heightmap, ManagerConfig};
+
+    #[test]
+    fn errors_cross_threads() {
+        fn send_sync<T: Send + Sync + 'static>() {}
+        send_sync::<SnowError>();
+        send_sync::<crate::render::RenderError>();
+    }
+
+    #[test]
+    fn a_bad_setting_is_matchable_without_parsing_text() {
+        let bad = ManagerConfig {
+            updates_per_frame: 0,
+            ..ManagerConfig::default()
+        };
+        let e = bad.validate().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                SnowError::Config {
+                    config: "manager setting",
+                    what: "updates_per_frame",
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "manager setting updates_per_frame is 0, but it must be 1 or more"
+        );
+    }
+
+    #[test]
+    fn loading_a_heightmap_that_is_not_a_png_says_it_could_not_read_it() {
+        let dir = std::env::temp_dir().join(format!("snowprint-error-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("not.png");
+        std::fs::write(&path, b"this is text, not a PNG").unwrap();
+        let e = Heightmap::load_png(&path).unwrap_err();
+        assert!(matches!(e, SnowError::PngDecode { .. }), "{e:?}");
+        assert!(e.to_string().starts_with("could not read "), "{e}");
+        assert!(std::error::Error::source(&e).is_some());
+        let missing = Heightmap::load_png(&dir.join("missing.png")).unwrap_err();
+        assert!(matches!(missing, SnowError::ReadFile { .. }), "{missing:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -29,7 +29,7 @@ impl Heightmap {
         }
     }
 
-    /// Convert channels at `precision` (see [`crate::pool`]) to 16-bit units, rounding to nearest.
+    /// Convert channels at `precision` (see [`crate::Precision`]) to 16-bit units, rounding to nearest.
     pub fn from_channels(
         width: u32,
         height: u32,
@@ -65,16 +65,13 @@ impl Heightmap {
             let mut enc = png::Encoder::new(&mut bytes, self.width, self.height);
             enc.set_color(png::ColorType::Grayscale);
             enc.set_depth(png::BitDepth::Sixteen);
-            let mut w = enc
-                .write_header()
-                .map_err(|e| SnowError::Readback(format!("PNG encoding failed: {e}")))?;
+            let mut w = enc.write_header()?;
             let data: Vec<u8> = self
                 .depression
                 .iter()
                 .flat_map(|v| v.to_be_bytes())
                 .collect();
-            w.write_image_data(&data)
-                .map_err(|e| SnowError::Readback(format!("PNG encoding failed: {e}")))?;
+            w.write_image_data(&data)?;
         }
         Ok(bytes)
     }
@@ -82,31 +79,35 @@ impl Heightmap {
     /// Write the depression as a 16-bit greyscale PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
         let bytes = self.to_png()?;
-        std::fs::write(path, bytes).map_err(|e| SnowError::Output {
+        std::fs::write(path, bytes).map_err(|source| SnowError::WriteFile {
             path: path.to_owned(),
-            reason: e.to_string(),
+            source,
         })
     }
 
     /// Read a 16-bit greyscale PNG written by [`Heightmap::save_png`] (displaced is zero).
     pub fn load_png(path: &Path) -> Result<Self> {
-        let err = |reason: String| SnowError::Output {
+        let decode = |source| SnowError::PngDecode {
             path: path.to_owned(),
-            reason,
+            source,
         };
-        let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+        let file = std::fs::File::open(path).map_err(|source| SnowError::ReadFile {
+            path: path.to_owned(),
+            source,
+        })?;
         let mut reader = png::Decoder::new(std::io::BufReader::new(file))
             .read_info()
-            .map_err(|e| err(e.to_string()))?;
+            .map_err(decode)?;
         let info = reader.info().clone();
         if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Sixteen
         {
-            return Err(err("is not a 16-bit greyscale PNG".into()));
+            return Err(SnowError::PngFormat {
+                path: path.to_owned(),
+                reason: "it is not a 16-bit greyscale PNG",
+            });
         }
         let mut buf = vec![0; reader.output_buffer_size().unwrap_or(0)];
-        reader
-            .next_frame(&mut buf)
-            .map_err(|e| err(e.to_string()))?;
+        reader.next_frame(&mut buf).map_err(decode)?;
         let depression: Vec<u16> = buf
             .chunks_exact(2)
             .map(|c| u16::from_be_bytes([c[0], c[1]]))

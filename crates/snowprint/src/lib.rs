@@ -20,23 +20,45 @@
 //! ```
 //!
 //! See `docs/ARCHITECTURE.md` for the data flow from deformers to heightmaps.
+//!
+//! # What to reach for
+//!
+//! | you want | reach for |
+//! |---|---|
+//! | a GPU device, checked for what the passes need | [`GpuContext`], [`GpuOptions`], [`Capabilities`] |
+//! | the engine's own device and command encoder | [`required_features`], [`required_limits`], [`GpuContext::from_device`], [`SnowWorld::encode_update`], [`PendingFrame`], [`render::Renderer::encode_to_view`] |
+//! | snow surfaces stepped by deformers | [`SnowWorld`], [`WorldConfig`], [`SurfaceDesc`], [`Deformer`], [`Shape`], [`Pose`], [`Mesh`] |
+//! | the heightmaps back, or their place in the pool | [`Heightmap`], [`PoolFormat`], [`Precision`], [`FrameView`], [`SurfaceSnapshot`] |
+//! | a city of surfaces paged in and out, saves | [`manager`]: [`SnowManager`], [`ManagerConfig`], [`manager::SaveFile`] |
+//! | scene files (TOML) | [`scene`]: [`scene::Scene`] |
+//! | pictures: the snow material, sky, shadows, falling snow | [`render`]: [`render::Renderer`], [`render::RenderConfig`], [`render::RenderFrame`] |
+//! | the CPU references the GPU passes are tested against | [`reference`](mod@reference) |
+//! | the passes themselves, to drive from an engine or a tool | [`low_level`] |
+//! | the WGSL modules, composed and validated, with their reflected bindings and shared constants | [`wgsl`] |
+//! | errors to match on | [`SnowError`], [`render::RenderError`] (both `#[non_exhaustive]`) |
+//!
+//! The crate re-exports the [`glam`] and [`wgpu`] it is built against, so an engine can name the
+//! same versions.
 
-pub mod accumulate;
-pub mod capture;
-pub mod deformer;
-pub mod error;
+mod accumulate;
+mod capture;
+mod deformer;
+mod error;
 mod extract;
-pub mod gpu;
-pub mod heightmap;
+mod gpu;
+mod heightmap;
 pub mod manager;
-pub mod mesh;
-pub mod pool;
+mod mesh;
+mod pool;
 pub mod render;
 pub mod scene;
-pub mod surface;
-pub mod view;
+mod surface;
+mod view;
 pub mod wgsl;
-pub mod world;
+mod world;
+
+pub use glam;
+pub use wgpu;
 
 pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};
 pub use error::{Result, SnowError};
@@ -46,11 +68,106 @@ pub use heightmap::Heightmap;
 pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
 };
-pub use mesh::{Mesh, MeshId};
+pub use mesh::{
+    MAX_GLTF_DEPTH, MAX_GLTF_FILE_BYTES, MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_GLTF_VERTICES,
+    Mesh, MeshId,
+};
 pub use pool::{PoolFormat, Precision};
-pub use surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
     CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, PendingFrame, SnowWorld,
     StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
+pub use world::{
+    Footstep, MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus,
+    ProbeTicket,
+};
+
+/// CPU references of the GPU passes: the same maths on the same inputs and layouts, written for
+/// clarity, against which the tests compare the GPU's results texel by texel.
+pub mod reference {
+    /// The capture's ray cast from below: depth of capsules, boxes and triangle meshes per texel.
+    pub mod capture {
+        pub use crate::capture::cpu::*;
+    }
+    /// The accumulation: blur, merge into the history, normals (also what the fused pass computes).
+    pub mod accumulate {
+        pub use crate::accumulate::cpu::*;
+    }
+    /// The snow material: Reoriented Normal Mapping, relief and parallax occlusion search, Sobel
+    /// normals, light visibility and horizon ambient occlusion.
+    pub mod material {
+        pub use crate::render::cpu::*;
+    }
+    /// The tessellated tier: the bank field raised beside a print and the dicing topology.
+    pub mod tessellate {
+        pub use crate::render::tessellate::cpu::*;
+    }
+}
+
+/// The pieces an engine or a tool may need that are not the everyday API: the world's frame plan,
+/// the capture and accumulation pipelines and their `encode`, the pool's allocator and surface
+/// records, the render graph's pass table, the manager's imprint queue and pages, GPU readback and
+/// timestamps. These follow the internals and change more often than the crate root.
+pub mod low_level {
+    /// The world's plan of a frame, made on the CPU before anything is encoded.
+    pub mod world {
+        pub use crate::world::plan::*;
+    }
+    /// The capture pass: pipelines, primitives, atlas packing and `encode`.
+    pub mod capture {
+        pub use crate::capture::{
+            ATLAS_FORMAT, AtlasPlacement, CaptureBuffers, CaptureMesh, CapturePipelines,
+            CapturePlan, CaptureView, CaptureVolume, CapturedSurface, GpuPrimitive,
+            MAX_MESH_SUBSTEPS, MAX_SUBSTEPS, MESH_STEP, MeshDraw, NO_LIST, ONE_BITS, PRIM_BOX,
+            PRIM_CAPSULE, decode_depth, encode, encode_depth, mesh_substeps, pack_atlas,
+            pack_atlas_compact, push_mesh_draws, push_primitives, substeps,
+        };
+    }
+    /// The accumulation passes: pipelines and `encode`.
+    pub mod accumulate {
+        pub use crate::accumulate::{
+            AccumulateBuffers, AccumulatePipelines, AccumulatePlan, TILE_LIST_HEADER, WORKGROUP,
+            encode,
+        };
+    }
+    /// The heightmap pool: slot allocator and the per-surface record the passes read.
+    pub mod pool {
+        pub use crate::pool::{
+            MODE_MESHES, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN, Slot, SlotAllocator, SurfaceRecord,
+            TILE_LIST_HEADER, TILE_SIDE,
+        };
+    }
+    /// The render graph: the pass table and its check.
+    pub mod graph {
+        pub use crate::render::graph::*;
+    }
+    /// The renderer's GPU-side structs (uniforms, records, vertex layouts), laid out as in WGSL.
+    pub mod render {
+        pub use crate::render::geometry::*;
+        pub use crate::render::gpu::*;
+    }
+    /// The tessellated tier's GPU records: base triangles, dicing and bank parameters, the
+    /// counters and indirect arguments the dicing pass writes.
+    pub mod tessellate {
+        pub use crate::render::tessellate::{
+            ARGS_BASE, ARGS_STRIDE, BankParams, BaseTriangle, COUNTER_INDICES, COUNTER_OVERFLOW,
+            COUNTER_VERTICES, DiceParams, MAX_BASE_TRIANGLES, MAX_LEVEL, VERTEX_BYTES,
+        };
+    }
+    /// GPU readback and timestamp queries, and the adapter checks.
+    pub mod gpu {
+        pub use crate::gpu::readback::*;
+        pub use crate::gpu::timestamps::*;
+        pub use crate::gpu::{REQUIRED_DOWNLEVEL, check_device, describe, missing_capabilities};
+    }
+    /// The manager's per-surface imprint queue (merging, bounding).
+    pub mod queue {
+        pub use crate::manager::queue::*;
+    }
+    /// Compressed pages of surfaces paged out of the pool.
+    pub mod pages {
+        pub use crate::manager::pages::*;
+    }
+}

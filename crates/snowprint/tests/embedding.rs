@@ -3,7 +3,7 @@
 //! GPU times that never make the frame wait.
 
 use glam::Vec3;
-use snowprint::gpu::readback::download;
+use snowprint::low_level::gpu::download;
 use snowprint::render::{
     Environment, OUTPUT_FORMAT, RenderConfig, RenderError, RenderFrame, Renderer, Tier,
 };

@@ -21,7 +21,7 @@ use fuzz_support::{Watchdog, cases, config, finish};
 use glam::Vec3;
 use proptest::prelude::*;
 use proptest::test_runner::TestRunner;
-use snowprint::manager::save::SaveFile;
+use snowprint::manager::SaveFile;
 use snowprint::manager::{ManagedDeformer, ManagerConfig, SnowManager, ZoneId};
 use snowprint::{Deformer, Mesh, Pose, Shape, SurfaceDesc};
 

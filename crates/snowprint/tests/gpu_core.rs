@@ -4,8 +4,9 @@
 mod common;
 
 use glam::{Quat, Vec2, Vec3};
-use snowprint::accumulate::cpu::{self as acc_cpu, BlurInput};
-use snowprint::capture::{self, CaptureVolume, cpu as cap_cpu};
+use snowprint::low_level::capture::{self, CaptureVolume};
+use snowprint::reference::accumulate::{self as acc_cpu, BlurInput};
+use snowprint::reference::capture as cap_cpu;
 use snowprint::{
     CaptureConfig, CaptureMode, Deformer, Mesh, PassMode, PoolFormat, Pose, Precision, Shape,
     SnowError, SnowWorld, SurfaceDesc, WorldConfig,
@@ -1152,7 +1153,10 @@ fn moving_mesh_is_swept_within_a_frame() {
         )
         .unwrap();
     // 0.5 m at most 3 cm a step: capped at 8 draws.
-    assert_eq!(stats.mesh_draws, snowprint::capture::MAX_MESH_SUBSTEPS);
+    assert_eq!(
+        stats.mesh_draws,
+        snowprint::low_level::capture::MAX_MESH_SUBSTEPS
+    );
     let map = w.read_heightmap(id).unwrap();
     let row = map.height / 2;
     // 4 cm texels, x = -0.25 .. 0.25 is columns 19 .. 31: every column between is pressed.

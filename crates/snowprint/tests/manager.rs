@@ -9,12 +9,12 @@ use std::collections::HashMap;
 
 use glam::{Quat, Vec3};
 use proptest::prelude::*;
-use snowprint::manager::queue;
+use snowprint::PoolFormat;
+use snowprint::low_level::queue;
 use snowprint::manager::{
     CameraView, CatchUp, Lookup, ManagedDeformer, ManagedId, ManagerConfig, Planner,
     ResidencyChange, SnowManager, UNLIMITED, ZoneId,
 };
-use snowprint::pool::PoolFormat;
 
 /// Pool bytes of a surface's slot in the managers' default format.
 fn slot_bytes(layout: snowprint::SurfaceLayout) -> u64 {

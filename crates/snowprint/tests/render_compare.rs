@@ -1,4 +1,4 @@
-//! The snow material's GPU maths against their CPU references (`snowprint::render::cpu`), on the
+//! The snow material's GPU maths against their CPU references (`snowprint::reference::material`), on the
 //! same inputs: the heightfield pass (Sobel normals, horizon AO, moon visibility) on a synthetic
 //! heightmap, and the relief search, POM search and RNM of `snow.wgsl` run in a compute harness on
 //! analytic heightfields.
@@ -6,9 +6,8 @@
 mod common;
 
 use glam::{Vec2, Vec3};
-use snowprint::render::cpu;
-use snowprint::render::gpu::HeightfieldParams;
-use snowprint::render::shaders;
+use snowprint::low_level::render::HeightfieldParams;
+use snowprint::reference::material as cpu;
 use wgpu::util::DeviceExt;
 
 fn f16_to_f32(h: u16) -> f32 {
@@ -121,7 +120,7 @@ fn heightfield_pass_matches_its_cpu_reference() {
     let (shape, lit) = (texture(), texture());
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("heightfield.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(shaders::heightfield().into()),
+        source: wgpu::ShaderSource::Wgsl(snowprint::wgsl::HEIGHTFIELD.source.into()),
     });
     let pipeline = dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: None,
@@ -375,7 +374,7 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
         .flat_map(|(a, b)| [[a.x, a.y, a.z, 0.0], [b.x, b.y, b.z, 0.0]])
         .collect();
 
-    let source = format!("{}\n{HARNESS}", shaders::SNOW);
+    let source = format!("{}\n{HARNESS}", snowprint::wgsl::files::SNOW);
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("snow.wgsl harness"),
         source: wgpu::ShaderSource::Wgsl(source.into()),

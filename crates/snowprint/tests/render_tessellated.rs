@@ -7,7 +7,8 @@ mod common;
 use std::collections::HashMap;
 
 use glam::{Quat, Vec2, Vec3};
-use snowprint::render::tessellate::{BankSettings, DicedKind, DicedMesh, SurfaceGeometry, cpu};
+use snowprint::reference::tessellate as cpu;
+use snowprint::render::{BankSettings, DicedKind, DicedMesh, SurfaceGeometry};
 use snowprint::render::{
     DebugView, Environment, RenderConfig, RenderError, RenderFrame, RenderOutput, Renderer,
     SurfaceMesh, Tier,

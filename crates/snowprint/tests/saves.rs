@@ -5,7 +5,7 @@
 mod common;
 
 use glam::Vec3;
-use snowprint::manager::save::SaveFile;
+use snowprint::manager::SaveFile;
 use snowprint::manager::{ManagedDeformer, ManagedId, ManagerConfig, SnowManager, ZoneId};
 use snowprint::{
     Deformer, Heightmap, Mesh, MeshId, PoolFormat, Pose, Precision, Shape, SnowError, SurfaceDesc,

@@ -13,37 +13,16 @@
 //!
 //! CPU reference: [`cpu`].
 
-pub mod cpu;
+pub(crate) mod cpu;
 mod encode;
 
 pub use encode::{AccumulateBuffers, AccumulatePlan, encode};
 
-use crate::gpu::resources::compute_storage;
 use crate::pool::Precision;
 
-use crate::wgsl::{ShaderModule, files};
+use crate::wgsl::ShaderModule;
 
-/// Record layout shared by every pass.
-pub const SHARED: &str = files::SHARED;
-/// Stage 1 (without its imports).
-pub const BLUR_SHADER: &str = files::BLUR;
-/// Stage 2 (without its imports).
-pub const MERGE_SHADER: &str = files::MERGE;
-/// Normals (without its imports).
-pub const NORMALS_SHADER: &str = files::NORMALS;
-/// Blur and merge in one pass (without its imports).
-pub const FUSED_SHADER: &str = files::FUSED;
-/// The indirect arguments of the listed fused pass (without its imports).
-pub const SEAL_SHADER: &str = files::SEAL;
 pub use crate::pool::TILE_LIST_HEADER;
-/// The arithmetic shared by every stage.
-pub const MATHS: &str = files::MATHS;
-/// Reading the capture buffer (for the passes that bind it).
-pub const CAPTURE_READ: &str = files::CAPTURE_READ;
-/// Reading heights from the pool at any precision.
-pub const TEXEL_READ: &str = files::TEXEL;
-/// Writing heights to the pool at any precision.
-pub const TEXEL_WRITE: &str = files::TEXEL_WRITE;
 
 /// Workgroup side of the separate accumulation passes.
 pub const WORKGROUP: u32 = crate::wgsl::consts::WORKGROUP;
@@ -79,42 +58,13 @@ pub struct AccumulatePipelines {
 impl AccumulatePipelines {
     /// Compile the passes for heightmaps of `precision`.
     pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
-        let blur_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("blur"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, true),
-                compute_storage(3, false),
-            ],
-        });
-        let merge_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("merge"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-            ],
-        });
-        let fused_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fused"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-                compute_storage(3, true),
-                compute_storage(4, true),
-                compute_storage(5, true),
-            ],
-        });
-        let seal_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("seal"),
-            entries: &[compute_storage(0, false)],
-        });
-        let normals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("normals"),
-            entries: &[compute_storage(0, true), compute_storage(1, false)],
-        });
+        use crate::wgsl::{BLUR, FUSED, MERGE, NORMALS, SEAL};
+        let blur_layout = BLUR.bind_group_layout(device, "blur", 0);
+        let merge_layout = MERGE.bind_group_layout(device, "merge", 0);
+        // One layout for both fused entry points: the module's group 0 covers what either reads.
+        let fused_layout = FUSED.bind_group_layout(device, "fused", 0);
+        let seal_layout = SEAL.bind_group_layout(device, "seal", 0);
+        let normals_layout = NORMALS.bind_group_layout(device, "normals", 0);
         let constants = [("PRECISION", precision.bits() as f64)];
         let make = |name: &str, shader: &ShaderModule, layout: &wgpu::BindGroupLayout| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -140,12 +90,12 @@ impl AccumulatePipelines {
             })
         };
         Self {
-            blur: make("blur", &crate::wgsl::BLUR, &blur_layout),
-            merge: make("merge", &crate::wgsl::MERGE, &merge_layout),
-            normals: make("normals", &crate::wgsl::NORMALS, &normals_layout),
-            fused: make("fused", &crate::wgsl::FUSED, &fused_layout),
-            fused_listed: make("fused_listed", &crate::wgsl::FUSED, &fused_layout),
-            seal: make("seal_tiles", &crate::wgsl::SEAL, &seal_layout),
+            blur: make("blur", &BLUR, &blur_layout),
+            merge: make("merge", &MERGE, &merge_layout),
+            normals: make("normals", &NORMALS, &normals_layout),
+            fused: make("fused", &FUSED, &fused_layout),
+            fused_listed: make("fused_listed", &FUSED, &fused_layout),
+            seal: make("seal_tiles", &SEAL, &seal_layout),
             seal_layout,
             blur_layout,
             merge_layout,

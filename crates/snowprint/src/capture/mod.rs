@@ -14,7 +14,7 @@
 //!
 //! CPU reference: [`cpu`].
 
-pub mod cpu;
+pub(crate) mod cpu;
 mod encode;
 
 pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode};
@@ -347,51 +347,8 @@ impl CapturePipelines {
             label: Some("capture.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
         });
-        let uniform = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let fragment_storage = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: false },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("capture view"),
-            entries: &[
-                uniform(0, vf),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                fragment_storage(2),
-                fragment_storage(3),
-                fragment_storage(4),
-                fragment_storage(5),
-            ],
-        });
-        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("capture mesh draw"),
-            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
-        });
+        let view_layout = crate::wgsl::CAPTURE.bind_group_layout(device, "capture view", 0);
+        let draw_layout = crate::wgsl::CAPTURE.bind_group_layout(device, "capture mesh draw", 1);
         let prim_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("capture primitives"),
             bind_group_layouts: &[Some(&view_layout)],

@@ -8,10 +8,10 @@
 //! and hands it over with [`GpuContext::from_device`], which checks them.
 
 mod limits;
-pub mod readback;
+pub(crate) mod readback;
 pub(crate) mod resources;
 pub(crate) mod ring;
-pub mod timestamps;
+pub(crate) mod timestamps;
 
 pub use limits::{check_device, required_features, required_limits};
 
@@ -269,6 +269,6 @@ impl GpuContext {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| SnowError::Readback(e.to_string()))
+            .map_err(SnowError::from)
     }
 }

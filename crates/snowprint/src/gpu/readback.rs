@@ -16,16 +16,10 @@ pub fn map_read(
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| SnowError::Readback(e.to_string()))?;
+    device.poll(wgpu::PollType::wait_indefinitely())?;
     rx.recv()
-        .map_err(|e| SnowError::Readback(e.to_string()))?
-        .map_err(|e| SnowError::Readback(e.to_string()))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| SnowError::Readback(format!("{e:?}")))?
-        .to_vec();
+        .map_err(|e| SnowError::Readback(e.to_string()))??;
+    let data = slice.get_mapped_range()?.to_vec();
     buffer.unmap();
     Ok(data)
 }

@@ -11,7 +11,7 @@ pub(crate) struct Growable {
 
 impl Growable {
     /// A buffer of at least `size` bytes (16 at least, so that it can always be bound).
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         label: &'static str,
         usage: wgpu::BufferUsages,
@@ -31,38 +31,10 @@ impl Growable {
     }
 
     /// Make sure the buffer holds at least `size` bytes.
-    pub fn ensure(&mut self, device: &wgpu::Device, size: u64) {
+    pub(crate) fn ensure(&mut self, device: &wgpu::Device, size: u64) {
         if self.buffer.size() < size {
             *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
         }
-    }
-}
-
-/// A storage buffer binding seen by compute shaders.
-pub(crate) fn compute_storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-/// A uniform buffer binding (no dynamic offset).
-pub(crate) fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
     }
 }
 

@@ -38,10 +38,13 @@ impl CameraView {
 
     /// The six planes of the view, checking every field.
     pub fn frustum(&self) -> Result<Frustum> {
-        let bad = |what: &str, value: String, expected: &str| {
-            Err(SnowError::Scene(format!(
-                "camera {what} is {value}, but it must be {expected}"
-            )))
+        let bad = |what: &'static str, value: String, expected: &'static str| {
+            Err(SnowError::Config {
+                config: "camera",
+                what,
+                value,
+                expected,
+            })
         };
         if !self.eye.is_finite() || !self.target.is_finite() {
             return bad(

@@ -23,7 +23,7 @@ pub struct ManagerConfig {
     pub player_slots: usize,
     /// Most imprints kept queued on a surface that waits for its update (default 1024, about
     /// 96 bytes each); past it, neighbouring entries merge into covering sweeps (see
-    /// [`super::queue`]). A surface updated in a frame takes its whole queue, however long.
+    /// [`crate::low_level::queue`]). A surface updated in a frame takes its whole queue, however long.
     pub queue_cap: usize,
     /// Bytes the page store may hold (evicted heightmaps, compressed); default unlimited
     /// (`u64::MAX`). A surface is evicted only when the store has room for its whole slot, so a
@@ -82,10 +82,13 @@ impl Default for ManagerConfig {
 impl ManagerConfig {
     /// Check every field, naming the first one that is wrong.
     pub fn validate(&self) -> Result<()> {
-        let bad = |what: &str, value: String, expected: &str| {
-            Err(SnowError::Scene(format!(
-                "manager setting {what} is {value}, but it must be {expected}"
-            )))
+        let bad = |what: &'static str, value: String, expected: &'static str| {
+            Err(SnowError::Config {
+                config: "manager setting",
+                what,
+                value,
+                expected,
+            })
         };
         if self.updates_per_frame == 0 {
             return bad("updates_per_frame", "0".into(), "1 or more");

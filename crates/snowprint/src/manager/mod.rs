@@ -34,11 +34,11 @@
 //! See `docs/MANAGER.md` for the priority rule, the starvation bound, the queue bound, the eviction
 //! order and the memory accounting.
 
-pub mod pages;
-pub mod planner;
-pub mod quadtree;
-pub mod queue;
-pub mod save;
+pub(crate) mod pages;
+pub(crate) mod planner;
+pub(crate) mod quadtree;
+pub(crate) mod queue;
+pub(crate) mod save;
 
 mod apply;
 mod camera;
@@ -53,6 +53,7 @@ pub use quadtree::{Aabb, SurfaceIndex};
 use apply::{apply_changes, update_planned};
 pub use camera::{CameraView, Frustum};
 pub use config::{CatchUp, ManagerConfig, UNLIMITED};
+pub use save::{SaveFile, SavedSurface, Section};
 pub use stats::TickStats;
 
 use crate::deformer::{Deformer, Shape};

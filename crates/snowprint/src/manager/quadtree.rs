@@ -15,9 +15,9 @@
 use glam::Vec3;
 
 /// Most items a leaf holds before it is split (unless splitting would not separate them).
-pub const LEAF_CAPACITY: usize = 8;
+pub(crate) const LEAF_CAPACITY: usize = 8;
 /// Deepest level of the tree.
-pub const MAX_DEPTH: u32 = 14;
+pub(crate) const MAX_DEPTH: u32 = 14;
 
 /// An axis-aligned box in world space, closed on every side.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -20,12 +20,6 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// WGSL that reads a surface's heights from a `pool: array<u32>` binding at any precision
-/// (`pool_texel`, `pool_fractions`, `channel_max`), for renderers that sample the pool.
-pub const TEXEL_WGSL: &str = crate::wgsl::libraries::TEXEL;
-/// WGSL of `channel_max(bits)` alone (part of [`TEXEL_WGSL`]).
-pub const CHANNELS_WGSL: &str = crate::wgsl::files::CHANNELS;
-
 /// Side of the update's tiles, texels: the fused pass's workgroup, and the unit in which the
 /// capture flags what it wrote (`TILE` of `wgsl/constants.wgsl`).
 pub const TILE_SIDE: u32 = crate::wgsl::consts::TILE;

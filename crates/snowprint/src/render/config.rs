@@ -17,7 +17,7 @@ pub enum Tier {
     /// Parallax occlusion mapping: more taps, secant refinement, self-shadowing.
     Pom,
     /// Real geometry: each surface's mesh diced on the GPU by screen size and relief, displaced by
-    /// the heightmap, banks and macro waves, drawn into the shadow map ([`tessellate`]).
+    /// the heightmap, banks and macro waves, drawn into the shadow map ([`crate::reference::tessellate`]).
     Tessellated,
 }
 

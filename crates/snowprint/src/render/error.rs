@@ -3,7 +3,12 @@
 use crate::error::SnowError;
 
 /// What the renderer can report instead of panicking.
+///
+/// Variants that come from wgpu or the world keep that error as their
+/// [`source`](std::error::Error::source); new variants may be added in any release, so a `match`
+/// needs a `_` arm.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum RenderError {
     /// A setting of [`RenderConfig`](super::RenderConfig) is not usable.
     #[error("render setting {what} is {value}, but it must be {expected}")]
@@ -44,13 +49,22 @@ pub enum RenderError {
     /// The world refused a request (a stale surface handle, an invalid mesh).
     #[error(transparent)]
     World(#[from] SnowError),
-    /// The GPU did not finish or a readback failed.
+    /// The GPU did not finish or a readback failed, for a reason other than those below.
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// Waiting for the GPU failed (the device was lost, or the wait timed out).
+    #[error("GPU readback failed: {0}")]
+    Poll(#[from] wgpu::PollError),
+    /// A buffer could not be mapped for reading.
+    #[error("GPU readback failed: {0}")]
+    BufferMap(#[from] wgpu::BufferAsyncError),
+    /// A mapped buffer's range could not be viewed.
+    #[error("GPU readback failed: {0}")]
+    MapRange(#[from] wgpu::MapRangeError),
     /// The GPU refused a pipeline or a frame (a driver that cannot compile a shader, a limit
-    /// exceeded); wgpu's message is kept.
+    /// exceeded); wgpu's error is kept as the source.
     #[error("the GPU refused the renderer's work: {0}")]
-    Gpu(String),
+    Gpu(#[from] wgpu::Error),
 }
 
 /// Result of the renderer.

@@ -30,7 +30,7 @@ pub(super) struct MeshSet {
 }
 
 impl MeshSet {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
         Self {
             meshes: Vec::new(),
             instances: Growable::new(
@@ -45,14 +45,14 @@ impl MeshSet {
     }
 
     /// Register a mesh; normals are computed here (smooth, split at creases).
-    pub fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
+    pub(super) fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
         let gpu = upload(device, mesh)?;
         self.meshes.push(gpu);
         Ok(RenderMeshId(self.meshes.len() as u32 - 1))
     }
 
     /// Replace a registered mesh.
-    pub fn update(
+    pub(super) fn update(
         &mut self,
         device: &wgpu::Device,
         id: RenderMeshId,
@@ -67,7 +67,12 @@ impl MeshSet {
 
     /// Upload the frame's instances: all of them grouped by mesh, then the shadow casters grouped
     /// by mesh.
-    pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &[Instance]) {
+    pub(super) fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &[Instance],
+    ) {
         let mut order: Vec<usize> = (0..frame.len()).collect();
         order.sort_by_key(|&i| frame[i].mesh.0);
         let raw = |inst: &Instance| {
@@ -114,7 +119,7 @@ impl MeshSet {
     }
 
     /// Whether the frame has instances (`shadow`: shadow casters) to draw.
-    pub fn has_draws(&self, shadow: bool) -> bool {
+    pub(super) fn has_draws(&self, shadow: bool) -> bool {
         !if shadow {
             &self.shadow_draws
         } else {
@@ -125,7 +130,7 @@ impl MeshSet {
 
     /// Draw the frame's instances (`shadow`: the shadow casters) with the pass's pipeline and
     /// bind groups set.
-    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, shadow: bool) {
+    pub(super) fn draw(&self, p: &mut wgpu::RenderPass<'_>, shadow: bool) {
         p.set_vertex_buffer(1, self.instances.buffer.slice(..));
         let runs = if shadow {
             &self.shadow_draws

@@ -31,7 +31,7 @@
 //! the world once, through [`SnowWorld::frame_view`](crate::SnowWorld::frame_view).
 //!
 //! The material is the WGSL module [`SNOW_WGSL`], which another renderer can import (see the
-//! header of `snow.wgsl` and `docs/RENDERING.md`). Its maths have CPU references in [`cpu`].
+//! header of `snow.wgsl` and `docs/RENDERING.md`). Its maths have CPU references in [`crate::reference::material`].
 //!
 //! ```no_run
 //! use glam::{Mat4, Vec3};
@@ -62,12 +62,12 @@
 mod cascades;
 mod classify;
 mod config;
-pub mod cpu;
+pub(crate) mod cpu;
 mod error;
 mod frame;
-pub mod geometry;
-pub mod gpu;
-pub mod graph;
+pub(crate) mod geometry;
+pub(crate) mod gpu;
+pub(crate) mod graph;
 mod heightfield;
 mod inputs;
 mod meshes;
@@ -75,14 +75,13 @@ mod opaque;
 mod pipeline;
 mod readback;
 mod report;
-pub mod shaders;
 mod shadow;
 mod sky;
 mod snow;
 mod snowfall;
 mod stats;
 mod targets;
-pub mod tessellate;
+pub(crate) mod tessellate;
 mod tonemap;
 
 use std::collections::HashMap;
@@ -114,7 +113,7 @@ pub use tessellate::{
 };
 
 /// The snow material as a WGSL module (no bindings, no entry points), for renderers of your own.
-pub const SNOW_WGSL: &str = shaders::SNOW;
+pub const SNOW_WGSL: &str = crate::wgsl::files::SNOW;
 
 /// A frame recorded into a caller's command encoder by [`Renderer::encode_to_view`], waiting
 /// for the caller's `queue.submit`; give it to [`Renderer::submitted`] after submitting.
@@ -228,7 +227,7 @@ impl Renderer {
             config,
         };
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(RenderError::Gpu(e));
         }
         Ok(renderer)
     }
@@ -360,7 +359,7 @@ impl Renderer {
         self.copy_stats(&mut encoder, surfaces);
         self.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(RenderError::Gpu(e));
         }
         self.stats.start_map();
 
@@ -369,17 +368,12 @@ impl Renderer {
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        self.device.poll(wgpu::PollType::wait_indefinitely())?;
         rx.recv()
-            .map_err(|e| RenderError::Readback(e.to_string()))?
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+            .map_err(|e| RenderError::Readback(e.to_string()))??;
         let mut rgba8 = Vec::with_capacity((w * h * 4) as usize);
         {
-            let data = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
+            let data = slice.get_mapped_range()?;
             for row in 0..h as usize {
                 let o = row * self.targets.padded_row as usize;
                 rgba8.extend_from_slice(&data[o..o + w as usize * 4]);
@@ -416,7 +410,7 @@ impl Renderer {
         let pending = self.encode_to_view(&mut encoder, world, frame, target, format)?;
         self.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
+            return Err(RenderError::Gpu(e));
         }
         Ok(self.submitted(pending))
     }

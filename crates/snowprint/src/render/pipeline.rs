@@ -1,7 +1,7 @@
 //! Small builders shared by the passes: shader modules, pipeline layouts, compute and render
 //! pipelines, depth states and layout entries.
 
-use super::targets::{DEPTH_FORMAT, HEIGHTFIELD_FORMAT};
+use super::targets::DEPTH_FORMAT;
 
 /// A WGSL shader module.
 pub(super) fn shader(device: &wgpu::Device, label: &str, source: String) -> wgpu::ShaderModule {
@@ -59,7 +59,7 @@ pub(super) struct Raster<'a> {
 }
 
 impl Raster<'_> {
-    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(super) fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(self.label),
             layout: Some(&layout(device, self.label, self.groups)),
@@ -172,35 +172,4 @@ pub(super) fn shadow_depth_state() -> Option<wgpu::DepthStencilState> {
         },
         ..d
     })
-}
-
-/// A 2D texture read in the fragment stage.
-pub(super) fn texture_entry(
-    binding: u32,
-    sample_type: wgpu::TextureSampleType,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
-
-/// A heightfield texture written by a compute pass.
-pub(super) fn storage_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format: HEIGHTFIELD_FORMAT,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        },
-        count: None,
-    }
 }

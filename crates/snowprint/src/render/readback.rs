@@ -25,6 +25,9 @@ pub(super) fn map_staging(device: &wgpu::Device, staging: &wgpu::Buffer) -> Rend
 fn readback_error(e: crate::SnowError) -> RenderError {
     match e {
         crate::SnowError::Readback(reason) => RenderError::Readback(reason),
+        crate::SnowError::Poll(e) => RenderError::Poll(e),
+        crate::SnowError::BufferMap(e) => RenderError::BufferMap(e),
+        crate::SnowError::MapRange(e) => RenderError::MapRange(e),
         other => RenderError::Readback(other.to_string()),
     }
 }

@@ -47,7 +47,7 @@ pub struct FrameReport {
     /// Each surface drawn and its material.
     pub surfaces: Vec<SurfaceShading>,
     /// Base triangles the dicing pass dropped for want of room
-    /// ([`DiceSettings::max_triangles`]); 0 when everything fit.
+    /// ([`DiceSettings::max_triangles`](super::DiceSettings::max_triangles)); 0 when everything fit.
     pub dice_overflow: u32,
 }
 

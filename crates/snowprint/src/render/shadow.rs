@@ -19,7 +19,7 @@ pub(super) struct ShadowPass {
 }
 
 impl ShadowPass {
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         mesh_module: &wgpu::ShaderModule,
         shadow_layout: &wgpu::BindGroupLayout,
@@ -73,7 +73,7 @@ impl ShadowPass {
 
     /// A render pass into one cascade (`clear`: the first to draw into it this frame); the
     /// pass's timestamps open with the near cascade and close with the far one.
-    pub fn cascade_pass<'e>(
+    pub(super) fn cascade_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
@@ -104,7 +104,7 @@ impl ShadowPass {
     }
 
     /// Both cascades, the near one first; the pass's timestamps span both.
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -36,7 +36,7 @@ pub(super) struct StatsSources<'a> {
 }
 
 impl StatsReadback {
-    pub fn new(device: &wgpu::Device) -> Self {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
         Self {
             buffer: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("render stats readback"),
@@ -51,12 +51,12 @@ impl StatsReadback {
     }
 
     /// Whether no readback is in flight (the buffer can take a new frame's copy).
-    pub fn is_idle(&self) -> bool {
+    pub(super) fn is_idle(&self) -> bool {
         self.state.load(Ordering::Acquire) == MAP_IDLE
     }
 
     /// Copy the frame's state words, counters and timestamps into the readback buffer.
-    pub fn copy(
+    pub(super) fn copy(
         &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
@@ -103,7 +103,7 @@ impl StatsReadback {
     }
 
     /// Start mapping the buffer (after the frame's submission).
-    pub fn start_map(&mut self) {
+    pub(super) fn start_map(&mut self) {
         let state = self.state.clone();
         state.store(MAP_PENDING, Ordering::Release);
         self.buffer
@@ -118,7 +118,7 @@ impl StatsReadback {
 
     /// The report when the readback has arrived (waiting for it when `wait`); `None` when
     /// nothing was in flight or it has not arrived yet.
-    pub fn finish(
+    pub(super) fn finish(
         &mut self,
         device: &wgpu::Device,
         timestamps: Option<&Timestamps>,
@@ -132,9 +132,7 @@ impl StatsReadback {
         } else {
             wgpu::PollType::Poll
         };
-        device
-            .poll(poll)
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        device.poll(poll)?;
         match self.state.load(Ordering::Acquire) {
             MAP_READY => {}
             MAP_FAILED => {
@@ -146,11 +144,7 @@ impl StatsReadback {
             _ => return Ok(None),
         }
         let report = {
-            let data = self
-                .buffer
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
+            let data = self.buffer.slice(..).get_mapped_range()?;
             self.report(&data, timestamps)
         };
         self.buffer.unmap();

@@ -18,7 +18,7 @@ pub(super) struct Targets {
 }
 
 impl Targets {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32, supersample: u32) -> Self {
+    pub(super) fn new(device: &wgpu::Device, width: u32, height: u32, supersample: u32) -> Self {
         let texture = |label, w, h, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -77,7 +77,7 @@ impl Targets {
     }
 
     /// The scene colour as a pass's only colour attachment.
-    pub fn color(
+    pub(super) fn color(
         &self,
         load: wgpu::LoadOp<wgpu::Color>,
     ) -> [Option<wgpu::RenderPassColorAttachment<'_>>; 1] {
@@ -93,7 +93,7 @@ impl Targets {
     }
 
     /// The scene depth as a pass's depth attachment (`None`: read-only).
-    pub fn depth(
+    pub(super) fn depth(
         &self,
         ops: Option<wgpu::Operations<f32>>,
     ) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {

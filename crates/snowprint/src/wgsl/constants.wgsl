@@ -28,8 +28,7 @@ const MODE_MESHES: u32 = 2u;
 const PRIM_CAPSULE: u32 = 0u;
 // Primitive kind of a capture primitive: an oriented box.
 const PRIM_BOX: u32 = 1u;
-// Words per surface in the renderer's surface state table (written by classify.wgsl, which keeps
-// its own copy, checked by a test: it does not import this module).
+// Words per surface in the renderer's surface state table (written by classify.wgsl).
 const STATE_WORDS: u32 = 16u;
 // Word of a surface's state holding the "deformed" flag.
 const STATE_TOUCHED: u32 = 11u;

@@ -5,8 +5,9 @@
 //! entry module's imports (once each, recursively) before its own text, validates the result with
 //! naga (a broken shader fails `cargo build` with the module and the file and line of the error),
 //! and reflects its bindings: group, binding, the stages of the entry points that use it, and the
-//! binding's type. [`ShaderModule::layout_entries`] turns them into bind-group layout entries; what
-//! naga cannot know (whether a float texture or a sampler filters, dynamic offsets) comes from
+//! binding's type. [`ShaderModule::layout_entries`] turns them into bind-group layout entries, from
+//! which every pipeline's layouts are made (a binding is declared once, in WGSL); what naga cannot
+//! know (whether a float texture or a sampler filters, dynamic offsets) comes from
 //! [`OVERRIDES`]. The constants that Rust and WGSL share are defined once, in
 //! `src/wgsl/constants.wgsl`, and reflected into [`consts`].
 //!
@@ -231,6 +232,31 @@ impl ShaderModule {
                 self.layout_entry(b, stages, filterable_rgba16f)
             })
             .collect()
+    }
+
+    /// The bind-group layout of group `group` ([`Self::layout_entries`]), labelled `label`.
+    pub(crate) fn bind_group_layout(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        group: u32,
+    ) -> wgpu::BindGroupLayout {
+        self.bind_group_layout_for(device, label, group, true)
+    }
+
+    /// The bind-group layout of group `group` on a device that filters `Rgba16Float` or not
+    /// ([`Self::layout_entries_for`]), labelled `label`.
+    pub(crate) fn bind_group_layout_for(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        group: u32,
+        filterable_rgba16f: bool,
+    ) -> wgpu::BindGroupLayout {
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &self.layout_entries_for(group, filterable_rgba16f),
+        })
     }
 
     /// The layout entries of group `group` that only the named entry points need, visible to their

@@ -54,249 +54,85 @@ fn registry_validates() {
     }
 }
 
-// Today's hand-written bind-group layouts, transcribed from where pipelines are created
-// (`accumulate/mod.rs`, `capture/mod.rs`, `render/mod.rs`, `render/tessellate/gpu.rs`), as
-// (module, group, entries), with the helpers those files use.
-
-use crate::gpu::resources::{compute_storage, uniform};
-use wgpu::ShaderStages as S;
-
-type Layouts = Vec<(&'static str, u32, Vec<wgpu::BindGroupLayoutEntry>)>;
-
-fn entry(binding: u32, visibility: S, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty,
-        count: None,
+/// Every binding's layout entry is visible to the stages of every entry point that uses it (an
+/// `Override::Stages` may widen the reflected stages, never narrow them), on devices that filter
+/// Rgba16Float and on those that do not.
+#[test]
+fn layout_visibility_covers_every_use() {
+    for module in all() {
+        for filterable in [true, false] {
+            for group in 0..4 {
+                let entries = module.layout_entries_for(group, filterable);
+                for b in module.bindings.iter().filter(|b| b.group == group) {
+                    let entry = entries.iter().find(|e| e.binding == b.binding).unwrap();
+                    let used = module
+                        .entry_points
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| b.entry_points & (1 << i) != 0)
+                        .fold(0, |s, (_, ep)| s | ep.stages);
+                    assert_eq!(used, b.stages, "{}.{}", module.name, b.name);
+                    assert!(
+                        entry
+                            .visibility
+                            .contains(wgpu::ShaderStages::from_bits_truncate(used)),
+                        "{}.{}: {:?} misses stages {used:#b}",
+                        module.name,
+                        b.name,
+                        entry.visibility
+                    );
+                }
+            }
+        }
     }
 }
 
-fn buffer(ty: wgpu::BufferBindingType, has_dynamic_offset: bool) -> wgpu::BindingType {
-    wgpu::BindingType::Buffer {
-        ty,
-        has_dynamic_offset,
-        min_binding_size: None,
-    }
-}
-
-fn storage(read_only: bool) -> wgpu::BufferBindingType {
-    wgpu::BufferBindingType::Storage { read_only }
-}
-
-fn texture(
-    sample_type: wgpu::TextureSampleType,
-    view_dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindingType {
-    wgpu::BindingType::Texture {
-        sample_type,
-        view_dimension,
-        multisampled: false,
-    }
-}
-
-fn float(filterable: bool) -> wgpu::BindingType {
-    texture(
-        wgpu::TextureSampleType::Float { filterable },
-        wgpu::TextureViewDimension::D2,
-    )
-}
-
-fn storage_texture(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    entry(
-        binding,
-        S::COMPUTE,
-        wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format: wgpu::TextureFormat::Rgba16Float,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        },
-    )
-}
-
-/// The update's layouts: capture and accumulation.
-fn update_layouts() -> Layouts {
-    let vf = S::VERTEX_FRAGMENT;
-    let dynamic_uniform = |binding, visibility| {
-        entry(
-            binding,
-            visibility,
-            buffer(wgpu::BufferBindingType::Uniform, true),
-        )
-    };
-    let fragment_storage = |binding| entry(binding, S::FRAGMENT, buffer(storage(false), false));
-    let cs = compute_storage;
-    vec![
-        (
-            "capture",
-            0,
-            vec![
-                dynamic_uniform(0, vf),
-                entry(1, vf, buffer(storage(true), false)),
-                fragment_storage(2),
-                fragment_storage(3),
-                fragment_storage(4),
-                fragment_storage(5),
-            ],
-        ),
-        ("capture", 1, vec![dynamic_uniform(0, S::VERTEX)]),
-        (
-            "blur",
-            0,
-            vec![cs(0, true), cs(1, true), cs(2, true), cs(3, false)],
-        ),
-        ("merge", 0, vec![cs(0, true), cs(1, true), cs(2, false)]),
-        (
-            "fused",
-            0,
-            vec![
-                cs(0, true),
-                cs(1, true),
-                cs(2, false),
-                cs(3, true),
-                cs(4, true),
-                cs(5, true),
-            ],
-        ),
-        ("seal", 0, vec![cs(0, false)]),
-        ("normals", 0, vec![cs(0, true), cs(1, false)]),
-    ]
-}
-
-/// The renderer's layouts on a device that filters Rgba16Float or not.
-fn render_layouts(filterable: bool) -> Layouts {
-    let vf = S::VERTEX_FRAGMENT;
-    let c = S::COMPUTE;
-    let linear = if filterable {
-        wgpu::SamplerBindingType::Filtering
-    } else {
-        wgpu::SamplerBindingType::NonFiltering
-    };
-    let frame = vec![
-        uniform(0, vf),
-        entry(
-            1,
-            S::FRAGMENT,
-            texture(
-                wgpu::TextureSampleType::Depth,
-                wgpu::TextureViewDimension::D2Array,
-            ),
-        ),
-        entry(
-            2,
-            S::FRAGMENT,
-            wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-        ),
-        entry(3, S::FRAGMENT, wgpu::BindingType::Sampler(linear)),
-    ];
-    let depth = texture(
-        wgpu::TextureSampleType::Depth,
-        wgpu::TextureViewDimension::D2,
-    );
-    let cs = compute_storage;
-    let mut layouts: Layouts = [
+/// frame.wgsl's group 0 is one layout that every pass of the renderer shares (`render/frame`
+/// makes it from the snow pass's module): every module that imports it reflects the same one.
+#[test]
+fn frame_layout_is_the_same_in_every_module() {
+    let importers: Vec<_> = all()
+        .iter()
+        .filter(|m| m.bindings.iter().any(|b| b.group == 0 && b.name == "frame"))
+        .collect();
+    let names: Vec<_> = importers.iter().map(|m| m.name).collect();
+    for name in [
         "surface",
         "sky",
         "snowfall",
         "tonemap",
         "mesh",
         "tess_surface",
-    ]
-    .into_iter()
-    .map(|name| (name, 0, frame.clone()))
-    .collect();
-    layouts.extend([
-        (
-            "surface",
-            1,
-            vec![
-                uniform(0, vf),
-                entry(1, S::FRAGMENT, float(filterable)),
-                entry(2, S::FRAGMENT, float(filterable)),
-            ],
-        ),
-        (
-            "tonemap",
-            1,
-            vec![
-                entry(0, S::FRAGMENT, float(false)),
-                entry(1, S::FRAGMENT, depth),
-            ],
-        ),
-        ("classify", 0, vec![cs(0, true), cs(1, true), cs(2, false)]),
-        (
-            "heightfield",
-            0,
-            vec![
-                cs(0, true),
-                uniform(1, c),
-                storage_texture(2),
-                storage_texture(3),
-            ],
-        ),
-        (
-            "banks",
-            0,
-            vec![
-                uniform(0, c),
-                entry(1, c, float(false)),
-                entry(2, c, float(false)),
-                entry(3, c, float(false)),
-                storage_texture(4),
-            ],
-        ),
-        (
-            "dice",
-            0,
-            vec![
-                uniform(0, c),
-                cs(1, true),
-                entry(2, c, float(false)),
-                entry(3, c, float(false)),
-                cs(4, true),
-                cs(5, false),
-                cs(6, false),
-                cs(7, false),
-            ],
-        ),
-        (
-            "tess_surface",
-            1,
-            vec![
-                uniform(0, vf),
-                entry(1, vf, float(filterable)),
-                entry(2, vf, float(filterable)),
-                entry(3, vf, float(false)),
-                entry(4, vf, buffer(storage(true), false)),
-            ],
-        ),
-    ]);
-    layouts
-}
-
-/// The layouts reflected from the modules (with `OVERRIDES`) are the hand-written ones, on devices
-/// that filter Rgba16Float and on those that do not.
-#[test]
-fn reflected_layouts_match_hand_written() {
+    ] {
+        assert!(names.contains(&name), "{name} does not bind the frame");
+    }
     for filterable in [true, false] {
-        for (name, group, expected) in update_layouts()
-            .into_iter()
-            .chain(render_layouts(filterable))
-        {
-            let reflected = get(name).unwrap().layout_entries_for(group, filterable);
+        let shared = SURFACE.layout_entries_for(0, filterable);
+        for module in &importers {
             assert_eq!(
-                reflected, expected,
-                "{name} group {group} (filterable {filterable}): reflected vs hand-written"
+                module.layout_entries_for(0, filterable),
+                shared,
+                "{} group 0 (filterable {filterable})",
+                module.name
             );
         }
     }
 }
 
 /// The shadow passes' group 0 is the frame uniform alone, seen by the vertex stage: what their
-/// vertex entry points use (`render/mod.rs` and `render/tessellate/gpu.rs` write it by hand).
+/// vertex entry points use, the same for both (`render/frame` makes it from `mesh`'s).
 #[test]
 fn shadow_layouts_from_their_entry_points() {
-    let expected = vec![uniform(0, S::VERTEX)];
+    let expected = vec![wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::VERTEX,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }];
     for (module, entry) in [("mesh", "vs_shadow"), ("tess_surface", "vs_tess_shadow")] {
         for filterable in [true, false] {
             let reflected = get(module)
@@ -305,7 +141,7 @@ fn shadow_layouts_from_their_entry_points() {
             assert_eq!(reflected, expected, "{module}::{entry}");
         }
     }
-    // The snow pass's own entry points need the whole frame group, as shared.
+    // The snow pass's own entry points need the whole group, as shared.
     let surface = get("surface").unwrap();
     let names: Vec<_> = surface.entry_points.iter().map(|e| e.name).collect();
     assert_eq!(

@@ -115,6 +115,7 @@ impl SnowWorld {
             return Err(SnowError::FramePending);
         }
         self.validate(updates)?;
+        self.probes_before_update();
         let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
         self.plan_into(&mut plan, updates);
         self.frames += 1;
@@ -135,6 +136,7 @@ impl SnowWorld {
             frame: self.frames,
             timestamp_slot,
         });
+        self.probes_after_update(updates);
         stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(PendingFrame {
             world: self.id,
@@ -167,6 +169,8 @@ impl SnowWorld {
         self.scratch_cpu.carries = carries;
         std::mem::swap(&mut self.last.captured, &mut self.scratch_cpu.captured);
         self.free_deferred();
+        // Probe answers that came back while the frame was being submitted.
+        self.poll_probes_only();
         let mut stats = pending.stats;
         if let Some(ring) = self.timestamps.as_mut() {
             if let Some(slot) = in_flight.timestamp_slot {

@@ -31,7 +31,9 @@ impl SnowWorld {
             vertex_count: mesh.positions.len(),
             radius: mesh.bounding_radius(),
         }));
-        Ok(MeshId(self.meshes.len() as u32 - 1))
+        let index = self.meshes.len() - 1;
+        self.probes.keep_mesh(index, &mesh.positions);
+        Ok(MeshId(index as u32))
     }
 
     /// Replace a mesh's vertex positions (an animated mesh posed for this frame). The count must
@@ -61,6 +63,7 @@ impl SnowWorld {
         mesh.radius = positions.iter().map(|p| p.length()).fold(0.0, f32::max);
         self.queue
             .write_buffer(&mesh.vertices, 0, bytemuck::cast_slice(positions));
+        self.probes.keep_mesh(id.0 as usize, positions);
         Ok(())
     }
 
@@ -73,6 +76,8 @@ impl SnowWorld {
             .ok_or(SnowError::StaleHandle {
                 what: "mesh",
                 index: id.0,
-            })
+            })?;
+        self.probes.forget_mesh(id.0 as usize);
+        Ok(())
     }
 }

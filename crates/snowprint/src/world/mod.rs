@@ -15,16 +15,22 @@
 //! deformers (`meshes.rs`), snapshots (`snapshot.rs`) and readbacks (`readback.rs`).
 
 mod config;
+mod footstep;
 mod frame;
 mod meshes;
-pub mod plan;
+pub(crate) mod plan;
+mod probe;
 mod readback;
 mod snapshot;
 
 pub use crate::capture::{CaptureConfig, CaptureMode};
 pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
+pub use footstep::Footstep;
 pub use frame::PendingFrame;
-pub use plan::FramePlan;
+pub(crate) use plan::FramePlan;
+pub use probe::{
+    MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus, ProbeTicket,
+};
 pub use snapshot::SurfaceSnapshot;
 
 use crate::accumulate::AccumulatePipelines;
@@ -113,6 +119,8 @@ pub struct SnowWorld {
     /// Slots of surfaces removed while a frame was in flight, freed once it is submitted: the
     /// frame still writes them.
     deferred_frees: Vec<Slot>,
+    /// Gameplay probes, their ring and cache, and the last update's footsteps.
+    probes: probe::Probes,
 }
 
 /// Source of [`SnowWorld`] ids.
@@ -139,16 +147,20 @@ impl SnowWorld {
         let mut config = config;
         let c = config.capture;
         if !(c.ankle_height.is_finite() && c.ankle_height > 0.0) {
-            return Err(SnowError::Scene(format!(
-                "capture ankle_height {} must be a finite number of metres above 0",
-                c.ankle_height
-            )));
+            return Err(SnowError::Config {
+                config: "capture",
+                what: "ankle_height",
+                value: c.ankle_height.to_string(),
+                expected: "a finite number of metres above 0",
+            });
         }
         if !(c.mask_depth.is_finite() && c.mask_depth > 0.0 && c.mask_depth <= 1.0) {
-            return Err(SnowError::Scene(format!(
-                "capture mask_depth {} must be a fraction in (0, 1]",
-                c.mask_depth
-            )));
+            return Err(SnowError::Config {
+                config: "capture",
+                what: "mask_depth",
+                value: c.mask_depth.to_string(),
+                expected: "a fraction in (0, 1]",
+            });
         }
         let max_pool = gpu
             .caps
@@ -190,6 +202,7 @@ impl SnowWorld {
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
             acc: AccumulatePipelines::new(&device, config.format.precision),
+            probes: probe::Probes::new(&device),
             records: Growable::new(
                 &device,
                 "surface records",
@@ -422,7 +435,7 @@ impl SnowWorld {
 
     /// Pool placement of a surface's slot, for renderers that read the heightmap on the GPU:
     /// `(heights word offset, normals word offset when kept)`. Valid while the surface lives;
-    /// read the heights with `pool/texel.wgsl` ([`crate::pool::TEXEL_WGSL`]) at
+    /// read the heights with `pool/texel.wgsl` (`wgsl::libraries::TEXEL`) at
     /// [`SnowWorld::pool_format`]'s precision.
     pub fn gpu_offsets(&self, id: SurfaceId) -> Result<(u32, Option<u32>)> {
         let s = self.state(id)?;

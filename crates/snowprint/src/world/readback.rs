@@ -18,7 +18,7 @@ impl SnowWorld {
     }
 
     /// The words of a surface's heights region as stored (layout per precision: see
-    /// [`crate::pool`]; at 16 bits, depression in the low 16 bits and displaced in the high 16).
+    /// [`crate::PoolFormat`]; at 16 bits, depression in the low 16 bits and displaced in the high 16).
     pub fn read_packed(&self, id: SurfaceId) -> Result<Vec<u32>> {
         let s = self.state(id)?;
         let bytes = self.download(

@@ -17,7 +17,7 @@ pub struct SurfaceSnapshot {
     pub width: u32,
     /// Heightmap texels along local z.
     pub height: u32,
-    /// How `words` are laid out (see [`crate::pool`]).
+    /// How `words` are laid out (see [`crate::PoolFormat`]).
     pub format: PoolFormat,
     /// Replenishment not yet applied, units at the format's precision (a fraction in `[0, 1)`).
     pub carry: f64,

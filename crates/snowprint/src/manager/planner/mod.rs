@@ -48,7 +48,7 @@ use crate::surface::SurfaceDesc;
 
 /// Margin, metres, added to every touch test so that the planner's answer is a superset of the
 /// world's own culling (float rounding between the two can never hide a touch).
-pub const TOUCH_MARGIN: f32 = 1e-3;
+pub(crate) const TOUCH_MARGIN: f32 = 1e-3;
 
 /// How the planner finds which surfaces a box overlaps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -81,7 +81,7 @@ pub struct PlannedUpdate {
     /// Frames the surface waited since it became due.
     pub wait_frames: u64,
     /// Everything that touched it since its last update: swept shapes, one per frame and deformer
-    /// after de-duplication (see [`super::queue`]), in frame order.
+    /// after de-duplication (see [`crate::low_level::queue`]), in frame order.
     pub imprints: Vec<Deformer>,
     /// The frame of each imprint: the update captures each frame's imprints on their own, in
     /// order, as if the surface had been updated in every frame.

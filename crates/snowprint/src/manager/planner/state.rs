@@ -89,7 +89,11 @@ impl Planner {
     /// A planner with `config` that continues from `state`, every part of it checked (a state
     /// read from a file may be anything): one sentence for the first thing that is wrong.
     pub(crate) fn from_state(config: &ManagerConfig, state: PlannerState) -> Result<Self> {
-        let bad = |what: String| Err(SnowError::Scene(format!("saved planner state: {what}")));
+        let bad = |what: String| {
+            Err(SnowError::SaveContent(format!(
+                "saved planner state: {what}"
+            )))
+        };
         let mut p = Planner::new(config)?;
         if !(state.time.is_finite() && state.time >= 0.0) {
             return bad(format!(
@@ -114,7 +118,7 @@ impl Planner {
             let mut seen = vec![false; n];
             for &i in list {
                 if i as usize >= n || std::mem::replace(&mut seen[i as usize], true) {
-                    return Err(SnowError::Scene(format!(
+                    return Err(SnowError::SaveContent(format!(
                         "saved planner state: {what} names surface {i} of {n}, or twice"
                     )));
                 }

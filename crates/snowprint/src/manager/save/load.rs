@@ -18,14 +18,17 @@ impl SnowManager {
         let bytes = std::fs::read(path).map_err(|e| SnowError::SaveFile {
             path: path.to_owned(),
             reason: format!("it cannot be read: {e}"),
+            source: Some(Box::new(e)),
         })?;
         let file = SaveFile::parse(&bytes).map_err(|reason| SnowError::SaveFile {
             path: path.to_owned(),
             reason,
+            source: None,
         })?;
         Self::from_save(gpu, file).map_err(|e| SnowError::SaveFile {
             path: path.to_owned(),
             reason: one_line(&e.to_string()),
+            source: Some(Box::new(e)),
         })
     }
 
@@ -40,7 +43,7 @@ impl SnowManager {
             / 256
             * 256;
         if file.config.pool_bytes / 256 * 256 > max_pool {
-            return Err(SnowError::Scene(format!(
+            return Err(SnowError::SaveContent(format!(
                 "the save's pool of {} bytes is larger than this device allows ({max_pool} bytes)",
                 file.config.pool_bytes
             )));
@@ -103,13 +106,13 @@ impl SnowManager {
         for s in file.surfaces {
             let i = s.index as usize;
             if i >= held.len() || std::mem::replace(&mut held[i], true) {
-                return Err(SnowError::Scene(format!(
+                return Err(SnowError::SaveContent(format!(
                     "heightmap section for surface {i} is out of range or repeated"
                 )));
             }
             let desc = m.planner.surface(crate::manager::ManagedId(s.index))?;
             if &s.snapshot.desc != desc {
-                return Err(SnowError::Scene(format!(
+                return Err(SnowError::SaveContent(format!(
                     "heightmap section {i} is not surface {:?}'s",
                     desc.name
                 )));
@@ -121,7 +124,7 @@ impl SnowManager {
                         .slot(crate::manager::ManagedId(s.index))
                         .map(|s| s.offset);
                     if want != Some(offset) {
-                        return Err(SnowError::Scene(format!(
+                        return Err(SnowError::SaveContent(format!(
                             "surface {:?}'s heightmap is at {offset}, its slot elsewhere",
                             desc.name
                         )));
@@ -131,7 +134,7 @@ impl SnowManager {
                 }
                 None => {
                     if !paged[i] {
-                        return Err(SnowError::Scene(format!(
+                        return Err(SnowError::SaveContent(format!(
                             "surface {:?} has a page but is not paged out",
                             desc.name
                         )));
@@ -144,7 +147,7 @@ impl SnowManager {
         }
         for i in 0..held.len() {
             if (paged[i] || resident[i]) && !held[i] {
-                return Err(SnowError::Scene(format!(
+                return Err(SnowError::SaveContent(format!(
                     "surface {i} holds a heightmap but the save has none for it"
                 )));
             }

@@ -26,14 +26,14 @@ mod parse;
 mod write;
 
 /// The first eight bytes of every save.
-pub const MAGIC: [u8; 8] = *b"SNOWSAVE";
+pub(crate) const MAGIC: [u8; 8] = *b"SNOWSAVE";
 /// The format version this build writes and the newest it reads.
-pub const VERSION: u32 = 1;
+pub(crate) const VERSION: u32 = 1;
 /// Most sections a save may have (a section per surface, plus three).
-pub const MAX_SECTIONS: u32 = 1 << 20;
+pub(crate) const MAX_SECTIONS: u32 = 1 << 20;
 /// Most bytes a section may expand to (a 512^2 surface at 32 bits with normals is 3 MiB; the
 /// JSON sections of a city of 10,000 surfaces with long queues stay far below).
-pub const MAX_SECTION_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_SECTION_BYTES: u64 = 1 << 30;
 
 pub(super) const HEADER: usize = 20;
 pub(super) const SECTION_HEADER: usize = 28;

@@ -109,9 +109,12 @@ impl SnowManager {
             f.sync_all()?;
             std::fs::rename(&tmp, path)
         };
-        write().map_err(|e| {
+        write().map_err(|source| {
             let _ = std::fs::remove_file(&tmp);
-            out(e.to_string())
+            SnowError::WriteFile {
+                path: path.to_owned(),
+                source,
+            }
         })?;
         Ok(bytes.len() as u64)
     }
@@ -119,5 +122,5 @@ impl SnowManager {
 
 /// JSON for the text sections, with the error as the library's.
 pub(super) fn to_json<T: serde::Serialize>(v: &T) -> Result<Vec<u8>> {
-    serde_json::to_vec(v).map_err(|e| SnowError::Scene(format!("save: {e}")))
+    serde_json::to_vec(v).map_err(SnowError::SaveEncode)
 }

@@ -64,28 +64,32 @@ impl Mesh {
     ///
     /// As [`Mesh::load_gltf`]; also [`SnowError::MeshFile`] when `path` itself is outside `root`.
     pub fn load_gltf_within(path: &Path, root: &Path) -> Result<Mesh> {
-        let err = |reason: String| SnowError::MeshFile {
+        let err = |reason: String, source: Option<std::io::Error>| SnowError::MeshFile {
             path: path.to_owned(),
             reason,
+            source,
         };
         let canonical_root = canonical_folder(root).map_err(|e| {
-            err(format!(
+            let reason = format!(
                 "its allowed folder {} cannot be opened ({e}); check that the folder exists",
                 root.display()
-            ))
+            );
+            err(reason, Some(e))
         })?;
         let canonical = path.canonicalize().map_err(|e| {
-            err(format!(
-                "cannot be opened ({e}); check the path and that the file exists"
-            ))
+            let reason = format!("cannot be opened ({e}); check the path and that the file exists");
+            err(reason, Some(e))
         })?;
         if !canonical.starts_with(&canonical_root) {
-            return Err(err(format!(
-                "lies outside {}, the only folder meshes may be read from here; move the file into that folder",
-                canonical_root.display()
-            )));
+            return Err(err(
+                format!(
+                    "lies outside {}, the only folder meshes may be read from here; move the file into that folder",
+                    canonical_root.display()
+                ),
+                None,
+            ));
         }
-        let bytes = read_bounded(&canonical).map_err(err)?;
+        let bytes = read_bounded(&canonical).map_err(|(reason, source)| err(reason, source))?;
         let folder = parent_folder(&canonical);
         parse(&bytes, path, Some((&folder, &canonical_root)))
     }
@@ -111,6 +115,7 @@ impl Mesh {
                         "its allowed folder {} cannot be opened ({e}); check that the folder exists",
                         root.display()
                     ),
+                    source: Some(e),
                 })?;
                 parse(bytes, name, Some((folder, &root)))
             }
@@ -134,29 +139,42 @@ fn canonical_folder(root: &Path) -> std::io::Result<PathBuf> {
     }
 }
 
+/// Why a file could not be read: a sentence, and the I/O error where there is one.
+pub(super) type ReadFailure = (String, Option<std::io::Error>);
+
 /// A whole file, refused beyond [`MAX_GLTF_FILE_BYTES`].
-pub(super) fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, String> {
+pub(super) fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, ReadFailure> {
+    let io = |e: std::io::Error, what: &str, fix: &str| (format!("{what} ({e}); {fix}"), Some(e));
     let file = std::fs::File::open(path)
-        .map_err(|e| format!("cannot be opened ({e}); check the path and its permissions"))?;
+        .map_err(|e| io(e, "cannot be opened", "check the path and its permissions"))?;
     let meta = file
         .metadata()
-        .map_err(|e| format!("cannot be read ({e}); check the path and its permissions"))?;
+        .map_err(|e| io(e, "cannot be read", "check the path and its permissions"))?;
     if !meta.is_file() {
-        return Err("is not a file; give the path of a glTF (.gltf) or GLB (.glb) file".into());
+        return Err((
+            "is not a file; give the path of a glTF (.gltf) or GLB (.glb) file".into(),
+            None,
+        ));
     }
     if meta.len() > MAX_GLTF_FILE_BYTES {
-        return Err(format!(
-            "is {} bytes, more than the {MAX_GLTF_FILE_BYTES} bytes a mesh file may have; simplify the mesh",
-            meta.len()
+        return Err((
+            format!(
+                "is {} bytes, more than the {MAX_GLTF_FILE_BYTES} bytes a mesh file may have; simplify the mesh",
+                meta.len()
+            ),
+            None,
         ));
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     file.take(MAX_GLTF_FILE_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot be read ({e}); check the file"))?;
+        .map_err(|e| io(e, "cannot be read", "check the file"))?;
     if bytes.len() as u64 > MAX_GLTF_FILE_BYTES {
-        return Err(format!(
-            "is more than the {MAX_GLTF_FILE_BYTES} bytes a mesh file may have; simplify the mesh"
+        return Err((
+            format!(
+                "is more than the {MAX_GLTF_FILE_BYTES} bytes a mesh file may have; simplify the mesh"
+            ),
+            None,
         ));
     }
     Ok(bytes)
@@ -166,6 +184,7 @@ fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mes
     let err = |reason: String| SnowError::MeshFile {
         path: path.to_owned(),
         reason,
+        source: None,
     };
     let not_gltf = |e: &dyn std::fmt::Display| {
         let e = e.to_string();

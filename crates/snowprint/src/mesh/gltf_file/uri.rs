@@ -215,7 +215,7 @@ pub(super) fn follow_uri(
     if !read {
         return Ok(None);
     }
-    read_bounded(&file).map(Some).map_err(|reason| {
+    read_bounded(&file).map(Some).map_err(|(reason, _)| {
         (
             format!("names {}, which {reason}", file.display()),
             "fix the file or the uri".to_owned(),

@@ -5,7 +5,7 @@
 // dispatch of its heightfield pass (zero workgroups when basic), and the flag the report reads.
 // Reads: the heightmap pool, the surface list. Writes: the surface state table.
 
-// import texel
+// import texel, constants
 
 // Must match `ClassifyRecord` in src/render/gpu.rs.
 struct ClassifyRecord {
@@ -18,10 +18,6 @@ struct ClassifyRecord {
     _pad1: u32,
     _pad2: u32,
 }
-
-// Words per surface in the state table: STATE_WORDS of wgsl/constants.wgsl, which this module does
-// not import (a test in src/render/gpu.rs checks the two agree).
-const STATE_WORDS: u32 = 16u;
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
 @group(0) @binding(1) var<storage, read> records: array<ClassifyRecord>;
@@ -62,7 +58,7 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
         state[base + 8u] = select(0u, (rec.width + 7u) / 8u, touched == 1u);
         state[base + 9u] = (rec.height + 7u) / 8u;
         state[base + 10u] = 1u;
-        state[base + 11u] = touched;
+        state[base + STATE_TOUCHED] = touched;
         state[base + 12u] = bitcast<u32>(f32(d) / f32(channel_max(rec.bits)));
     }
 }

@@ -8,8 +8,7 @@ use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
 use super::graph::PASSES;
 use super::pipeline;
 use super::readback::{Timestamps, compute_writes};
-use super::shaders;
-use crate::gpu::resources::{Growable, bind_group, compute_storage};
+use crate::gpu::resources::{Growable, bind_group};
 
 pub(super) struct ClassifyPass {
     layout: wgpu::BindGroupLayout,
@@ -24,16 +23,9 @@ pub(super) struct ClassifyPass {
 }
 
 impl ClassifyPass {
-    pub fn new(device: &wgpu::Device) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("classify"),
-            entries: &[
-                compute_storage(0, true),
-                compute_storage(1, true),
-                compute_storage(2, false),
-            ],
-        });
-        let module = pipeline::shader(device, "classify.wgsl", shaders::classify());
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        let layout = crate::wgsl::CLASSIFY.bind_group_layout(device, "classify", 0);
+        let module = pipeline::shader(device, "classify.wgsl", crate::wgsl::CLASSIFY.wgsl());
         let pipeline = pipeline::compute(device, "classify", &module, "classify", &[&layout]);
         use wgpu::BufferUsages as U;
         Self {
@@ -57,7 +49,7 @@ impl ClassifyPass {
     }
 
     /// Upload the surfaces' records and make room for their state.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -97,7 +89,12 @@ impl ClassifyPass {
         });
     }
 
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, ts: Option<&Timestamps>, slot: usize) {
+    pub(super) fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+    ) {
         let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(PASSES[slot].name),
             timestamp_writes: compute_writes(ts, slot),

@@ -10,7 +10,7 @@ use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
 use super::inputs::{PointLight, RenderFrame};
 use super::tessellate::SurfaceGeometry;
 use crate::extract::SurfaceView;
-use crate::gpu::resources::{bind_group, uniform};
+use crate::gpu::resources::bind_group;
 use crate::view::GroundMaterial;
 
 /// Near and far planes of the camera, metres.
@@ -31,7 +31,7 @@ pub(super) struct FrameSurface<'a> {
 
 impl FrameSurface<'_> {
     /// Sides of a heightmap texel, metres.
-    pub fn texel(&self) -> Vec2 {
+    pub(super) fn texel(&self) -> Vec2 {
         let (desc, layout) = (self.view.desc, self.view.layout);
         Vec2::new(
             desc.size.x / layout.width as f32,
@@ -59,42 +59,13 @@ pub(super) struct FrameLayouts {
 }
 
 impl FrameLayouts {
-    pub fn new(device: &wgpu::Device, filterable: bool) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &[
-                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(if filterable {
-                        wgpu::SamplerBindingType::Filtering
-                    } else {
-                        wgpu::SamplerBindingType::NonFiltering
-                    }),
-                    count: None,
-                },
-            ],
-        });
+    pub(super) fn new(device: &wgpu::Device, filterable: bool) -> Self {
+        // frame.wgsl's group 0, the same in every module that imports it (OVERRIDES give it the
+        // stages of all of them); the shadow passes' is what their vertex entry points read.
+        let layout = crate::wgsl::SURFACE.bind_group_layout_for(device, "frame", 0, filterable);
         let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow frame"),
-            entries: &[uniform(0, wgpu::ShaderStages::VERTEX)],
+            entries: &crate::wgsl::MESH.layout_entries_of(&["vs_shadow"], 0, filterable),
         });
         Self {
             layout,
@@ -105,7 +76,7 @@ impl FrameLayouts {
 
 impl FrameResources {
     /// The uniform buffer, samplers and bind groups over the moon's shadow map `shadow_view`.
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         layouts: FrameLayouts,
         shadow_view: &wgpu::TextureView,
@@ -162,7 +133,7 @@ impl FrameResources {
     }
 
     /// Upload the frame's uniform.
-    pub fn prepare(&self, queue: &wgpu::Queue, uniform: &FrameUniform) {
+    pub(super) fn prepare(&self, queue: &wgpu::Queue, uniform: &FrameUniform) {
         queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(uniform));
     }
 }

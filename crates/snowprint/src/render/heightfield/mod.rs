@@ -11,12 +11,11 @@ use super::error::{RenderError, RenderResult};
 use super::frame::FrameSurface;
 use super::gpu::{HeightfieldParams, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use super::graph::PASSES;
-use super::pipeline::{self, storage_texture_entry};
+use super::pipeline;
 use super::readback::{Timestamps, compute_writes, f16_to_f32, map_staging};
-use super::shaders;
 use super::targets::HEIGHTFIELD_FORMAT;
 use super::tessellate::SurfaceFields;
-use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::surface::SurfaceId;
 
 /// A deformed surface's shading textures, written by the heightfield pass.
@@ -82,17 +81,9 @@ pub(super) struct HeightfieldPass {
 }
 
 impl HeightfieldPass {
-    pub fn new(device: &wgpu::Device) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("heightfield"),
-            entries: &[
-                compute_storage(0, true),
-                uniform(1, wgpu::ShaderStages::COMPUTE),
-                storage_texture_entry(2),
-                storage_texture_entry(3),
-            ],
-        });
-        let module = pipeline::shader(device, "heightfield.wgsl", shaders::heightfield());
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        let layout = crate::wgsl::HEIGHTFIELD.bind_group_layout(device, "heightfield", 0);
+        let module = pipeline::shader(device, "heightfield.wgsl", crate::wgsl::HEIGHTFIELD.wgsl());
         let pipeline = pipeline::compute(device, "heightfield", &module, "heightfield", &[&layout]);
         Self {
             params: Growable::new(
@@ -109,13 +100,13 @@ impl HeightfieldPass {
     }
 
     /// A surface's textures (after [`HeightfieldPass::prepare`] of a frame that drew it).
-    pub fn texture(&self, id: SurfaceId) -> Option<&HeightfieldTexture> {
+    pub(super) fn texture(&self, id: SurfaceId) -> Option<&HeightfieldTexture> {
         self.textures.get(&id)
     }
 
     /// Upload each surface's parameters (with the moon in its frame), make its textures at its
     /// heightmap's size, and bind them.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -182,7 +173,7 @@ impl HeightfieldPass {
     }
 
     /// One indirect dispatch per surface, its arguments written by `classify` in `state`.
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
@@ -205,7 +196,7 @@ impl HeightfieldPass {
 
     /// A surface's smoothed depression, displaced channel and bank heights as the latest frame's
     /// passes wrote them.
-    pub fn read_fields(
+    pub(super) fn read_fields(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,

@@ -6,11 +6,11 @@ use super::graph::PASSES;
 use super::meshes::MeshSet;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
-use super::{gpu, pipeline, shaders};
+use super::{gpu, pipeline};
 
 /// The module of `mesh.wgsl` (after `frame.wgsl` and `snow.wgsl`).
 pub(super) fn mesh_module(device: &wgpu::Device) -> wgpu::ShaderModule {
-    pipeline::shader(device, "mesh.wgsl", shaders::mesh())
+    pipeline::shader(device, "mesh.wgsl", crate::wgsl::MESH.wgsl())
 }
 
 pub(super) struct OpaquePass {
@@ -18,7 +18,7 @@ pub(super) struct OpaquePass {
 }
 
 impl OpaquePass {
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         mesh_module: &wgpu::ShaderModule,
         frame_layout: &wgpu::BindGroupLayout,
@@ -42,7 +42,7 @@ impl OpaquePass {
     }
 
     /// Clear colour and depth, then draw every instance.
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

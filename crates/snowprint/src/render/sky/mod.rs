@@ -2,17 +2,17 @@
 //! everything (depth test only).
 
 use super::graph::PASSES;
+use super::pipeline;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
-use super::{pipeline, shaders};
 
 pub(super) struct SkyPass {
     pipeline: wgpu::RenderPipeline,
 }
 
 impl SkyPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
-        let module = pipeline::shader(device, "sky.wgsl", shaders::sky());
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+        let module = pipeline::shader(device, "sky.wgsl", crate::wgsl::SKY.wgsl());
         let pipeline = pipeline::Raster {
             label: "sky",
             module: &module,
@@ -29,7 +29,7 @@ impl SkyPass {
         Self { pipeline }
     }
 
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -11,13 +11,12 @@ use super::gpu::{
 };
 use super::graph::PASSES;
 use super::heightfield::HeightfieldPass;
-use super::pipeline::{self, texture_entry};
+use super::pipeline;
 use super::readback::{Timestamps, render_span};
-use super::shaders;
 use super::targets::{KEEP, Targets};
 use super::tessellate::dice::DicePass;
 use super::tessellate::snow_shadow::TessSurface;
-use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::view::GroundMaterial;
 
 pub(super) struct SnowPass {
@@ -31,20 +30,14 @@ pub(super) struct SnowPass {
 }
 
 impl SnowPass {
-    pub fn new(
+    pub(super) fn new(
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
         filterable: bool,
     ) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("snow surface"),
-            entries: &[
-                uniform(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                texture_entry(1, wgpu::TextureSampleType::Float { filterable }),
-                texture_entry(2, wgpu::TextureSampleType::Float { filterable }),
-            ],
-        });
-        let module = pipeline::shader(device, "surface.wgsl", shaders::surface());
+        let layout =
+            crate::wgsl::SURFACE.bind_group_layout_for(device, "snow surface", 1, filterable);
+        let module = pipeline::shader(device, "surface.wgsl", crate::wgsl::SURFACE.wgsl());
         let snow = |label, fs, constants| {
             pipeline::Raster {
                 label,
@@ -82,7 +75,7 @@ impl SnowPass {
 
     /// Upload each surface's uniform (transform, grid, ground, search and look) and bind it with
     /// its heightfield textures.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -162,7 +155,7 @@ impl SnowPass {
 
     /// The relief-mapped surfaces (indirect draws of both materials), then the diced ones.
     #[allow(clippy::too_many_arguments)]
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

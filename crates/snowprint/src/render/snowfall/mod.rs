@@ -2,17 +2,17 @@
 //! scene and hidden by its depth. The frame uniform carries the number of flakes (0: none).
 
 use super::graph::PASSES;
+use super::pipeline;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
-use super::{pipeline, shaders};
 
 pub(super) struct SnowfallPass {
     pipeline: wgpu::RenderPipeline,
 }
 
 impl SnowfallPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
-        let module = pipeline::shader(device, "snowfall.wgsl", shaders::snowfall());
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+        let module = pipeline::shader(device, "snowfall.wgsl", crate::wgsl::SNOWFALL.wgsl());
         let blended = [Some(wgpu::ColorTargetState {
             format: super::targets::HDR_FORMAT,
             blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
@@ -35,7 +35,7 @@ impl SnowfallPass {
     }
 
     /// Draw `flakes` flakes (the frame uniform's count).
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -27,7 +27,7 @@
 //! `tests/render_tessellated.rs`).
 
 pub(in crate::render) mod banks;
-pub mod cpu;
+pub(crate) mod cpu;
 pub(in crate::render) mod dice;
 pub(crate) mod gpu;
 pub(in crate::render) mod snow_shadow;

@@ -5,9 +5,8 @@
 use std::collections::HashMap;
 
 use super::graph::PASSES;
-use super::pipeline::{self, texture_entry};
+use super::pipeline;
 use super::readback::{Timestamps, render_writes};
-use super::shaders;
 use super::targets::Targets;
 use crate::gpu::resources::bind_group;
 
@@ -21,15 +20,9 @@ pub(super) struct TonemapPass {
 }
 
 impl TonemapPass {
-    pub fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tonemap inputs"),
-            entries: &[
-                texture_entry(0, wgpu::TextureSampleType::Float { filterable: false }),
-                texture_entry(1, wgpu::TextureSampleType::Depth),
-            ],
-        });
-        let module = pipeline::shader(device, "tonemap.wgsl", shaders::tonemap());
+    pub(super) fn new(device: &wgpu::Device, frame_layout: &wgpu::BindGroupLayout) -> Self {
+        let layout = crate::wgsl::TONEMAP.bind_group_layout(device, "tonemap inputs", 1);
+        let module = pipeline::shader(device, "tonemap.wgsl", crate::wgsl::TONEMAP.wgsl());
         let pipeline_layout = pipeline::layout(device, "tonemap", &[frame_layout, &layout]);
         Self {
             layout,
@@ -87,7 +80,7 @@ impl TonemapPass {
     }
 
     /// Bind the scene's colour and depth, and pick the pipeline of the output's format.
-    pub fn prepare(
+    pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         targets: &Targets,
@@ -107,7 +100,7 @@ impl TonemapPass {
         self.current = Some((pipeline, inputs));
     }
 
-    pub fn encode(
+    pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

@@ -4,14 +4,13 @@
 //! share into the scratch texture, `bank_gather` collects it into the bank heights.
 
 use super::BankParams;
-use super::gpu::texture;
-use crate::gpu::resources::{Growable, bind_group, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
+use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_writes};
-use crate::render::{pipeline, shaders};
 
 pub(in crate::render) struct BanksPass {
     layout: wgpu::BindGroupLayout,
@@ -24,19 +23,9 @@ pub(in crate::render) struct BanksPass {
 }
 
 impl BanksPass {
-    pub fn new(device: &wgpu::Device) -> Self {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("banks"),
-            entries: &[
-                uniform(0, c),
-                texture(1, c, false),
-                texture(2, c, false),
-                texture(3, c, false),
-                pipeline::storage_texture_entry(4),
-            ],
-        });
-        let module = pipeline::shader(device, "banks.wgsl", shaders::BANKS.to_owned());
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
+        let layout = crate::wgsl::BANKS.bind_group_layout(device, "banks", 0);
+        let module = pipeline::shader(device, "banks.wgsl", crate::wgsl::BANKS.wgsl());
         let norm = pipeline::compute(device, "bank norm", &module, "bank_norm", &[&layout]);
         let gather = pipeline::compute(device, "bank gather", &module, "bank_gather", &[&layout]);
         Self {
@@ -55,7 +44,7 @@ impl BanksPass {
 
     /// Upload each diced surface's bank parameters and bind its heightfield textures (nothing
     /// outside the tessellated tier, `active` false).
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -127,7 +116,7 @@ impl BanksPass {
     }
 
     /// Both bank passes run over the deformed surfaces only (the heightfield's dispatch).
-    pub fn encode(
+    pub(crate) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,

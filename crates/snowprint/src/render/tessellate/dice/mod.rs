@@ -9,9 +9,9 @@ use std::collections::HashMap;
 use glam::Mat4;
 
 use super::VERTEX_BYTES;
-use super::gpu::{counters_bytes, texture};
+use super::gpu::counters_bytes;
 use super::{ARGS_BASE, ARGS_STRIDE, DiceParams, DicedKind, DicedMesh, DicedVertex, SurfaceMesh};
-use crate::gpu::resources::{Growable, bind_group, compute_storage, uniform, uniform_block};
+use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::config::RenderConfig;
 use crate::render::error::RenderResult;
 use crate::render::frame::{FAR, FrameSurface, NEAR};
@@ -19,8 +19,8 @@ use crate::render::gpu::{FrameUniform, UNIFORM_STRIDE};
 use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::inputs::RenderFrame;
+use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_writes, read_back};
-use crate::render::{pipeline, shaders};
 use crate::surface::SurfaceId;
 
 /// A surface's base mesh on the GPU.
@@ -47,22 +47,9 @@ pub(in crate::render) struct DicePass {
 }
 
 impl DicePass {
-    pub fn new(device: &wgpu::Device) -> Self {
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dice"),
-            entries: &[
-                uniform(0, c),
-                compute_storage(1, true),
-                texture(2, c, false),
-                texture(3, c, false),
-                compute_storage(4, true),
-                compute_storage(5, false),
-                compute_storage(6, false),
-                compute_storage(7, false),
-            ],
-        });
-        let module = pipeline::shader(device, "dice.wgsl", shaders::DICE.to_owned());
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
+        let layout = crate::wgsl::DICE.bind_group_layout(device, "dice", 0);
+        let module = pipeline::shader(device, "dice.wgsl", crate::wgsl::DICE.wgsl());
         let dice = pipeline::compute(device, "dice", &module, "dice_surface", &[&layout]);
         let seal = pipeline::compute(device, "dice seal", &module, "seal", &[&layout]);
         use wgpu::BufferUsages as U;
@@ -95,7 +82,7 @@ impl DicePass {
     }
 
     /// Whether any surface is diced this frame.
-    pub fn any(&self) -> bool {
+    pub(crate) fn any(&self) -> bool {
         self.bind_groups.iter().any(Option::is_some)
     }
 
@@ -103,7 +90,7 @@ impl DicePass {
     /// the diced mesh; upload the diced surfaces' base meshes (when their size or geometry
     /// changed) and dicing parameters, and bind them.
     #[allow(clippy::too_many_arguments)]
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -241,7 +228,12 @@ impl DicePass {
 
     /// Clear the counters (every tier: all draw arguments start at zero), then dice one surface
     /// after the other: `seal` closes each surface's run of indices.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, ts: Option<&Timestamps>, slot: usize) {
+    pub(crate) fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+    ) {
         encoder.clear_buffer(&self.counters.buffer, 0, None);
         let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(PASSES[slot].name),
@@ -257,13 +249,13 @@ impl DicePass {
     }
 
     /// Byte offset of surface slot `s`'s indexed indirect draw in the counters.
-    pub fn args_offset(s: usize) -> u64 {
+    pub(crate) fn args_offset(s: usize) -> u64 {
         (ARGS_BASE + ARGS_STRIDE * s as u64) * 4
     }
 
     /// Draw each diced surface's mesh: `groups` holds the draw's bind group 1 per surface slot
     /// (`None`: not diced); the pass's pipeline and group 0 are set.
-    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, groups: &[Option<wgpu::BindGroup>]) {
+    pub(crate) fn draw(&self, p: &mut wgpu::RenderPass<'_>, groups: &[Option<wgpu::BindGroup>]) {
         p.set_vertex_buffer(0, self.vertices.buffer.slice(..));
         p.set_index_buffer(self.indices.buffer.slice(..), wgpu::IndexFormat::Uint32);
         for (s, g) in groups.iter().enumerate() {
@@ -275,7 +267,7 @@ impl DicePass {
     }
 
     /// The diced mesh of surface slot `s` in the latest frame, read back from the GPU.
-    pub fn read_mesh(
+    pub(crate) fn read_mesh(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,

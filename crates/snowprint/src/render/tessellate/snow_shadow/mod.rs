@@ -5,14 +5,13 @@
 
 use super::VERTEX_BYTES;
 use super::dice::DicePass;
-use super::gpu::texture;
-use crate::gpu::resources::{bind_group, uniform, uniform_block};
+use crate::gpu::resources::{bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::SurfaceUniform;
 use crate::render::heightfield::HeightfieldPass;
+use crate::render::pipeline;
 use crate::render::readback::Timestamps;
 use crate::render::shadow::ShadowPass;
-use crate::render::{pipeline, shaders};
 
 pub(in crate::render) struct TessSurface {
     layout: wgpu::BindGroupLayout,
@@ -25,33 +24,23 @@ pub(in crate::render) struct TessSurface {
 }
 
 impl TessSurface {
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
         shadow_layout: &wgpu::BindGroupLayout,
         filterable: bool,
     ) -> Self {
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tessellated snow surface"),
-            entries: &[
-                uniform(0, vf),
-                texture(1, vf, filterable),
-                texture(2, vf, filterable),
-                texture(3, vf, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let module = pipeline::shader(device, "tess_surface.wgsl", shaders::tess_surface());
+        let layout = crate::wgsl::TESS_SURFACE.bind_group_layout_for(
+            device,
+            "tessellated snow surface",
+            1,
+            filterable,
+        );
+        let module = pipeline::shader(
+            device,
+            "tess_surface.wgsl",
+            crate::wgsl::TESS_SURFACE.wgsl(),
+        );
         const VERTEX: [wgpu::VertexAttribute; 2] =
             wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4];
         let buffers = [Some(wgpu::VertexBufferLayout {
@@ -94,7 +83,7 @@ impl TessSurface {
 
     /// Bind each diced surface's uniform (in the snow pass's `surfaces` buffer), textures and
     /// state.
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
         surfaces: &[FrameSurface<'_>],
@@ -128,7 +117,7 @@ impl TessSurface {
     }
 
     /// The `snow_shadow` pass: the displaced snow into both cascades, over the meshes' shadows.
-    pub fn encode_shadow(
+    pub(crate) fn encode_shadow(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
@@ -153,7 +142,12 @@ impl TessSurface {
     }
 
     /// The tessellated snow into the scene (within the `snow` pass).
-    pub fn draw(&self, p: &mut wgpu::RenderPass<'_>, frame: &wgpu::BindGroup, dice: &DicePass) {
+    pub(crate) fn draw(
+        &self,
+        p: &mut wgpu::RenderPass<'_>,
+        frame: &wgpu::BindGroup,
+        dice: &DicePass,
+    ) {
         if dice.any() {
             p.set_pipeline(&self.draw);
             p.set_bind_group(0, frame, &[]);
