@@ -264,6 +264,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     let timestamps = world.has_timestamps();
     let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals, mut fused) =
         (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+    let (mut gpu_times, mut measured_from) = (Vec::new(), u64::MAX);
     for f in 0..args.warmup + args.frames {
         // Each surface is given the deformers over it, as a manager's spatial lookup would.
         let deformers: Vec<Vec<Deformer>> = centers
@@ -281,31 +282,49 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             .collect();
         let start = Instant::now();
         let stats = world.update(&updates).map_err(|e| e.to_string())?;
-        if !timestamps {
-            gpu.wait_idle().map_err(|e| e.to_string())?;
-        }
+        // Each frame runs alone on the GPU, as it did when profiling waited for its times: frames
+        // that overlap would share the GPU (and, on a software adapter, the CPU that encodes).
+        gpu.wait_idle().map_err(|e| e.to_string())?;
         let wall = start.elapsed().as_secs_f64() * 1e6;
+        if f == args.warmup {
+            measured_from = stats.frame;
+        }
+        // GPU times arrive a frame or two late, each with its frame's number.
+        if let (Some(frame), Some(times)) = (stats.gpu_frame, stats.gpu) {
+            gpu_times.push((frame, times));
+        }
         if f < args.warmup {
             continue;
         }
         cpu.push(stats.cpu_encode_ms * 1e3);
-        match stats.gpu {
-            Some(StageTimes {
-                capture_ms,
-                blur_ms,
-                merge_ms,
-                normals_ms,
-                fused_ms,
-            }) => {
-                cap.push(capture_ms * 1e3);
-                blur.push(blur_ms * 1e3);
-                merge.push(merge_ms * 1e3);
-                normals.push(normals_ms * 1e3);
-                fused.push(fused_ms * 1e3);
-                total.push((capture_ms + blur_ms + merge_ms + normals_ms + fused_ms) * 1e3);
-            }
-            None => total.push(wall),
+        if !timestamps {
+            total.push(wall);
         }
+    }
+    if timestamps {
+        // The last frames' times are still on their way: wait for them here, outside the loop.
+        gpu.wait_idle().map_err(|e| e.to_string())?;
+        while let Some(late) = world.take_gpu_times().map_err(|e| e.to_string())? {
+            gpu_times.push(late);
+        }
+    }
+    for &(_, t) in gpu_times
+        .iter()
+        .filter(|(frame, _)| *frame >= measured_from)
+    {
+        let StageTimes {
+            capture_ms,
+            blur_ms,
+            merge_ms,
+            normals_ms,
+            fused_ms,
+        } = t;
+        cap.push(capture_ms * 1e3);
+        blur.push(blur_ms * 1e3);
+        merge.push(merge_ms * 1e3);
+        normals.push(normals_ms * 1e3);
+        fused.push(fused_ms * 1e3);
+        total.push(t.total_ms() * 1e3);
     }
     let bytes = c.surfaces as u64 * format.heights_bytes(c.resolution, c.resolution);
     let copy = CopyTimer::new(gpu, bytes);

@@ -41,6 +41,32 @@ pub enum SnowError {
         /// The underlying wgpu error.
         source: wgpu::RequestDeviceError,
     },
+    /// A caller's device was created with a limit below what snowprint's passes need.
+    #[error(
+        "the GPU device's limit {limit} is {available}, but snowprint needs {required}: create the device with `snowprint::required_limits()` (or limits at least as good, e.g. `required_limits().using_resolution(adapter.limits())`)"
+    )]
+    DeviceLimit {
+        /// The `wgpu::Limits` field.
+        limit: &'static str,
+        /// What snowprint needs ([`crate::required_limits`]).
+        required: u64,
+        /// What the device was created with.
+        available: u64,
+    },
+    /// A caller's device was created without a feature snowprint's passes need.
+    #[error(
+        "the GPU device lacks the features {missing}: create it with `snowprint::required_features()` among its required features"
+    )]
+    DeviceFeature {
+        /// The missing `wgpu::Features`, printed.
+        missing: String,
+    },
+    /// A frame was encoded and not yet reported submitted: the per-frame tables it uploaded are
+    /// still in use.
+    #[error(
+        "a snow frame was encoded and not reported submitted: call SnowWorld::submitted with its PendingFrame after queue.submit (or SnowWorld::abandon_pending if its encoder was dropped) before encoding another"
+    )]
+    FramePending,
     /// A surface description is not usable.
     #[error("surface {name:?}: {what} is {value}, but it must be {expected}")]
     InvalidSurface {

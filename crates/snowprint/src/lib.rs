@@ -26,6 +26,7 @@
 //! | you want | reach for |
 //! |---|---|
 //! | a GPU device, checked for what the passes need | [`GpuContext`], [`GpuOptions`], [`Capabilities`] |
+//! | the engine's own device and command encoder | [`required_features`], [`required_limits`], [`GpuContext::from_device`], [`SnowWorld::encode_update`], [`PendingFrame`], [`render::Renderer::encode_to_view`] |
 //! | snow surfaces stepped by deformers | [`SnowWorld`], [`WorldConfig`], [`SurfaceDesc`], [`Deformer`], [`Shape`], [`Pose`], [`Mesh`] |
 //! | the heightmaps back, or their place in the pool | [`Heightmap`], [`PoolFormat`], [`Precision`], [`FrameView`], [`SurfaceSnapshot`] |
 //! | a city of surfaces paged in and out, saves | [`manager`]: [`SnowManager`], [`ManagerConfig`], [`manager::SaveFile`] |
@@ -62,7 +63,7 @@ pub use wgpu;
 pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};
 pub use error::{Result, SnowError};
 pub use extract::{FrameView, SurfaceView};
-pub use gpu::{Capabilities, GpuContext, GpuOptions};
+pub use gpu::{Capabilities, GpuContext, GpuOptions, required_features, required_limits};
 pub use heightmap::Heightmap;
 pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
@@ -76,8 +77,8 @@ pub use render::gpu::SurfaceUniform;
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
-    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, SnowWorld, StageTimes,
-    SurfaceSnapshot, SurfaceUpdate, WorldConfig,
+    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, PendingFrame, SnowWorld,
+    StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
 pub use world::{
     Footstep, MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus,
@@ -160,7 +161,7 @@ pub mod low_level {
     pub mod gpu {
         pub use crate::gpu::readback::*;
         pub use crate::gpu::timestamps::*;
-        pub use crate::gpu::{REQUIRED_DOWNLEVEL, describe, missing_capabilities};
+        pub use crate::gpu::{REQUIRED_DOWNLEVEL, check_device, describe, missing_capabilities};
     }
     /// The manager's per-surface imprint queue (merging, bounding).
     pub mod queue {

@@ -4,10 +4,16 @@
 //! backend (Vulkan, Metal and DX12 before GL), unless one is named by [`GpuOptions::adapter`] or the
 //! `SNOWPRINT_ADAPTER` environment variable. Optional features (timestamp queries) are requested only
 //! where the adapter has them; where one is missing the library falls back and says so with a warning.
+//! An engine that owns its device creates it with [`required_features`] and [`required_limits`]
+//! and hands it over with [`GpuContext::from_device`], which checks them.
 
+mod limits;
 pub(crate) mod readback;
 pub(crate) mod resources;
+pub(crate) mod ring;
 pub(crate) mod timestamps;
+
+pub use limits::{check_device, required_features, required_limits};
 
 use crate::error::{Result, SnowError};
 
@@ -64,6 +70,18 @@ pub const REQUIRED_DOWNLEVEL: wgpu::DownlevelFlags =
 /// The required capabilities an adapter lacks (empty when it has them all).
 pub fn missing_capabilities(adapter: &wgpu::Adapter) -> wgpu::DownlevelFlags {
     REQUIRED_DOWNLEVEL.difference(adapter.get_downlevel_capabilities().flags)
+}
+
+/// [`SnowError::AdapterUnsupported`] when the adapter lacks [`REQUIRED_DOWNLEVEL`].
+fn check_downlevel(adapter: &wgpu::Adapter) -> Result<()> {
+    let missing = missing_capabilities(adapter);
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(SnowError::AdapterUnsupported {
+        adapter: describe(&adapter.get_info()),
+        missing: format!("{missing:?}"),
+    })
 }
 
 /// Rank of an adapter: lower is better.
@@ -142,28 +160,65 @@ impl GpuContext {
         Self::from_adapter(adapter).await
     }
 
-    /// Create a device on a given adapter, checking capabilities.
+    /// Create a device on a given adapter, checking capabilities: it requests
+    /// [`required_features`] and [`required_limits`], with timestamp queries where the adapter has
+    /// them, and the size limits the pool and the atlas grow into (largest storage binding and
+    /// buffer, texture side, workgroups a dispatch) raised to the adapter's.
     pub async fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
-        let missing = missing_capabilities(&adapter);
-        if !missing.is_empty() {
-            return Err(SnowError::AdapterUnsupported {
-                adapter: describe(&info),
-                missing: format!("{missing:?}"),
-            });
-        }
+        check_downlevel(&adapter)?;
         let features = adapter.features();
         let limits = adapter.limits();
-        let mut warnings = Vec::new();
-
-        let mut required = wgpu::Features::empty();
-        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        if timestamps {
+        // An adapter that cannot give what the passes need is refused before asking for a device.
+        limits::check(features, &limits)?;
+        let mut required = required_features();
+        if features.contains(wgpu::Features::TIMESTAMP_QUERY) {
             required |= wgpu::Features::TIMESTAMP_QUERY;
             if features.contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
                 required |= wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
             }
-        } else {
+        }
+        let required_limits = wgpu::Limits {
+            max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
+            max_buffer_size: limits.max_buffer_size,
+            max_texture_dimension_2d: limits.max_texture_dimension_2d,
+            max_compute_workgroups_per_dimension: limits.max_compute_workgroups_per_dimension,
+            ..required_limits()
+        };
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("snowprint"),
+                required_features: required,
+                required_limits,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|source| SnowError::RequestDevice {
+                adapter: info.name.clone(),
+                source,
+            })?;
+        Self::from_device(&adapter, device, queue)
+    }
+
+    /// Use a device the caller created (an engine's own) on `adapter`. Its features and limits are
+    /// checked against [`required_features`] and [`required_limits`]: what falls short is
+    /// [`SnowError::DeviceLimit`] or [`SnowError::DeviceFeature`], naming what to request.
+    /// Timestamp queries are used where the device was created with
+    /// `wgpu::Features::TIMESTAMP_QUERY`; without them profiling falls back to CPU times.
+    pub fn from_device(
+        adapter: &wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Result<Self> {
+        let info = adapter.get_info();
+        check_downlevel(adapter)?;
+        check_device(&device)?;
+        let limits = device.limits();
+        let mut warnings = Vec::new();
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        if !timestamps {
             warnings.push(format!(
                 "{} has no GPU timestamp queries: per-pass GPU times are unavailable, whole frames are timed on the CPU instead",
                 info.name
@@ -191,31 +246,6 @@ impl GpuContext {
                 info.name
             ));
         }
-
-        let required_limits = wgpu::Limits {
-            max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
-            max_buffer_size: limits.max_buffer_size,
-            max_texture_dimension_2d: limits.max_texture_dimension_2d,
-            max_compute_workgroups_per_dimension: limits.max_compute_workgroups_per_dimension,
-            max_storage_buffers_per_shader_stage: limits
-                .max_storage_buffers_per_shader_stage
-                .min(8),
-            ..wgpu::Limits::downlevel_defaults()
-        };
-        let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("snowprint"),
-                required_features: required,
-                required_limits,
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
-                memory_hints: wgpu::MemoryHints::Performance,
-                trace: wgpu::Trace::Off,
-            })
-            .await
-            .map_err(|source| SnowError::RequestDevice {
-                adapter: info.name.clone(),
-                source,
-            })?;
         for w in &warnings {
             tracing::warn!("{w}");
         }

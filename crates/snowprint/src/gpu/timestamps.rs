@@ -123,13 +123,26 @@ impl<'a> StageQueries<'a> {
         self.stages.is_empty()
     }
 
+    /// The stages of the measured passes, in order.
+    pub fn stages(&self) -> &[&'static str] {
+        &self.stages
+    }
+
     /// Record the resolve of the frame's queries and their copy to the readback buffer (last in
     /// the frame's encoder).
     pub fn resolve(&self, enc: &mut wgpu::CommandEncoder) {
+        if let Some(ts) = self.timestamps {
+            self.resolve_to(enc, &ts.readback);
+        }
+    }
+
+    /// Record the resolve of the frame's queries and their copy to `readback` (`COPY_DST`, 16
+    /// bytes a measured pass), last in the frame's encoder.
+    pub fn resolve_to(&self, enc: &mut wgpu::CommandEncoder, readback: &wgpu::Buffer) {
         if let (Some(ts), false) = (self.timestamps, self.stages.is_empty()) {
             let n = self.stages.len() as u32 * 2;
             enc.resolve_query_set(&ts.set, 0..n, &ts.resolve, 0);
-            enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.readback, 0, n as u64 * 8);
+            enc.copy_buffer_to_buffer(&ts.resolve, 0, readback, 0, n as u64 * 8);
         }
     }
 

@@ -115,10 +115,13 @@ pub use tessellate::{
 /// The snow material as a WGSL module (no bindings, no entry points), for renderers of your own.
 pub const SNOW_WGSL: &str = crate::wgsl::files::SNOW;
 
-/// What a frame's encoding needs after the passes.
-struct Encoded {
-    encoder: wgpu::CommandEncoder,
-    surfaces: Vec<SurfaceId>,
+/// A frame recorded into a caller's command encoder by [`Renderer::encode_to_view`], waiting
+/// for the caller's `queue.submit`; give it to [`Renderer::submitted`] after submitting.
+#[must_use = "give it to Renderer::submitted after submitting the encoder"]
+#[derive(Debug)]
+pub struct RenderPending {
+    /// Whether the frame's report was copied for reading back.
+    report_copied: bool,
 }
 
 /// The renderer. See the [module documentation](self).
@@ -168,7 +171,12 @@ impl std::fmt::Debug for Renderer {
 
 impl Renderer {
     /// Create a renderer on a GPU context (pipelines are built here, once).
+    ///
+    /// The device is checked against [`crate::required_features`] and
+    /// [`crate::required_limits`] first: [`crate::SnowError::DeviceLimit`] (as
+    /// [`RenderError::World`]) when it falls short.
     pub fn new(gpu: &GpuContext, config: RenderConfig) -> RenderResult<Self> {
+        crate::gpu::check_device(&gpu.device)?;
         let device = gpu.device.clone();
         config.validate(&device)?;
         // Pipelines are checked by naga in the tests; a driver that still refuses one is reported
@@ -324,10 +332,8 @@ impl Renderer {
         self.finish_stats(true)?;
         let output_view = self.targets.output_view.clone();
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let Encoded {
-            mut encoder,
-            surfaces,
-        } = self.encode(world, frame, &output_view, OUTPUT_FORMAT)?;
+        let mut encoder = self.frame_encoder();
+        let surfaces = self.encode(&mut encoder, world, frame, &output_view, OUTPUT_FORMAT)?;
         let (w, h) = self.targets.size;
         encoder.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
@@ -389,8 +395,9 @@ impl Renderer {
     }
 
     /// Render a frame into a caller's texture view (a window's surface texture) of the configured
-    /// size and the given format, without waiting for the GPU. Returns the report of the latest
-    /// earlier frame whose GPU results have come back, if any.
+    /// size and the given format, without waiting for the GPU: [`Renderer::encode_to_view`] into
+    /// an encoder of its own, submitted at once. Returns the report of the latest earlier frame
+    /// whose GPU results have come back, if any.
     pub fn render_to_view(
         &mut self,
         world: &SnowWorld,
@@ -398,6 +405,29 @@ impl Renderer {
         target: &wgpu::TextureView,
         format: wgpu::TextureFormat,
     ) -> RenderResult<Option<FrameReport>> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = self.frame_encoder();
+        let pending = self.encode_to_view(&mut encoder, world, frame, target, format)?;
+        self.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Gpu(e));
+        }
+        Ok(self.submitted(pending))
+    }
+
+    /// Record a frame's passes into the caller's `encoder` (between the engine's own passes),
+    /// drawing into `target` (of the configured size, in `format`). The passes' tables are written
+    /// with `queue.write_buffer`, so they land with the caller's next submission: record one
+    /// frame a submission. Nothing waits for the GPU; after submitting the encoder, give the
+    /// [`RenderPending`] to [`Renderer::submitted`].
+    pub fn encode_to_view(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        world: &SnowWorld,
+        frame: &RenderFrame<'_>,
+        target: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+    ) -> RenderResult<RenderPending> {
         let t = target.texture();
         let expected = self.targets.size;
         if (t.width(), t.height()) != expected {
@@ -407,23 +437,29 @@ impl Renderer {
             });
         }
         self.finish_stats(false)?;
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let Encoded {
-            mut encoder,
-            surfaces,
-        } = self.encode(world, frame, target, format)?;
-        let copied = self.stats.is_idle();
-        if copied {
-            self.copy_stats(&mut encoder, surfaces);
+        let surfaces = self.encode(encoder, world, frame, target, format)?;
+        let report_copied = self.stats.is_idle();
+        if report_copied {
+            self.copy_stats(encoder, surfaces);
         }
-        self.queue.submit([encoder.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e));
-        }
-        if copied {
+        Ok(RenderPending { report_copied })
+    }
+
+    /// The caller submitted the encoder that `pending` was recorded into: start reading its
+    /// report back (without waiting). Returns the report of the latest earlier frame whose GPU
+    /// results have come back, if any.
+    pub fn submitted(&mut self, pending: RenderPending) -> Option<FrameReport> {
+        if pending.report_copied && self.stats.is_idle() {
             self.stats.start_map();
         }
-        Ok(self.latest.clone())
+        self.latest.clone()
+    }
+
+    fn frame_encoder(&self) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("snowprint frame"),
+            })
     }
 
     /// Slot of a surface in the latest frame encoded.
@@ -483,14 +519,15 @@ impl Renderer {
 
     /// Check the frame, extract what it reads of the world ([`SnowWorld::frame_view`]), prepare
     /// every pass (uploads and bind groups), then record the passes in the order of [`PASSES`]
-    /// into one command encoder.
+    /// into `encoder`.
     fn encode(
         &mut self,
+        encoder: &mut wgpu::CommandEncoder,
         world: &SnowWorld,
         frame: &RenderFrame<'_>,
         target: &wgpu::TextureView,
         format: wgpu::TextureFormat,
-    ) -> RenderResult<Encoded> {
+    ) -> RenderResult<Vec<SurfaceId>> {
         frame.check(self.meshes.meshes.len())?;
         let view = world.frame_view();
         let tessellated_tier = self.config.tier == Tier::Tessellated;
@@ -542,20 +579,12 @@ impl Renderer {
         self.tonemap
             .prepare(device, &self.targets, format, self.config.supersample);
 
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("snowprint frame"),
-            });
         // The table sets the order: pass `slot` of PASSES is recorded `slot`-th.
         let flakes = uniform.options[3];
         for slot in 0..PASSES.len() {
-            self.encode_pass(&mut encoder, slot, target, flakes);
+            self.encode_pass(encoder, slot, target, flakes);
         }
-        Ok(Encoded {
-            encoder,
-            surfaces: self.last_surfaces.clone(),
-        })
+        Ok(self.last_surfaces.clone())
     }
 
     /// Record pass `slot` of [`PASSES`] (its label and timestamp slots come from the table).

@@ -100,8 +100,15 @@ pub struct FrameStats {
     pub mesh_draws: u32,
     /// CPU time spent building and encoding the frame, milliseconds.
     pub cpu_encode_ms: f64,
-    /// Per-stage GPU times, when profiling is on and the adapter has timestamp queries.
+    /// The world's number of this frame: 1 for its first update, one more for each after.
+    pub frame: u64,
+    /// Per-stage GPU times of an earlier frame (number [`FrameStats::gpu_frame`]), when
+    /// profiling is on and the adapter has timestamp queries. They are read back without waiting
+    /// for the GPU, so a frame's times arrive with the stats of a later frame, usually the next
+    /// or the one after; [`SnowWorld::take_gpu_times`] collects the last ones.
     pub gpu: Option<StageTimes>,
+    /// The number ([`FrameStats::frame`]) of the frame that [`FrameStats::gpu`] measured.
+    pub gpu_frame: Option<u64>,
 }
 
 /// Bytes of GPU memory the world holds.

@@ -1,20 +1,87 @@
 //! The per-frame update: validate, plan ([`FramePlan`]), upload the plan's tables, record the
-//! capture and the accumulation, submit, and report.
+//! capture and the accumulation into an encoder (the caller's, or the world's own for
+//! [`SnowWorld::step`]), and, once the caller says it was submitted, keep the replenishment and
+//! read the GPU times back without waiting.
 
 use std::time::Instant;
 
 use super::plan::{FramePlan, PlanSettings, PlanSurface};
-use super::{FrameStats, LastFrame, SnowWorld, StageTimes, SurfaceUpdate};
+use super::{FrameStats, InFlight, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
 use crate::capture::{self, CaptureBuffers};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::gpu::timestamps::StageQueries;
+use crate::pool::SurfaceRecord;
+
+/// A frame recorded into a caller's command encoder by [`SnowWorld::encode_update`] or
+/// [`SnowWorld::encode_step`], waiting for the caller's `queue.submit`. Give it back with
+/// [`SnowWorld::submitted`] after submitting the encoder: that keeps the frame's replenishment
+/// and starts reading its GPU times back.
+#[must_use = "give it to SnowWorld::submitted after submitting the encoder"]
+#[derive(Debug)]
+pub struct PendingFrame {
+    world: u64,
+    frame: u64,
+    stats: FrameStats,
+    start: Instant,
+}
+
+impl PendingFrame {
+    /// The frame's number ([`FrameStats::frame`]).
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+}
 
 impl SnowWorld {
-    /// Advance every surface by `dt` seconds with the deformers as posed at the end of the frame.
+    /// Advance every surface by `dt` seconds with the deformers as posed at the end of the frame:
+    /// [`SnowWorld::encode_step`] into an encoder of its own, submitted at once.
     pub fn step(&mut self, dt: f32, deformers: &[Deformer]) -> Result<FrameStats> {
+        let mut encoder = self.encoder();
+        let pending = self.encode_step(&mut encoder, dt, deformers)?;
+        self.submit_own(encoder, pending)
+    }
+
+    /// Update chosen surfaces, each with its own deformers and the time since its last update
+    /// (snow replenishes by that much). Surfaces not listed keep their heightmap untouched. This is
+    /// what a manager with a per-frame budget calls; [`SnowWorld::step`] updates every surface.
+    /// Everything is checked before anything changes. [`SnowWorld::encode_update`] into an
+    /// encoder of its own, submitted at once.
+    pub fn update(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<FrameStats> {
+        let mut encoder = self.encoder();
+        let pending = self.encode_update(&mut encoder, updates)?;
+        self.submit_own(encoder, pending)
+    }
+
+    fn encoder(&self) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("snow update"),
+            })
+    }
+
+    /// Submit an encoder of the world's own and report it submitted; the CPU time includes the
+    /// submission.
+    fn submit_own(
+        &mut self,
+        encoder: wgpu::CommandEncoder,
+        mut pending: PendingFrame,
+    ) -> Result<FrameStats> {
+        self.queue.submit([encoder.finish()]);
+        pending.stats.cpu_encode_ms = pending.start.elapsed().as_secs_f64() * 1e3;
+        self.submitted(pending)
+    }
+
+    /// [`SnowWorld::step`] recorded into the caller's `encoder` (between the engine's own
+    /// passes, say): every surface advances by `dt` seconds. See [`SnowWorld::encode_update`].
+    pub fn encode_step(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        dt: f32,
+        deformers: &[Deformer],
+    ) -> Result<PendingFrame> {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(SnowError::InvalidTimeStep { dt });
         }
@@ -29,35 +96,122 @@ impl SnowWorld {
                 deformers,
             })
             .collect();
-        self.update(&updates)
+        self.encode_update(encoder, &updates)
     }
 
-    /// Update chosen surfaces, each with its own deformers and the time since its last update
-    /// (snow replenishes by that much). Surfaces not listed keep their heightmap untouched. This is
-    /// what a manager with a per-frame budget calls; [`SnowWorld::step`] updates every surface.
-    /// Everything is checked before anything changes.
-    pub fn update(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<FrameStats> {
+    /// [`SnowWorld::update`] recorded into the caller's `encoder`: the capture and accumulation
+    /// passes are appended to it, and the frame's tables are written with `queue.write_buffer`
+    /// (so they land with the caller's next submission, before its command buffers). Nothing
+    /// waits for the GPU. After submitting the encoder, give the [`PendingFrame`] to
+    /// [`SnowWorld::submitted`]; until then the world refuses another encode with
+    /// [`SnowError::FramePending`] (one frame's tables at a time).
+    pub fn encode_update(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        updates: &[SurfaceUpdate<'_>],
+    ) -> Result<PendingFrame> {
         let start = Instant::now();
+        if self.in_flight.is_some() {
+            return Err(SnowError::FramePending);
+        }
         self.validate(updates)?;
         self.probes_before_update();
         let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
         self.plan_into(&mut plan, updates);
+        self.frames += 1;
         let mut stats = plan.stats();
-        let result = if plan.is_empty() {
-            // Nothing captured: the debug readbacks of the last step must not show an older one.
-            self.last.captured.clear();
-            self.commit_carries(&plan);
-            stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
-            Ok(())
+        stats.frame = self.frames;
+        let timestamp_slot = if plan.is_empty() {
+            None
         } else {
             self.upload(&plan);
-            self.record_and_submit(&plan, start, &mut stats)
+            self.record(encoder, &plan)
         };
+        let scratch = &mut self.scratch_cpu;
+        scratch.carries.clear();
+        scratch.carries.extend_from_slice(&plan.carries);
+        remember_captures(&mut scratch.captured, &plan);
         self.scratch_cpu.plan = plan;
-        if result.is_ok() {
-            self.probes_after_update(updates);
+        self.in_flight = Some(InFlight {
+            frame: self.frames,
+            timestamp_slot,
+        });
+        self.probes_after_update(updates);
+        stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(PendingFrame {
+            world: self.id,
+            frame: self.frames,
+            stats,
+            start,
+        })
+    }
+
+    /// The caller submitted the encoder that `pending` was recorded into: keep the frame's
+    /// replenishment, make its captures what the debug readbacks show, and start reading its GPU
+    /// times back. Returns the frame's stats, with the GPU times of the oldest earlier frame
+    /// whose times have arrived (checked without waiting).
+    ///
+    /// # Errors
+    ///
+    /// [`SnowError::StaleHandle`] when `pending` is not this world's frame in flight (nothing
+    /// changes); [`SnowError::Readback`] when reading times back failed (the frame is kept).
+    pub fn submitted(&mut self, pending: PendingFrame) -> Result<FrameStats> {
+        let in_flight = self
+            .in_flight
+            .filter(|f| pending.world == self.id && f.frame == pending.frame)
+            .ok_or(SnowError::StaleHandle {
+                what: "pending frame",
+                index: pending.frame as u32,
+            })?;
+        self.in_flight = None;
+        let carries = std::mem::take(&mut self.scratch_cpu.carries);
+        self.commit_carries(&carries);
+        self.scratch_cpu.carries = carries;
+        std::mem::swap(&mut self.last.captured, &mut self.scratch_cpu.captured);
+        self.free_deferred();
+        // Probe answers that came back while the frame was being submitted.
+        self.poll_probes_only();
+        let mut stats = pending.stats;
+        if let Some(ring) = self.timestamps.as_mut() {
+            if let Some(slot) = in_flight.timestamp_slot {
+                ring.submitted(slot);
+            }
+            if let Some((frame, times)) = ring.poll(&self.device)? {
+                stats.gpu = Some(stage_times(&times));
+                stats.gpu_frame = Some(frame);
+            }
         }
-        result.map(|()| stats)
+        Ok(stats)
+    }
+
+    /// Forget the frame in flight, whose encoder will never be submitted (dropped, or its
+    /// [`PendingFrame`] lost): its replenishment is not kept, and the world encodes again.
+    pub fn abandon_pending(&mut self) {
+        if let Some(f) = self.in_flight.take() {
+            if let (Some(ring), Some(slot)) = (self.timestamps.as_mut(), f.timestamp_slot) {
+                ring.abandon(slot);
+            }
+            self.free_deferred();
+        }
+    }
+
+    /// The oldest measured frame whose GPU times have arrived and were not yet reported, with
+    /// its number ([`FrameStats::frame`]); checked without waiting. After the last frame (and,
+    /// say, [`crate::GpuContext::wait_idle`]) this collects the times still on their way.
+    pub fn take_gpu_times(&mut self) -> Result<Option<(u64, StageTimes)>> {
+        let Some(ring) = self.timestamps.as_mut() else {
+            return Ok(None);
+        };
+        Ok(ring
+            .poll(&self.device)?
+            .map(|(frame, times)| (frame, stage_times(&times))))
+    }
+
+    /// Give back the slots of surfaces removed while a frame was in flight.
+    fn free_deferred(&mut self) {
+        for slot in self.deferred_frees.drain(..) {
+            self.alloc.free(slot);
+        }
     }
 
     /// Refuse a bad time step, a stale or repeated surface, a bad deformer or a stale mesh.
@@ -127,9 +281,9 @@ impl SnowWorld {
     }
 
     /// Keep the replenishment carried by every surface planned.
-    fn commit_carries(&mut self, plan: &FramePlan) {
-        for &(index, carry) in &plan.carries {
-            if let Some(s) = self.surfaces[index].as_mut() {
+    fn commit_carries(&mut self, carries: &[(usize, f64)]) {
+        for &(index, carry) in carries {
+            if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
                 s.carry = carry;
             }
         }
@@ -166,22 +320,15 @@ impl SnowWorld {
         self.tile_list.ensure(device, sizes.tile_list);
     }
 
-    /// Record the plan's capture and accumulation, submit them, keep the carries and what the
-    /// debug readbacks need, and read the stage times back when profiling.
-    fn record_and_submit(
-        &mut self,
-        plan: &FramePlan,
-        start: Instant,
-        stats: &mut FrameStats,
-    ) -> Result<()> {
+    /// Record the plan's capture and accumulation into `enc`, with the resolve of their
+    /// timestamps when profiling (into a free slot of the ring, which it returns).
+    fn record(&mut self, enc: &mut wgpu::CommandEncoder, plan: &FramePlan) -> Option<usize> {
         let atlas = self.atlas(plan.capture.atlas_side);
-        let timestamps = self.timestamps.as_ref().filter(|_| self.profiling);
+        // A frame is measured only while a readback slot is free: times are never waited for.
+        let ring = self.timestamps.as_ref().filter(|_| self.profiling);
+        let slot = ring.and_then(|r| r.free_slot());
+        let timestamps = ring.filter(|_| slot.is_some()).map(|r| r.timestamps());
         let mut queries = StageQueries::new(timestamps);
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("snow update"),
-            });
         let capture_buffers = CaptureBuffers {
             views: &self.views.buffer,
             prims: &self.prims.buffer,
@@ -194,7 +341,7 @@ impl SnowWorld {
         };
         capture::encode(
             &self.device,
-            &mut enc,
+            enc,
             &self.capture_pipes,
             &plan.capture,
             &capture_buffers,
@@ -212,28 +359,24 @@ impl SnowWorld {
         };
         accumulate::encode(
             &self.device,
-            &mut enc,
+            enc,
             &self.acc,
             &plan.accumulate,
             &accumulate_buffers,
             &mut queries,
         );
-        queries.resolve(&mut enc);
-        self.queue.submit([enc.finish()]);
-        stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
-
-        let times = queries.read(&self.device);
-        drop(queries);
-        self.commit_carries(plan);
-        remember_captures(&mut self.last, plan);
-        let times = times?;
-        if !times.is_empty() {
-            stats.gpu = Some(stage_times(&times));
+        let (ring, slot) = (ring?, slot?);
+        if queries.is_empty() {
+            return None;
         }
-        Ok(())
+        ring.resolve(slot, &queries, enc);
+        let stages = queries.stages().to_vec();
+        drop(queries);
+        let frame = self.frames;
+        self.timestamps.as_mut()?.arm(slot, frame, &stages);
+        Some(slot)
     }
 }
-
 /// Write `items` as uniform blocks [`UNIFORM_STRIDE`] apart into `bytes` (at least `min` blocks).
 fn uniform_blocks<T: bytemuck::Pod>(bytes: &mut Vec<u8>, items: &[T], min: usize) {
     let stride = UNIFORM_STRIDE as usize;
@@ -245,10 +388,10 @@ fn uniform_blocks<T: bytemuck::Pod>(bytes: &mut Vec<u8>, items: &[T], min: usize
     }
 }
 
-/// The captured surfaces of a submitted frame, for the debug readbacks.
-fn remember_captures(last: &mut LastFrame, plan: &FramePlan) {
-    last.captured.clear();
-    last.captured.extend(plan.capture.surfaces.iter().map(|s| {
+/// The captured surfaces of a frame, for the debug readbacks once it is submitted.
+fn remember_captures(captured: &mut Vec<(usize, SurfaceRecord)>, plan: &FramePlan) {
+    captured.clear();
+    captured.extend(plan.capture.surfaces.iter().map(|s| {
         let j = s.record as usize;
         (plan.surfaces[j].index, plan.accumulate.records[j])
     }));

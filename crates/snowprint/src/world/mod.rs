@@ -9,9 +9,10 @@
 //! The update is a plan, then an encode (`frame.rs`): validate the updates, build the pure
 //! [`FramePlan`] on the CPU ([`plan`]: culling, sweeping, replenishment, atlas packing, records and
 //! buffer sizes), upload its tables, record it with [`crate::capture::encode`] and
-//! [`crate::accumulate::encode`], submit, and keep the plan's replenishment carries. The rest of
-//! the world is its surfaces and pool slots (here), mesh deformers (`meshes.rs`), snapshots
-//! (`snapshot.rs`) and readbacks (`readback.rs`).
+//! [`crate::accumulate::encode`] into an encoder (the caller's, with
+//! [`SnowWorld::encode_update`]), and once it is submitted keep the plan's replenishment carries
+//! ([`SnowWorld::submitted`]). The rest of the world is its surfaces and pool slots (here), mesh
+//! deformers (`meshes.rs`), snapshots (`snapshot.rs`) and readbacks (`readback.rs`).
 
 mod config;
 mod footstep;
@@ -25,6 +26,7 @@ mod snapshot;
 pub use crate::capture::{CaptureConfig, CaptureMode};
 pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
 pub use footstep::Footstep;
+pub use frame::PendingFrame;
 pub(crate) use plan::FramePlan;
 pub use probe::{
     MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus, ProbeTicket,
@@ -35,7 +37,7 @@ use crate::accumulate::AccumulatePipelines;
 use crate::capture::{self, CaptureMesh, CapturePipelines};
 use crate::error::{Result, SnowError};
 use crate::gpu::resources::{Growable, UNIFORM_STRIDE};
-use crate::gpu::timestamps::Timestamps;
+use crate::gpu::ring::TimestampRing;
 use crate::gpu::{Capabilities, GpuContext};
 use crate::pool::{PoolFormat, Slot, SlotAllocator, SurfaceRecord};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
@@ -64,6 +66,18 @@ struct FrameScratch {
     seen: Vec<bool>,
     /// Uniform blocks being uploaded, [`UNIFORM_STRIDE`] apart.
     blocks: Vec<u8>,
+    /// A pending frame's carries and captures, given back when it is submitted.
+    carries: Vec<(usize, f64)>,
+    captured: Vec<(usize, SurfaceRecord)>,
+}
+
+/// The frame encoded and not yet reported submitted.
+#[derive(Clone, Copy, Debug)]
+struct InFlight {
+    /// Its number.
+    frame: u64,
+    /// The timestamp ring's slot it resolves into.
+    timestamp_slot: Option<usize>,
 }
 
 /// The snow world: every surface's heightmap in one GPU pool, updated by [`SnowWorld::step`].
@@ -96,10 +110,21 @@ pub struct SnowWorld {
     last: LastFrame,
     scratch_cpu: FrameScratch,
     profiling: bool,
-    timestamps: Option<Timestamps>,
+    timestamps: Option<TimestampRing>,
+    /// Which world this is, so that a [`PendingFrame`] is given back to its own.
+    id: u64,
+    /// Frames encoded so far.
+    frames: u64,
+    in_flight: Option<InFlight>,
+    /// Slots of surfaces removed while a frame was in flight, freed once it is submitted: the
+    /// frame still writes them.
+    deferred_frees: Vec<Slot>,
     /// Gameplay probes, their ring and cache, and the last update's footsteps.
     probes: probe::Probes,
 }
+
+/// Source of [`SnowWorld`] ids.
+static NEXT_WORLD: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl std::fmt::Debug for SnowWorld {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -112,7 +137,12 @@ impl std::fmt::Debug for SnowWorld {
 
 impl SnowWorld {
     /// Create a world on a GPU context.
+    ///
+    /// The device is checked against [`crate::required_features`] and
+    /// [`crate::required_limits`] first (a hand-filled [`GpuContext`] too):
+    /// [`SnowError::DeviceLimit`] or [`SnowError::DeviceFeature`] when it falls short.
     pub fn new(gpu: &GpuContext, config: WorldConfig) -> Result<Self> {
+        crate::gpu::check_device(&gpu.device)?;
         let device = gpu.device.clone();
         let mut config = config;
         let c = config.capture;
@@ -135,6 +165,7 @@ impl SnowWorld {
         let max_pool = gpu
             .caps
             .max_storage_binding
+            .min(device.limits().max_storage_buffer_binding_size)
             .min(device.limits().max_buffer_size)
             / 256
             * 256;
@@ -146,7 +177,11 @@ impl SnowWorld {
             );
             config.pool_bytes = max_pool;
         }
-        config.atlas_side = config.atlas_side.clamp(64, gpu.caps.max_texture_side);
+        let max_side = gpu
+            .caps
+            .max_texture_side
+            .min(device.limits().max_texture_dimension_2d);
+        config.atlas_side = config.atlas_side.clamp(64, max_side);
         if config.passes == PassMode::Auto {
             config.passes = PassMode::Fused;
         }
@@ -161,10 +196,9 @@ impl SnowWorld {
             mapped_at_creation: false,
         });
         use wgpu::BufferUsages as U;
-        let timestamps = gpu
-            .caps
-            .timestamps
-            .then(|| Timestamps::new(&device, &gpu.queue, "snowprint timestamps", 256));
+        let timestamps = (gpu.caps.timestamps
+            && device.features().contains(wgpu::Features::TIMESTAMP_QUERY))
+        .then(|| TimestampRing::new(&device, &gpu.queue, "snowprint timestamps", 256));
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
             acc: AccumulatePipelines::new(&device, config.format.precision),
@@ -227,6 +261,10 @@ impl SnowWorld {
             scratch_cpu: FrameScratch::default(),
             profiling: false,
             timestamps,
+            id: NEXT_WORLD.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            frames: 0,
+            in_flight: None,
+            deferred_frees: Vec::new(),
         })
     }
 
@@ -235,8 +273,8 @@ impl SnowWorld {
         &self.config
     }
 
-    /// Measure each stage with GPU timestamp queries (when the adapter has them). Each
-    /// [`SnowWorld::step`] then waits for the GPU and reports [`FrameStats::gpu`].
+    /// Measure each stage with GPU timestamp queries (when the adapter has them). Nothing waits
+    /// for the GPU: [`FrameStats::gpu`] reports the times of an earlier frame, as they arrive.
     pub fn set_profiling(&mut self, on: bool) {
         self.profiling = on;
     }
@@ -278,9 +316,9 @@ impl SnowWorld {
             free: self.alloc.largest_free(),
             budget: self.alloc.budget(),
         })?;
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes));
-        self.queue.submit([enc.finish()]);
+        // Cleared with the next submission (before its command buffers), no encoder needed.
+        let zeros = vec![0u8; slot.bytes as usize];
+        self.queue.write_buffer(&self.pool, slot.offset, &zeros);
         Ok(slot)
     }
 
@@ -308,7 +346,11 @@ impl SnowWorld {
         let index = id.0 as usize;
         let state = self.surfaces[index].take().expect("checked live above");
         self.generations[index] = self.generations[index].saturating_add(1);
-        self.alloc.free(state.slot);
+        if self.in_flight.is_some() {
+            self.deferred_frees.push(state.slot);
+        } else {
+            self.alloc.free(state.slot);
+        }
         Ok(())
     }
 

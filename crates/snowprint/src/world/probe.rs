@@ -442,7 +442,7 @@ impl SnowWorld {
     }
 
     /// Poll the device without waiting and read what came back.
-    fn poll_probes_only(&mut self) {
+    pub(super) fn poll_probes_only(&mut self) {
         if self.probes.in_flight() == 0 {
             return;
         }
