@@ -129,13 +129,24 @@ impl SurfaceUniform {
 
     /// [`Self::for_surface`] from one surface of a view.
     pub fn for_view(surface: &crate::SurfaceView<'_>) -> Self {
+        let config = crate::render::RenderConfig::new(1, 1, crate::render::Tier::Relief);
+        let shading = Shading {
+            search: config.search_settings(),
+            look: config.look,
+            ground: 0,
+            index: surface.id.index(),
+            macro_waves: 1.0,
+        };
+        Self::shaded(surface, &shading)
+    }
+
+    /// One surface of a view with the material settings of `shading`.
+    pub(crate) fn shaded(surface: &crate::SurfaceView<'_>, shading: &Shading) -> Self {
         let (desc, layout) = (surface.desc, surface.layout);
         let texel_x = desc.size.x / layout.width as f32;
         let texel_z = desc.size.y / layout.height as f32;
         let local_to_world = desc.local_to_world();
-        let config = crate::render::RenderConfig::new(1, 1, crate::render::Tier::Relief);
-        let search = config.search_settings();
-        let look = config.look;
+        let (search, look) = (&shading.search, &shading.look);
         Self {
             local_to_world: local_to_world.to_cols_array_2d(),
             world_to_local: local_to_world.inverse().to_cols_array_2d(),
@@ -143,8 +154,8 @@ impl SurfaceUniform {
             snow_depth: desc.snow_depth,
             texel: texel_x.max(texel_z),
             grid: [layout.width as f32, layout.height as f32],
-            ground: 0,
-            index: surface.id.index(),
+            ground: shading.ground,
+            index: shading.index,
             search: [
                 search.taps_per_texel,
                 search.min_taps as f32,
@@ -157,7 +168,12 @@ impl SurfaceUniform {
                 look.occlusion,
                 search.shadow_taps as f32,
             ],
-            pattern: [desc.center.x, desc.center.z, look.switch_bits() as f32, 1.0],
+            pattern: [
+                desc.center.x,
+                desc.center.z,
+                look.switch_bits() as f32,
+                shading.macro_waves,
+            ],
             heights: surface.heights,
             row_words: crate::PoolFormat::new(surface.precision).row_words(layout.width),
             bits: surface.precision.bits(),
@@ -168,6 +184,20 @@ impl SurfaceUniform {
             texel_z,
         }
     }
+}
+
+/// The material settings of one surface's [`SurfaceUniform`].
+pub(crate) struct Shading {
+    /// The relief or POM search.
+    pub search: crate::render::SearchSettings,
+    /// The material's look and switches.
+    pub look: crate::render::SnowLook,
+    /// `SNOW_GROUND_TILES` or `SNOW_GROUND_CONCRETE`.
+    pub ground: u32,
+    /// The surface's slot in the renderer's per-surface tables.
+    pub index: u32,
+    /// Strength of the macro waves.
+    pub macro_waves: f32,
 }
 
 /// One surface for the classify pass. Must match `ClassifyRecord` in `classify.wgsl`.

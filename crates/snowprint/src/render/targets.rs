@@ -92,6 +92,27 @@ impl Targets {
         })]
     }
 
+    /// Begin a render pass over the scene colour (loaded as `color`) and depth (`depth`, `None`:
+    /// read-only), as the passes that draw into the scene do.
+    pub(super) fn scene_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
+        color: wgpu::LoadOp<wgpu::Color>,
+        depth: Option<wgpu::Operations<f32>>,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
+        let attachments = self.color(color);
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &attachments,
+            depth_stencil_attachment: self.depth(depth),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
     /// The scene depth as a pass's depth attachment (`None`: read-only).
     pub(super) fn depth(
         &self,

@@ -51,18 +51,17 @@ impl OpaquePass {
         frame: &wgpu::BindGroup,
         meshes: &MeshSet,
     ) {
-        let attachments = targets.color(wgpu::LoadOp::Clear(wgpu::Color::BLACK));
-        let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(PASSES[slot].name),
-            color_attachments: &attachments,
-            depth_stencil_attachment: targets.depth(Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
-                store: wgpu::StoreOp::Store,
-            })),
-            timestamp_writes: render_writes(ts, slot),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let clear_depth = wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        };
+        let mut p = targets.scene_pass(
+            encoder,
+            PASSES[slot].name,
+            wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            Some(clear_depth),
+            render_writes(ts, slot),
+        );
         if meshes.has_draws(false) {
             p.set_pipeline(&self.pipeline);
             p.set_bind_group(0, frame, &[]);

@@ -37,15 +37,13 @@ impl SkyPass {
         targets: &Targets,
         frame: &wgpu::BindGroup,
     ) {
-        let attachments = targets.color(wgpu::LoadOp::Load);
-        let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(PASSES[slot].name),
-            color_attachments: &attachments,
-            depth_stencil_attachment: targets.depth(None),
-            timestamp_writes: render_writes(ts, slot),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut p = targets.scene_pass(
+            encoder,
+            PASSES[slot].name,
+            wgpu::LoadOp::Load,
+            None,
+            render_writes(ts, slot),
+        );
         p.set_pipeline(&self.pipeline);
         p.set_bind_group(0, frame, &[]);
         p.draw(0..3, 0..1);

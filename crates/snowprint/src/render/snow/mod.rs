@@ -7,7 +7,7 @@
 use super::config::RenderConfig;
 use super::frame::FrameSurface;
 use super::gpu::{
-    STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, SurfaceUniform, UNIFORM_STRIDE,
+    STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, Shading, SurfaceUniform, UNIFORM_STRIDE,
 };
 use super::graph::PASSES;
 use super::heightfield::HeightfieldPass;
@@ -88,42 +88,17 @@ impl SnowPass {
         let stride = UNIFORM_STRIDE as usize;
         let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
         for (s, surface) in surfaces.iter().enumerate() {
-            let (desc, layout) = (surface.view.desc, surface.view.layout);
-            let texel = surface.texel();
-            let local_to_world = desc.local_to_world();
-            let u = SurfaceUniform {
-                local_to_world: local_to_world.to_cols_array_2d(),
-                world_to_local: local_to_world.inverse().to_cols_array_2d(),
-                half_size: (desc.size * 0.5).to_array(),
-                snow_depth: desc.snow_depth,
-                texel: texel.x.max(texel.y),
-                grid: [layout.width as f32, layout.height as f32],
+            let shading = Shading {
+                search,
+                look,
                 ground: match surface.ground {
                     GroundMaterial::RoofTiles => 0,
                     GroundMaterial::Concrete => 1,
                 },
                 index: s as u32,
-                search: [
-                    search.taps_per_texel,
-                    search.min_taps as f32,
-                    search.max_taps as f32,
-                    search.refine_taps as f32,
-                ],
-                look: [
-                    look.ground_from,
-                    look.ground_full,
-                    look.occlusion,
-                    search.shadow_taps as f32,
-                ],
-                pattern: [
-                    desc.center.x,
-                    desc.center.z,
-                    look.switch_bits() as f32,
-                    surface.geometry.macro_waves,
-                ],
-                // Where the texels lie in the pool (read by engines' shaders, not this pass).
-                ..SurfaceUniform::for_view(surface.view)
+                macro_waves: surface.geometry.macro_waves,
             };
+            let u = SurfaceUniform::shaded(surface.view, &shading);
             bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
                 .copy_from_slice(bytemuck::bytes_of(&u));
         }
