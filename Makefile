@@ -19,7 +19,6 @@ lint:
 
 test: vulkan lint
 	$(CARGO) test --release --locked --workspace
-	$(CARGO) run --release --locked -p snowprint --example custom_renderer
 
 bench: vulkan build
 	./target/release/snowprint bench

@@ -104,7 +104,8 @@ fn run() -> Result<(), String> {
     let view_proj = top_down(desc.center, desc.size.x, desc.size.y);
     let image = draw(&gpu, view.pool_buffer, &surface, view_proj, width, height)?;
 
-    if let Some(path) = std::env::args().nth(1) {
+    // `cargo test` runs this example as a test (no harness): flags it passes on are not paths.
+    if let Some(path) = std::env::args().nth(1).filter(|a| !a.starts_with('-')) {
         write_png(&path, width, height, &image.picture)?;
         println!("custom_renderer: wrote {path}");
     }
