@@ -81,6 +81,18 @@ pub(super) fn render_writes(
     render_span(ts, slot, true, true)
 }
 
+/// Begin pass `slot` of [`PASSES`] as one compute pass, labelled and timed from the table.
+pub(super) fn compute_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    ts: Option<&Timestamps>,
+    slot: usize,
+) -> wgpu::ComputePass<'e> {
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(PASSES[slot].name),
+        timestamp_writes: compute_writes(ts, slot),
+    })
+}
+
 /// The timestamp writes of a pass that is one compute pass.
 pub(super) fn compute_writes(
     ts: Option<&Timestamps>,

@@ -5,9 +5,8 @@
 
 use super::frame::FrameSurface;
 use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
-use super::graph::PASSES;
 use super::pipeline;
-use super::readback::{Timestamps, compute_writes};
+use super::readback::{Timestamps, compute_pass};
 use crate::gpu::resources::{Growable, bind_group};
 
 pub(super) struct ClassifyPass {
@@ -95,10 +94,7 @@ impl ClassifyPass {
         ts: Option<&Timestamps>,
         slot: usize,
     ) {
-        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(PASSES[slot].name),
-            timestamp_writes: compute_writes(ts, slot),
-        });
+        let mut p = compute_pass(encoder, ts, slot);
         if let Some(bg) = &self.bind_group {
             p.set_pipeline(&self.pipeline);
             p.set_bind_group(0, bg, &[]);

@@ -10,9 +10,8 @@ use glam::Vec3;
 use super::error::{RenderError, RenderResult};
 use super::frame::FrameSurface;
 use super::gpu::{HeightfieldParams, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
-use super::graph::PASSES;
 use super::pipeline;
-use super::readback::{Timestamps, compute_writes, f16_to_f32, map_staging};
+use super::readback::{Timestamps, compute_pass, f16_to_f32, map_staging};
 use super::targets::HEIGHTFIELD_FORMAT;
 use super::tessellate::SurfaceFields;
 use crate::gpu::resources::{Growable, bind_group, uniform_block};
@@ -180,10 +179,7 @@ impl HeightfieldPass {
         slot: usize,
         state: &wgpu::Buffer,
     ) {
-        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(PASSES[slot].name),
-            timestamp_writes: compute_writes(ts, slot),
-        });
+        let mut p = compute_pass(encoder, ts, slot);
         p.set_pipeline(&self.pipeline);
         for (s, bg) in self.bind_groups.iter().enumerate() {
             p.set_bind_group(0, bg, &[]);

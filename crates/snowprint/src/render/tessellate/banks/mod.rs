@@ -7,10 +7,9 @@ use super::BankParams;
 use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
-use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::pipeline;
-use crate::render::readback::{Timestamps, compute_writes};
+use crate::render::readback::{Timestamps, compute_pass};
 
 pub(in crate::render) struct BanksPass {
     layout: wgpu::BindGroupLayout,
@@ -123,10 +122,7 @@ impl BanksPass {
         slot: usize,
         state: &wgpu::Buffer,
     ) {
-        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(PASSES[slot].name),
-            timestamp_writes: compute_writes(ts, slot),
-        });
+        let mut p = compute_pass(encoder, ts, slot);
         for (step, pipeline) in [&self.norm, &self.gather].into_iter().enumerate() {
             p.set_pipeline(pipeline);
             for (s, groups) in self.bind_groups.iter().enumerate() {

@@ -16,11 +16,10 @@ use crate::render::config::RenderConfig;
 use crate::render::error::RenderResult;
 use crate::render::frame::{FAR, FrameSurface, NEAR};
 use crate::render::gpu::{FrameUniform, UNIFORM_STRIDE};
-use crate::render::graph::PASSES;
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::inputs::RenderFrame;
 use crate::render::pipeline;
-use crate::render::readback::{Timestamps, compute_writes, read_back};
+use crate::render::readback::{Timestamps, compute_pass, read_back};
 use crate::surface::SurfaceId;
 
 /// A surface's base mesh on the GPU.
@@ -235,10 +234,7 @@ impl DicePass {
         slot: usize,
     ) {
         encoder.clear_buffer(&self.counters.buffer, 0, None);
-        let mut p = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(PASSES[slot].name),
-            timestamp_writes: compute_writes(ts, slot),
-        });
+        let mut p = compute_pass(encoder, ts, slot);
         for (group, triangles) in self.bind_groups.iter().flatten() {
             p.set_bind_group(0, group, &[]);
             p.set_pipeline(&self.dice);
