@@ -413,3 +413,94 @@ fn the_renderer_records_into_the_callers_encoder() {
         "the frame recorded into the engine's encoder is the offscreen frame"
     );
 }
+
+/// Probes queued before an `encode_step` ride the caller's encoder: nothing is answered before
+/// the caller submits; after it submits (and, as a swapchain would, lets the GPU finish that
+/// frame) the answer is there. An abandoned frame queues its probes again.
+#[test]
+fn probes_ride_the_callers_encoder_and_survive_an_abandoned_frame() {
+    let gpu = engine_gpu(false);
+    let mut world = SnowWorld::new(&gpu, WorldConfig::default()).unwrap();
+    roof(&mut world);
+    world.step(0.01, &[foot()]).unwrap();
+    let point = Vec3::new(0.1, 0.2, -0.2);
+    let ticket = world.probe(&[point]).unwrap();
+
+    // Recorded into an encoder that is dropped: the request is queued again, not lost.
+    let mut dropped = gpu.device.create_command_encoder(&Default::default());
+    let _lost = world.encode_step(&mut dropped, 0.01, &[]).unwrap();
+    drop(dropped);
+    world.abandon_pending();
+    assert_eq!(world.probes_in_flight(), 0);
+    assert_eq!(
+        world.probe_result(ticket).unwrap(),
+        snowprint::ProbeStatus::Pending
+    );
+
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let pending = world.encode_step(&mut encoder, 0.01, &[]).unwrap();
+    assert_eq!(
+        world.probes_in_flight(),
+        1,
+        "recorded into the caller's encoder"
+    );
+    assert_eq!(
+        world.probe_result(ticket).unwrap(),
+        snowprint::ProbeStatus::Pending
+    );
+    let index = gpu.queue.submit([encoder.finish()]);
+    world.submitted(pending).unwrap();
+    // The engine's frame pacing, not the library: the frame has run on the GPU.
+    gpu.device
+        .poll(wgpu::PollType::Wait {
+            submission_index: Some(index),
+            timeout: None,
+        })
+        .unwrap();
+    let snowprint::ProbeStatus::Ready(samples) = world.probe_result(ticket).unwrap() else {
+        panic!("the frame that carried the probe has run, its answer must be there");
+    };
+    let map = world
+        .read_heightmap(world.surfaces().next().unwrap().0)
+        .unwrap();
+    let deepest = map.depression.iter().copied().max().unwrap();
+    assert!(deepest > 0);
+    // The sphere's centre is over the point: the probe reads a pressed texel.
+    assert!(samples[0].depression_m > 0.05, "{:?}", samples[0]);
+    assert!(samples[0].surface.is_some());
+}
+
+/// While it snows, an abandoned frame's replenishment is not kept: the carry a snapshot shows is
+/// the one before the frame, and a submitted frame moves it on exactly as `step` does.
+#[test]
+fn an_abandoned_frame_keeps_no_replenishment() {
+    let gpu = engine_gpu(false);
+    let mut world = SnowWorld::new(&gpu, WorldConfig::default()).unwrap();
+    let mut twin = SnowWorld::new(&gpu, WorldConfig::default()).unwrap();
+    let mut desc = SurfaceDesc::new("roof", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
+    desc.replenish_rate = 0.0123;
+    let id = world.add_surface(desc.clone()).unwrap();
+    let twin_id = twin.add_surface(desc).unwrap();
+    let carry = |w: &SnowWorld, id| w.snapshot_surfaces(&[id]).unwrap()[0].carry;
+    world.step(0.013, &[foot()]).unwrap();
+    twin.step(0.013, &[foot()]).unwrap();
+    let before = carry(&world, id);
+    assert!(before > 0.0, "the step's snowfall leaves a fraction behind");
+
+    let mut dropped = gpu.device.create_command_encoder(&Default::default());
+    let _lost = world.encode_step(&mut dropped, 0.017, &[]).unwrap();
+    world.abandon_pending();
+    assert_eq!(carry(&world, id), before);
+
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let pending = world.encode_step(&mut encoder, 0.017, &[]).unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    world.submitted(pending).unwrap();
+    twin.step(0.017, &[]).unwrap();
+    assert_ne!(carry(&world, id), before);
+    assert_eq!(carry(&world, id), carry(&twin, twin_id));
+    assert_eq!(
+        world.read_packed(id).unwrap(),
+        twin.read_packed(twin_id).unwrap()
+    );
+}

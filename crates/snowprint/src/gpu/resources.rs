@@ -77,3 +77,25 @@ pub(crate) fn bind_group(
         entries: &entries,
     })
 }
+
+/// Record a write of `bytes` into `target` at `offset` in `enc`, through a staging buffer made for
+/// it: unlike `queue.write_buffer`, which lands before every command buffer of the next
+/// submission, this lands in the encoder's order (after what `enc` recorded before it).
+pub(crate) fn write_in_order(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    target: &wgpu::Buffer,
+    offset: u64,
+    bytes: &[u8],
+) {
+    use wgpu::util::DeviceExt;
+    if bytes.is_empty() {
+        return;
+    }
+    let staging = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("in-order write"),
+        contents: bytes,
+        usage: wgpu::BufferUsages::COPY_SRC,
+    });
+    enc.copy_buffer_to_buffer(&staging, 0, target, offset, bytes.len() as u64);
+}

@@ -24,7 +24,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("fused", "accumulate/fused.wgsl", true),
     ("seal", "accumulate/seal.wgsl", true),
     // Gameplay probes: the pool under chosen points.
-    ("probe", "world/probe.wgsl", true),
+    ("probe", "world/probe/probe.wgsl", true),
     // The renderer.
     ("frame", "render/frame/frame.wgsl", false),
     ("snow", "render/snow/snow.wgsl", false),

@@ -111,6 +111,17 @@ pub struct FrameStats {
     pub gpu_frame: Option<u64>,
 }
 
+impl FrameStats {
+    /// Add the counts of one more layer of the frame (see the manager's catch-up).
+    pub(crate) fn add_layer(&mut self, layer: &FrameStats) {
+        self.updated += layer.updated;
+        self.captured += layer.captured;
+        self.capture_batches += layer.capture_batches;
+        self.primitives += layer.primitives;
+        self.mesh_draws += layer.mesh_draws;
+    }
+}
+
 /// Bytes of GPU memory the world holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct MemoryReport {

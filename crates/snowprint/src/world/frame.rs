@@ -39,6 +39,9 @@ impl SnowWorld {
     /// Advance every surface by `dt` seconds with the deformers as posed at the end of the frame:
     /// [`SnowWorld::encode_step`] into an encoder of its own, submitted at once.
     pub fn step(&mut self, dt: f32, deformers: &[Deformer]) -> Result<FrameStats> {
+        // Queued probes go first in a submission of their own, so that their answer does not
+        // wait for the update's passes.
+        self.send_probes();
         let mut encoder = self.encoder();
         let pending = self.encode_step(&mut encoder, dt, deformers)?;
         self.submit_own(encoder, pending)
@@ -50,6 +53,7 @@ impl SnowWorld {
     /// Everything is checked before anything changes. [`SnowWorld::encode_update`] into an
     /// encoder of its own, submitted at once.
     pub fn update(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<FrameStats> {
+        self.send_probes();
         let mut encoder = self.encoder();
         let pending = self.encode_update(&mut encoder, updates)?;
         self.submit_own(encoder, pending)
@@ -110,33 +114,72 @@ impl SnowWorld {
         encoder: &mut wgpu::CommandEncoder,
         updates: &[SurfaceUpdate<'_>],
     ) -> Result<PendingFrame> {
+        self.encode_layers(encoder, &[updates])
+    }
+
+    /// Record several updates one after the other into one encoder, as one frame: layer `j + 1`
+    /// starts from the snow layer `j` leaves (the manager's frame-by-frame catch-up). The first
+    /// layer's tables are written with `queue.write_buffer`, the later ones through staging
+    /// copies in the encoder, so that each layer's passes read its own tables. Replenishment
+    /// carries are kept as each layer is planned (and put back by
+    /// [`SnowWorld::abandon_pending`]).
+    pub(crate) fn encode_layers(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        layers: &[&[SurfaceUpdate<'_>]],
+    ) -> Result<PendingFrame> {
         let start = Instant::now();
         if self.in_flight.is_some() {
             return Err(SnowError::FramePending);
         }
-        self.validate(updates)?;
-        self.probes_before_update();
-        let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
-        self.plan_into(&mut plan, updates);
+        for updates in layers {
+            self.validate(updates)?;
+        }
+        self.probes_before_update(encoder);
         self.frames += 1;
-        let mut stats = plan.stats();
-        stats.frame = self.frames;
-        let timestamp_slot = if plan.is_empty() {
-            None
-        } else {
-            self.upload(&plan);
-            self.record(encoder, &plan)
+        let mut stats = FrameStats {
+            frame: self.frames,
+            ..FrameStats::default()
         };
-        let scratch = &mut self.scratch_cpu;
-        scratch.carries.clear();
-        scratch.carries.extend_from_slice(&plan.carries);
-        remember_captures(&mut scratch.captured, &plan);
-        self.scratch_cpu.plan = plan;
+        self.scratch_cpu.carries.clear();
+        // The ring is taken out while the layers borrow its query set.
+        let ring = self.timestamps.take();
+        // A frame is measured only while a readback slot is free: times are never waited for.
+        let measured = ring.as_ref().filter(|_| self.profiling);
+        let slot = measured.and_then(|r| r.free_slot());
+        let mut queries =
+            StageQueries::new(measured.filter(|_| slot.is_some()).map(|r| r.timestamps()));
+        for (j, updates) in layers.iter().enumerate() {
+            let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
+            self.plan_into(&mut plan, updates);
+            stats.add_layer(&plan.stats());
+            if !plan.is_empty() {
+                self.upload(&plan, (j > 0).then_some(&mut *encoder));
+                self.record(encoder, &plan, &mut queries);
+                remember_captures(&mut self.scratch_cpu.captured, &plan);
+            }
+            self.keep_carries(&plan.carries);
+            self.scratch_cpu.plan = plan;
+        }
+        let stages = queries.stages().to_vec();
+        let timestamp_slot = match (slot, stages.is_empty()) {
+            (Some(slot), false) => {
+                let r = ring.as_ref().expect("a slot comes from the ring");
+                r.resolve(slot, &queries, encoder);
+                Some(slot)
+            }
+            _ => None,
+        };
+        drop(queries);
+        self.timestamps = ring;
+        if let (Some(slot), Some(r)) = (timestamp_slot, self.timestamps.as_mut()) {
+            r.arm(slot, self.frames, &stages);
+        }
         self.in_flight = Some(InFlight {
             frame: self.frames,
             timestamp_slot,
         });
-        self.probes_after_update(updates);
+        self.probes_after_update(layers);
         stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(PendingFrame {
             world: self.id,
@@ -144,6 +187,20 @@ impl SnowWorld {
             stats,
             start,
         })
+    }
+
+    /// Keep the carries a layer leaves, remembering each surface's carry before the frame so
+    /// that an abandoned frame puts it back.
+    fn keep_carries(&mut self, carries: &[(usize, f64)]) {
+        for &(index, carry) in carries {
+            if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
+                let before = &mut self.scratch_cpu.carries;
+                if !before.iter().any(|&(i, _)| i == index) {
+                    before.push((index, s.carry));
+                }
+                s.carry = carry;
+            }
+        }
     }
 
     /// The caller submitted the encoder that `pending` was recorded into: keep the frame's
@@ -164,9 +221,8 @@ impl SnowWorld {
                 index: pending.frame as u32,
             })?;
         self.in_flight = None;
-        let carries = std::mem::take(&mut self.scratch_cpu.carries);
-        self.commit_carries(&carries);
-        self.scratch_cpu.carries = carries;
+        self.scratch_cpu.carries.clear();
+        self.probes_submitted();
         std::mem::swap(&mut self.last.captured, &mut self.scratch_cpu.captured);
         self.free_deferred();
         // Probe answers that came back while the frame was being submitted.
@@ -188,6 +244,12 @@ impl SnowWorld {
     /// [`PendingFrame`] lost): its replenishment is not kept, and the world encodes again.
     pub fn abandon_pending(&mut self) {
         if let Some(f) = self.in_flight.take() {
+            for (index, carry) in std::mem::take(&mut self.scratch_cpu.carries) {
+                if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
+                    s.carry = carry;
+                }
+            }
+            self.probes_abandoned();
             if let (Some(ring), Some(slot)) = (self.timestamps.as_mut(), f.timestamp_slot) {
                 ring.abandon(slot);
             }
@@ -280,38 +342,35 @@ impl SnowWorld {
         });
     }
 
-    /// Keep the replenishment carried by every surface planned.
-    fn commit_carries(&mut self, carries: &[(usize, f64)]) {
-        for &(index, carry) in carries {
-            if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
-                s.carry = carry;
-            }
-        }
-    }
-
-    /// Grow the per-frame buffers the plan needs and write its tables.
-    fn upload(&mut self, plan: &FramePlan) {
+    /// Grow the per-frame buffers the plan needs and write its tables: with `queue.write_buffer`
+    /// when `enc` is `None` (the frame's first layer), else through staging copies recorded in
+    /// `enc` (a later layer of the same encoder, whose tables must not overwrite the first's
+    /// before its passes ran).
+    fn upload(&mut self, plan: &FramePlan, mut enc: Option<&mut wgpu::CommandEncoder>) {
         let (device, queue) = (&self.device, &self.queue);
+        let mut write = |buffer: &wgpu::Buffer, bytes: &[u8]| match enc.as_deref_mut() {
+            None => queue.write_buffer(buffer, 0, bytes),
+            Some(enc) => crate::gpu::resources::write_in_order(device, enc, buffer, 0, bytes),
+        };
         let sizes = &plan.sizes;
         self.records.ensure(device, sizes.records);
-        queue.write_buffer(
+        write(
             &self.records.buffer,
-            0,
             bytemuck::cast_slice(&plan.accumulate.records),
         );
         let c = &plan.capture;
         let blocks = &mut self.scratch_cpu.blocks;
         uniform_blocks(blocks, &c.views, 1);
         self.views.ensure(device, sizes.views);
-        queue.write_buffer(&self.views.buffer, 0, blocks);
+        write(&self.views.buffer, blocks);
         if !c.prims.is_empty() {
             self.prims.ensure(device, sizes.prims);
-            queue.write_buffer(&self.prims.buffer, 0, bytemuck::cast_slice(&c.prims));
+            write(&self.prims.buffer, bytemuck::cast_slice(&c.prims));
         }
         if !c.draws.is_empty() {
             uniform_blocks(blocks, &c.draws, 0);
             self.draws.ensure(device, sizes.draws);
-            queue.write_buffer(&self.draws.buffer, 0, blocks);
+            write(&self.draws.buffer, blocks);
         }
         self.scratch.ensure(device, sizes.scratch);
         self.capture.ensure(device, sizes.capture);
@@ -320,15 +379,15 @@ impl SnowWorld {
         self.tile_list.ensure(device, sizes.tile_list);
     }
 
-    /// Record the plan's capture and accumulation into `enc`, with the resolve of their
-    /// timestamps when profiling (into a free slot of the ring, which it returns).
-    fn record(&mut self, enc: &mut wgpu::CommandEncoder, plan: &FramePlan) -> Option<usize> {
+    /// Record the plan's capture and accumulation into `enc`, measuring their passes with
+    /// `queries`.
+    fn record(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        plan: &FramePlan,
+        queries: &mut StageQueries<'_>,
+    ) {
         let atlas = self.atlas(plan.capture.atlas_side);
-        // A frame is measured only while a readback slot is free: times are never waited for.
-        let ring = self.timestamps.as_ref().filter(|_| self.profiling);
-        let slot = ring.and_then(|r| r.free_slot());
-        let timestamps = ring.filter(|_| slot.is_some()).map(|r| r.timestamps());
-        let mut queries = StageQueries::new(timestamps);
         let capture_buffers = CaptureBuffers {
             views: &self.views.buffer,
             prims: &self.prims.buffer,
@@ -346,7 +405,7 @@ impl SnowWorld {
             &plan.capture,
             &capture_buffers,
             &self.meshes,
-            &mut queries,
+            queries,
         );
         let accumulate_buffers = AccumulateBuffers {
             records: &self.records.buffer,
@@ -363,18 +422,8 @@ impl SnowWorld {
             &self.acc,
             &plan.accumulate,
             &accumulate_buffers,
-            &mut queries,
+            queries,
         );
-        let (ring, slot) = (ring?, slot?);
-        if queries.is_empty() {
-            return None;
-        }
-        ring.resolve(slot, &queries, enc);
-        let stages = queries.stages().to_vec();
-        drop(queries);
-        let frame = self.frames;
-        self.timestamps.as_mut()?.arm(slot, frame, &stages);
-        Some(slot)
     }
 }
 /// Write `items` as uniform blocks [`UNIFORM_STRIDE`] apart into `bytes` (at least `min` blocks).

@@ -1,14 +1,22 @@
 //! Gameplay probes: the snow under chosen world points, answered a frame or two later without
 //! waiting for the GPU.
 //!
-//! [`SnowWorld::probe`] queues points and hands back a [`ProbeTicket`]. At the start of the next
-//! update (or at [`SnowWorld::poll_probes`]) every queued point is looked up on the CPU (the
-//! surface whose rectangle holds it), and one small compute pass (`probe.wgsl`) reads each point's
-//! texel and its neighbours from the pool into a results buffer, copied into a staging buffer of a
-//! ring and mapped with `map_async`. Every update and every [`SnowWorld::poll_probes`] polls the
-//! device with [`wgpu::PollType::Poll`] only, never a blocking wait; a batch whose mapping has
-//! completed is read and its buffer returned to the ring. The samples show the snow as the updates
-//! submitted before the batch left it.
+//! [`SnowWorld::probe`] queues points and hands back a [`ProbeTicket`]. When the batch is sent,
+//! every queued point is looked up on the CPU (the surface whose rectangle holds it), and one
+//! small compute pass (`probe.wgsl`) reads each point's texel and its neighbours from the pool into
+//! a results buffer, copied into a staging buffer of a ring and mapped with `map_async`. The batch
+//! is sent:
+//! - by [`SnowWorld::encode_update`] and [`SnowWorld::encode_step`], recorded first in the
+//!   caller's encoder (mapped when the caller reports it submitted, so the answer comes once the
+//!   caller's frame has run on the GPU);
+//! - by [`SnowWorld::step`] and [`SnowWorld::update`], and by [`SnowWorld::send_probes`], as a
+//!   small submission of its own, ahead of the update.
+//!
+//! Every update and every [`SnowWorld::poll_probes`] polls the device with
+//! [`wgpu::PollType::Poll`] only, never a blocking wait; a batch whose mapping has completed is
+//! read and its buffer returned to the ring. The samples show the snow as the updates submitted
+//! before the batch left it. An abandoned frame ([`SnowWorld::abandon_pending`]) queues its
+//! batch's requests again.
 //!
 //! The ring holds [`PROBE_RING`] batches in flight. When every one is in flight and no batch is
 //! being gathered, a new probe is refused with [`SnowError::ProbeRingFull`] (nothing already asked
@@ -18,7 +26,9 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Quat, Vec3};
+
+mod batch;
 
 use super::SnowWorld;
 use super::footstep::Footstep;
@@ -34,7 +44,7 @@ pub const MAX_PROBE_POINTS: usize = 4096;
 /// for it then is [`SnowError::UnknownProbe`]).
 pub const MAX_UNCLAIMED_ANSWERS: usize = 1024;
 /// How far below a surface's ground a point may lie and still be over that surface, metres.
-const GROUND_SLACK: f32 = 0.01;
+pub(crate) const GROUND_SLACK: f32 = 0.01;
 
 /// A request for probe samples; ask [`SnowWorld::probe_result`] for its answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -139,6 +149,10 @@ struct RingSlot {
     /// Set by the `map_async` callback.
     mapped: Arc<AtomicU8>,
     in_flight: bool,
+    /// Recorded into a caller's encoder not yet reported submitted (mapped once it is).
+    awaiting_submit: bool,
+    /// Bytes of results the batch copies into the staging buffer.
+    points_bytes: u64,
     shares: Vec<Share>,
     points: Vec<PointInfo>,
     /// The world's frame when the batch was recorded.
@@ -202,6 +216,8 @@ impl Probes {
                     staging: None,
                     mapped: Arc::new(AtomicU8::new(MAP_PENDING)),
                     in_flight: false,
+                    awaiting_submit: false,
+                    points_bytes: 0,
                     shares: Vec::new(),
                     points: Vec::new(),
                     frame: 0,
@@ -291,7 +307,7 @@ impl Probes {
     fn harvest(&mut self) {
         for s in 0..self.ring.len() {
             let slot = &mut self.ring[s];
-            if !slot.in_flight {
+            if !slot.in_flight || slot.awaiting_submit {
                 continue;
             }
             let state = slot.mapped.load(Ordering::Acquire);
@@ -428,7 +444,7 @@ impl SnowWorld {
     /// Send the probes queued since the last update to the GPU now, without polling (so batches
     /// already back stay in flight until the next poll). Does nothing when none are queued.
     pub fn send_probes(&mut self) {
-        self.flush_probes();
+        self.flush_probes(None);
     }
 
     /// Probe batches in flight (at most [`PROBE_RING`]).
@@ -450,260 +466,7 @@ impl SnowWorld {
         let _ = self.device.poll(wgpu::PollType::Poll);
         self.probes.harvest();
     }
-
-    /// The surface under a point (see [`ProbeSample::surface`]): its query and what decodes it.
-    fn surface_under(&self, point: Vec3) -> Option<(ProbeQuery, PointInfo)> {
-        let format = self.config.format;
-        let mut best: Option<(f32, ProbeQuery, PointInfo)> = None;
-        for (i, s) in self.surfaces.iter().enumerate() {
-            let Some(s) = s else { continue };
-            let d = &s.desc;
-            let ground = d.center.y;
-            if ground > point.y + GROUND_SLACK || best.as_ref().is_some_and(|b| b.0 >= ground) {
-                continue;
-            }
-            let local = d.world_to_local().transform_point3(point);
-            let half = d.size * 0.5;
-            if !Vec2::new(local.x, local.z).abs().cmple(half).all() {
-                continue;
-            }
-            let (w, h) = (s.layout.width, s.layout.height);
-            let texel = d.size / Vec2::new(w as f32, h as f32);
-            let column = (((local.x + half.x) / texel.x).floor() as i64).clamp(0, w as i64 - 1);
-            let row = (((local.z + half.y) / texel.y).floor() as i64).clamp(0, h as i64 - 1);
-            let query = ProbeQuery {
-                base: s.slot.heights_word(),
-                width: w,
-                height: h,
-                texel: column as u32 | (row as u32) << 16,
-                bits: format.precision.bits(),
-                texel_x: texel.x,
-                texel_z: texel.y,
-                snow_depth: d.snow_depth,
-            };
-            let info = PointInfo {
-                point,
-                surface: Some(SurfaceId(i as u32, self.generations[i])),
-                snow_depth: d.snow_depth,
-                rotation: d.rotation(),
-                channel_max: format.precision.channel_max() as f64,
-            };
-            best = Some((ground, query, info));
-        }
-        best.map(|(_, q, i)| (q, i))
-    }
-
-    /// Record the queued probes as one batch into a free ring slot and submit it (the slot was
-    /// kept free when the batch's first request was queued).
-    fn flush_probes(&mut self) {
-        if self.probes.queued.is_empty() {
-            return;
-        }
-        let Some(s) = self.probes.ring.iter().position(|s| !s.in_flight) else {
-            // Unreachable by `enqueue`'s check; the requests wait for a slot.
-            return;
-        };
-        let requests = std::mem::take(&mut self.probes.queued);
-        self.probes.queued_points = 0;
-        let mut queries = Vec::new();
-        let mut points = std::mem::take(&mut self.probes.ring[s].points);
-        let mut shares = std::mem::take(&mut self.probes.ring[s].shares);
-        points.clear();
-        shares.clear();
-        for r in &requests {
-            shares.push(Share {
-                ticket: r.ticket,
-                key: r.key,
-                start: points.len(),
-                len: r.points.len(),
-            });
-            for &p in &r.points {
-                let (query, info) = self.surface_under(p).unwrap_or((
-                    ProbeQuery::default(),
-                    PointInfo {
-                        point: p,
-                        surface: None,
-                        snow_depth: 0.0,
-                        rotation: Quat::IDENTITY,
-                        channel_max: 1.0,
-                    },
-                ));
-                queries.push(query);
-                points.push(info);
-            }
-        }
-        self.record_probe_batch(s, &queries);
-        let frame = self.probes.frame;
-        let slot = &mut self.probes.ring[s];
-        slot.points = points;
-        slot.shares = shares;
-        slot.frame = frame;
-    }
-
-    /// Upload a batch's queries, dispatch the probe pass, copy the results into ring slot `s`'s
-    /// staging buffer and map it.
-    fn record_probe_batch(&mut self, s: usize, queries: &[ProbeQuery]) {
-        let n = queries.len().max(1) as u64;
-        let (device, queue) = (&self.device, &self.queue);
-        let p = &mut self.probes;
-        p.queries.ensure(device, n * 32);
-        p.results.ensure(device, n * 16);
-        if queries.is_empty() {
-            queue.write_buffer(&p.queries.buffer, 0, &[0; 32]);
-        } else {
-            queue.write_buffer(&p.queries.buffer, 0, bytemuck::cast_slice(queries));
-        }
-        let slot = &mut p.ring[s];
-        if slot.staging.as_ref().is_none_or(|b| b.size() < n * 16) {
-            slot.staging = Some(device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("probe staging"),
-                size: (n * 16).next_power_of_two().max(256),
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("probe"),
-            layout: &p.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.pool.as_entire_binding(),
-                },
-                sized(1, &p.queries.buffer, n * 32),
-                sized(2, &p.results.buffer, n * 16),
-            ],
-        });
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("snow probes"),
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("probe"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&p.pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(n.div_ceil(64) as u32, 1, 1);
-        }
-        let staging = slot.staging.as_ref().expect("made above");
-        enc.copy_buffer_to_buffer(&p.results.buffer, 0, staging, 0, n * 16);
-        queue.submit([enc.finish()]);
-        slot.mapped.store(MAP_PENDING, Ordering::Release);
-        let flag = slot.mapped.clone();
-        staging
-            .slice(..n * 16)
-            .map_async(wgpu::MapMode::Read, move |r| {
-                flag.store(
-                    if r.is_ok() { MAP_DONE } else { MAP_FAILED },
-                    Ordering::Release,
-                );
-            });
-        slot.in_flight = true;
-    }
-
-    /// Before an update: send the queued probes (they read the snow as the last update left it)
-    /// and read what came back.
-    pub(super) fn probes_before_update(&mut self) {
-        self.flush_probes();
-        self.poll_probes_only();
-    }
-
-    /// After a successful update: count the frame, note its footsteps, read what came back.
-    pub(super) fn probes_after_update(&mut self, updates: &[super::SurfaceUpdate<'_>]) {
-        self.probes.frame += 1;
-        let mut steps = std::mem::take(&mut self.probes.footsteps);
-        let meshes = &self.probes.mesh_vertices;
-        super::footstep::footsteps(
-            updates,
-            |id| self.state(id).ok().map(|s| &s.desc),
-            |m| meshes.get(m.0 as usize)?.as_deref(),
-            &mut steps,
-        );
-        self.probes.footsteps = steps;
-        self.poll_probes_only();
-    }
-}
-
-/// A storage binding of the first `size` bytes of a buffer.
-fn sized(binding: u32, buffer: &wgpu::Buffer, size: u64) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer,
-            offset: 0,
-            size: wgpu::BufferSize::new(size),
-        }),
-    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `ProbeQuery` here and in probe.wgsl: same fields, same order, 4 bytes each.
-    #[test]
-    fn query_layout_matches_wgsl() {
-        let module = naga::front::wgsl::parse_str(crate::wgsl::PROBE.source).unwrap();
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
-        let (handle, ty) = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("ProbeQuery"))
-            .unwrap();
-        let naga::TypeInner::Struct { members, .. } = &ty.inner else {
-            panic!("ProbeQuery is not a struct")
-        };
-        assert_eq!(
-            layouter[handle].size as usize,
-            std::mem::size_of::<ProbeQuery>()
-        );
-        let names: Vec<_> = members.iter().map(|m| m.name.clone().unwrap()).collect();
-        let expect = [
-            "base",
-            "width",
-            "height",
-            "texel",
-            "bits",
-            "texel_x",
-            "texel_z",
-            "snow_depth",
-        ];
-        assert_eq!(names, expect);
-        for (i, m) in members.iter().enumerate() {
-            assert_eq!(m.offset as usize, i * 4, "{:?}", m.name);
-        }
-    }
-
-    /// Raw results to samples by hand: channels to metres at the pool's precision, the slope to a
-    /// normal turned by the surface's yaw, and nothing for a point over no surface.
-    #[test]
-    fn decode_by_hand() {
-        let info = PointInfo {
-            point: Vec3::new(1.0, 2.0, 3.0),
-            surface: Some(SurfaceId(0, 0)),
-            snow_depth: 0.4,
-            rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
-            channel_max: 255.0,
-        };
-        // A quarter pressed, a tenth displaced (of 255), rising 1 m per m along local x.
-        let raw = [51u32 + 12, 25 + 1, 1f32.to_bits(), 0f32.to_bits()];
-        let s = decode(&info, raw);
-        assert!((s.depression_m - 0.4 * 63.0 / 255.0).abs() < 1e-6);
-        assert!((s.snow_depth_m - (0.4 - s.depression_m)).abs() < 1e-6);
-        assert!((s.displaced_m - 0.4 * 26.0 / 255.0).abs() < 1e-6);
-        // Local normal (-1, 1, 0) / sqrt 2; a quarter turn about +Y takes local -x to world +z.
-        let n = s.normal;
-        let h = std::f32::consts::FRAC_1_SQRT_2;
-        assert!((n - Vec3::new(0.0, h, h)).length() < 1e-5, "{n}");
-        let none = decode(
-            &PointInfo {
-                surface: None,
-                ..info
-            },
-            raw,
-        );
-        assert_eq!(none, ProbeSample::outside(info.point));
-    }
-}
+mod tests;
