@@ -28,7 +28,7 @@
 //! | a GPU device, checked for what the passes need | [`GpuContext`], [`GpuOptions`], [`Capabilities`] |
 //! | the engine's own device and command encoder | [`required_features`], [`required_limits`], [`GpuContext::from_device`], [`SnowWorld::encode_update`], [`PendingFrame`], [`render::Renderer::encode_to_view`] |
 //! | snow surfaces stepped by deformers | [`SnowWorld`], [`WorldConfig`], [`SurfaceDesc`], [`Deformer`], [`Shape`], [`Pose`], [`Mesh`] |
-//! | the heightmaps back, or their place in the pool | [`Heightmap`], [`PoolFormat`], [`Precision`], [`FrameView`], [`SurfaceSnapshot`] |
+//! | the heightmaps back, or their place in the pool | [`Heightmap`], [`PoolFormat`], [`Precision`], [`FrameView`], [`SurfaceSnapshot`], [`SnapshotRead`] |
 //! | a city of surfaces paged in and out, saves | [`manager`]: [`SnowManager`], [`ManagerConfig`], [`manager::SaveFile`] |
 //! | scene files (TOML) | [`scene`]: [`scene::Scene`] |
 //! | pictures: the snow material, sky, shadows, falling snow | [`render`]: [`render::Renderer`], [`render::RenderConfig`], [`render::RenderFrame`] |
@@ -77,8 +77,8 @@ pub use render::gpu::SurfaceUniform;
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
-    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, PendingFrame, SnowWorld,
-    StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
+    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, PendingFrame, SnapshotRead,
+    SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
 pub use world::{
     Footstep, MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus,

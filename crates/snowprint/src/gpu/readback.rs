@@ -44,22 +44,138 @@ pub fn download_ranges(
     source: &wgpu::Buffer,
     ranges: &[(u64, u64)],
 ) -> Result<Vec<u8>> {
-    let total: u64 = ranges.iter().map(|r| r.1).sum();
-    if total == 0 {
-        return Ok(Vec::new());
-    }
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: total,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
     let mut enc = device.create_command_encoder(&Default::default());
-    let mut at = 0;
-    for &(offset, size) in ranges {
-        enc.copy_buffer_to_buffer(source, offset, &staging, at, size);
-        at += size;
-    }
+    let Some(read) = RangeRead::record(device, &mut enc, source, ranges) else {
+        return Ok(Vec::new());
+    };
     queue.submit([enc.finish()]);
-    map_read(device, &staging, 0, total)
+    read.submitted();
+    read.wait(device)
+}
+
+const MAP_PENDING: u8 = 0;
+const MAP_DONE: u8 = 1;
+const MAP_FAILED: u8 = 2;
+const NOT_SUBMITTED: u8 = 3;
+
+/// Ranges of a buffer copied, in a caller's encoder, into a staging buffer of their own: mapped
+/// once the encoder is reported submitted, and read when the mapping has completed, checked
+/// without waiting ([`RangeRead::try_take`]) or waited for ([`RangeRead::wait`]).
+#[derive(Debug)]
+pub struct RangeRead {
+    staging: wgpu::Buffer,
+    total: u64,
+    state: std::sync::Arc<std::sync::atomic::AtomicU8>,
+}
+
+impl RangeRead {
+    /// Record the copy of `ranges` of `source` (`COPY_SRC`) into `enc`; `None` when they hold no
+    /// byte.
+    pub fn record(
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        source: &wgpu::Buffer,
+        ranges: &[(u64, u64)],
+    ) -> Option<Self> {
+        let total: u64 = ranges.iter().map(|r| r.1).sum();
+        if total == 0 {
+            return None;
+        }
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: total,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut at = 0;
+        for &(offset, size) in ranges {
+            enc.copy_buffer_to_buffer(source, offset, &staging, at, size);
+            at += size;
+        }
+        Some(Self {
+            staging,
+            total,
+            state: std::sync::Arc::new(std::sync::atomic::AtomicU8::new(NOT_SUBMITTED)),
+        })
+    }
+
+    /// The encoder was submitted: start mapping (once).
+    pub fn submitted(&self) {
+        use std::sync::atomic::Ordering;
+        if self
+            .state
+            .compare_exchange(
+                NOT_SUBMITTED,
+                MAP_PENDING,
+                Ordering::AcqRel,
+                Ordering::Acquire,
+            )
+            .is_err()
+        {
+            return;
+        }
+        let flag = self.state.clone();
+        self.staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                flag.store(
+                    if r.is_ok() { MAP_DONE } else { MAP_FAILED },
+                    Ordering::Release,
+                );
+            });
+    }
+
+    /// Whether the bytes have arrived (or failed to); the device must have been polled since.
+    pub fn is_ready(&self) -> bool {
+        let s = self.state.load(std::sync::atomic::Ordering::Acquire);
+        s == MAP_DONE || s == MAP_FAILED
+    }
+
+    /// The bytes, if they have arrived; never waits (poll the device first).
+    pub fn try_take(&self) -> Option<Result<Vec<u8>>> {
+        if !self.is_ready() {
+            return None;
+        }
+        Some(self.bytes())
+    }
+
+    /// The bytes, waiting for the GPU (the encoder must have been submitted).
+    pub fn wait(self, device: &wgpu::Device) -> Result<Vec<u8>> {
+        self.submitted();
+        while !self.is_ready() {
+            device.poll(wgpu::PollType::wait_indefinitely())?;
+        }
+        self.bytes()
+    }
+
+    /// The bytes, waiting for the GPU, left mapped so that [`RangeRead::try_take`] or
+    /// [`RangeRead::wait`] still give them (for readers that cannot take them).
+    pub fn peek(&self, device: &wgpu::Device) -> Result<Vec<u8>> {
+        self.submitted();
+        while !self.is_ready() {
+            device.poll(wgpu::PollType::wait_indefinitely())?;
+        }
+        if self.state.load(std::sync::atomic::Ordering::Acquire) != MAP_DONE {
+            return Err(SnowError::Readback(
+                "a readback buffer could not be mapped".into(),
+            ));
+        }
+        Ok(self
+            .staging
+            .slice(..self.total)
+            .get_mapped_range()?
+            .to_vec())
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>> {
+        if self.state.load(std::sync::atomic::Ordering::Acquire) != MAP_DONE {
+            return Err(SnowError::Readback(
+                "a readback buffer could not be mapped".into(),
+            ));
+        }
+        let slice = self.staging.slice(..self.total);
+        let data = slice.get_mapped_range()?.to_vec();
+        self.staging.unmap();
+        Ok(data)
+    }
 }

@@ -43,6 +43,8 @@ pub(crate) mod save;
 mod apply;
 mod camera;
 mod config;
+mod frame;
+mod probe;
 mod stats;
 
 use glam::Vec3;
@@ -50,20 +52,21 @@ use glam::Vec3;
 pub use planner::{Lookup, Plan, PlannedUpdate, Planner, ResidencyChange};
 pub use quadtree::{Aabb, SurfaceIndex};
 
-use apply::{apply_changes, update_planned};
 pub use camera::{CameraView, Frustum};
 pub use config::{CatchUp, ManagerConfig, UNLIMITED};
+pub use frame::PendingTick;
+pub use probe::{ManagedProbeStatus, ManagedProbeTicket, ManagedSample};
 pub use save::{SaveFile, SavedSurface, Section};
 pub use stats::TickStats;
 
-use crate::deformer::{Deformer, Shape};
+use crate::deformer::Deformer;
 use crate::error::{Result, SnowError};
 use crate::gpu::GpuContext;
 use crate::heightmap::Heightmap;
 use crate::mesh::{Mesh, MeshId};
 use crate::surface::{SurfaceDesc, SurfaceId};
 use crate::world::{SnowWorld, WorldConfig};
-use pages::{Page, PageStore};
+use pages::PageStore;
 
 /// Handle of a surface in a [`SnowManager`] (or a [`Planner`]); stable whether or not the surface
 /// holds a heightmap.
@@ -144,7 +147,20 @@ pub struct SnowManager {
     /// Bytes paged out between ticks (zone unloads), reported by the next tick.
     paged_between: u64,
     stats: TickStats,
+    /// Which manager this is, so that a [`PendingTick`] is given back to its own.
+    id: u64,
+    /// Ticks encoded so far.
+    ticks: u64,
+    /// The tick recorded and not yet reported submitted.
+    in_flight: Option<frame::TickInFlight>,
+    /// Page-outs on their way from the GPU.
+    arriving: Vec<frame::PageRead>,
+    /// Gameplay probes asked of the manager.
+    probes: probe::ManagerProbes,
 }
+
+/// Source of [`SnowManager`] ids.
+static NEXT_MANAGER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// A mesh deformer: its current posing and the world mesh that holds it.
 #[derive(Clone, Debug)]
@@ -201,6 +217,11 @@ impl SnowManager {
             retired_mesh: Default::default(),
             paged_between: 0,
             stats: TickStats::default(),
+            id: NEXT_MANAGER.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            ticks: 0,
+            in_flight: None,
+            arriving: Vec::new(),
+            probes: probe::ManagerProbes::default(),
         }
     }
 
@@ -227,34 +248,47 @@ impl SnowManager {
         self.planner.load_zone(zone);
     }
 
-    /// Unload a zone: its surfaces page their heightmaps out now and give their slots up; their
-    /// queued imprints wait for the zone to load. Returns the surfaces that held a heightmap.
+    /// Unload a zone: its surfaces give their slots up now, and their heightmaps are copied out
+    /// in a submission of their own, kept in the page store once they have arrived (checked
+    /// without waiting at each tick); their queued imprints wait for the zone to load. Returns the
+    /// surfaces that held a heightmap. Refused with [`SnowError::FramePending`] while a tick is
+    /// recorded and not submitted.
     pub fn unload_zone(&mut self, zone: ZoneId) -> Result<Vec<ManagedId>> {
+        self.not_pending()?;
         let freed = self.planner.unload_zone(zone);
         self.paged_between += self.page_out(&freed)?;
         Ok(freed)
     }
 
-    /// Snapshot the world surfaces of `ids` (one GPU round trip), keep them as pages and free
-    /// their slots. Returns the bytes read back.
+    /// Copy the world surfaces of `ids` out (one submission, not waited for), free their slots
+    /// and keep the copy on its way as their pages. Returns the bytes copied.
     fn page_out(&mut self, ids: &[ManagedId]) -> Result<u64> {
-        let world: Vec<SurfaceId> = ids
-            .iter()
-            .filter_map(|id| self.world_ids[id.0 as usize])
-            .collect();
-        let snaps = self.world.snapshot_surfaces(&world)?;
-        let mut bytes = 0;
-        let mut snaps = snaps.into_iter();
-        for id in ids {
-            if let Some(w) = self.world_ids[id.0 as usize].take() {
-                let snap = snaps.next().ok_or_else(|| {
-                    SnowError::Readback("a page-out returned fewer surfaces than asked".into())
-                })?;
-                bytes += snap.words.len() as u64 * 4;
-                self.pages.put(id.0, Page::compress(snap));
-                self.world.remove_surface(w)?;
+        let mut managed = Vec::new();
+        let mut world = Vec::new();
+        for &id in ids {
+            if let Some(w) = self.world_ids[id.0 as usize] {
+                managed.push(id);
+                world.push(w);
             }
         }
+        if world.is_empty() {
+            return Ok(0);
+        }
+        let mut encoder = self
+            .world
+            .device()
+            .create_command_encoder(&Default::default());
+        let read = self.world.encode_snapshot(&mut encoder, &world)?;
+        self.world.queue().submit([encoder.finish()]);
+        read.submitted();
+        let mut bytes = 0;
+        for (&id, &w) in managed.iter().zip(&world) {
+            bytes += self.world.payload_bytes_of(w)?;
+            self.world.remove_surface(w)?;
+            self.world_ids[id.0 as usize] = None;
+            self.planner.page_arriving(id);
+        }
+        self.arriving.push(frame::PageRead { read, ids: managed });
         Ok(bytes)
     }
 
@@ -280,7 +314,7 @@ impl SnowManager {
             .map(|i| MeshId(i as u32))
     }
 
-    fn mesh(&self, id: MeshId) -> Result<&ManagedMesh> {
+    pub(super) fn mesh(&self, id: MeshId) -> Result<&ManagedMesh> {
         self.meshes
             .get(id.0 as usize)
             .ok_or(SnowError::StaleHandle {
@@ -326,69 +360,41 @@ impl SnowManager {
         Ok(())
     }
 
-    /// Run one frame: decide (see [`Planner::tick`]), page heightmaps out and in, then update at
-    /// most `updates_per_frame` surfaces on the GPU with everything that touched them since their
-    /// last update. Bad input is an error before anything changes.
+    /// Run one frame: [`SnowManager::encode_tick`] into an encoder of the manager's own,
+    /// submitted at once; then wait for the heightmaps paged out in it (so that, as it returns,
+    /// every heightmap is in the pool or the page store).
     pub fn tick(
         &mut self,
         dt: f32,
         camera: Option<&CameraView>,
         deformers: &[ManagedDeformer],
     ) -> Result<TickStats> {
-        // Mesh handles are the manager's; the planner and the world see the current world mesh.
-        let mut translated = Vec::new();
-        let deformers = if deformers
-            .iter()
-            .any(|d| matches!(d.deformer.shape, Shape::Mesh(_)))
-        {
-            for d in deformers {
-                let mut d = *d;
-                if let Shape::Mesh(id) = d.deformer.shape {
-                    d.deformer.shape = Shape::Mesh(self.mesh(id)?.world);
-                }
-                translated.push(d);
-            }
-            &translated[..]
-        } else {
-            deformers
-        };
-        self.planner.tick(dt, camera, deformers)?;
-        let paged_between = std::mem::take(&mut self.paged_between);
-        let plan = self.planner.last_plan();
-        let (paged_out, paged_in, failed) = apply_changes(
-            &mut self.world,
-            &mut self.pages,
-            &mut self.world_ids,
-            &self.planner,
-        )?;
-        let paged_out = paged_out + paged_between;
-        let catch_up = self.planner.config().catch_up;
-        update_planned(&mut self.world, &self.world_ids, &plan.updates, catch_up)?;
-        let mut stats = plan.stats.clone();
-        for id in failed {
-            self.planner.admission_failed(id);
-        }
-        self.free_retired_meshes()?;
-        let memory = self.world.memory();
-        if memory.pool_used != self.planner.pool_used() {
-            tracing::warn!(
-                "pool accounting differs: world {} bytes, planner {} bytes",
-                memory.pool_used,
-                self.planner.pool_used()
-            );
-        }
-        stats.pool_bytes_used = memory.pool_used;
-        stats.pool_bytes_budget = memory.pool_budget;
-        stats.paged_out_bytes = paged_out;
-        stats.paged_in_bytes = paged_in;
+        let device = self.world.device().clone();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("snow manager tick"),
+        });
+        let pending = self.encode_tick(&mut encoder, dt, camera, deformers)?;
+        self.world.queue().submit([encoder.finish()]);
+        let mut stats = self.submitted(pending)?;
+        self.wait_pages()?;
         stats.page_store_bytes = self.pages.bytes();
         stats.paged_surfaces = self.pages.len();
         self.stats = stats.clone();
         Ok(stats)
     }
 
+    /// Wait for every page-out on its way (reads, saves and [`SnowManager::tick`] need them).
+    pub(super) fn wait_pages(&mut self) -> Result<()> {
+        let device = self.world.device().clone();
+        for p in std::mem::take(&mut self.arriving) {
+            let snaps = p.read.wait(&device)?;
+            self.keep_pages(p.ids, snaps);
+        }
+        Ok(())
+    }
+
     /// Free the world meshes of earlier posings that no queue names any more.
-    fn free_retired_meshes(&mut self) -> Result<()> {
+    pub(super) fn free_retired_meshes(&mut self) -> Result<()> {
         let mut k = 0;
         while k < self.retired.len() {
             let m = self.retired[k];
@@ -435,9 +441,12 @@ impl SnowManager {
     }
 
     /// A surface's heightmap: read back from the GPU while it holds a slot, from its page when it
-    /// is paged out, and untouched snow when it never held one. Imprints still queued are not in
-    /// it yet (see [`SnowManager::flush`]).
+    /// is paged out (waiting for the page when it is still on its way from the GPU), and
+    /// untouched snow when it never held one. Imprints still queued are not in it yet (see
+    /// [`SnowManager::flush`]). Refused with [`SnowError::FramePending`] while a tick is recorded
+    /// and not submitted.
     pub fn read_heightmap(&self, id: ManagedId) -> Result<Heightmap> {
+        self.not_pending()?;
         let desc = self.planner.surface(id)?;
         if let Some(w) = self.world_ids.get(id.0 as usize).copied().flatten() {
             return self.world.read_heightmap(w);
@@ -445,12 +454,41 @@ impl SnowManager {
         if let Some(page) = self.pages.get(id.0) {
             return page.decompress()?.heightmap();
         }
+        if let Some(snap) = self.arriving_snapshot(id)? {
+            return snap.heightmap();
+        }
         let l = desc.layout();
         Ok(Heightmap::from_packed(
             l.width,
             l.height,
             &vec![0; l.texels() as usize],
         ))
+    }
+
+    /// The snapshot of a surface whose page is on its way, waiting for it (left on its way).
+    pub(crate) fn arriving_snapshot(
+        &self,
+        id: ManagedId,
+    ) -> Result<Option<crate::world::SurfaceSnapshot>> {
+        for p in &self.arriving {
+            if let Some(k) = p.ids.iter().position(|&i| i == id) {
+                let mut snaps = p.read.peek(self.world.device())?;
+                return Ok(Some(snaps.swap_remove(k)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Every surface whose page is on its way, with its snapshot (waiting for them).
+    pub(crate) fn arriving_snapshots(
+        &self,
+    ) -> Result<Vec<(ManagedId, crate::world::SurfaceSnapshot)>> {
+        let mut out = Vec::new();
+        for p in &self.arriving {
+            let snaps = p.read.peek(self.world.device())?;
+            out.extend(p.ids.iter().copied().zip(snaps));
+        }
+        Ok(out)
     }
 
     /// The world handle of a surface while it holds a heightmap (for renderers).

@@ -41,4 +41,8 @@ pub struct TickStats {
     pub page_store_bytes: u64,
     /// Surfaces whose heightmap is paged out after this frame.
     pub paged_surfaces: usize,
+    /// Of those, surfaces whose page is still on its way from the GPU (copied out by a tick
+    /// recorded with [`super::SnowManager::encode_tick`] and not read back yet; they are not
+    /// admitted again until it has arrived).
+    pub pages_arriving: usize,
 }

@@ -243,13 +243,13 @@ impl SnowWorld {
     /// Forget the frame in flight, whose encoder will never be submitted (dropped, or its
     /// [`PendingFrame`] lost): its replenishment is not kept, and the world encodes again.
     pub fn abandon_pending(&mut self) {
+        self.probes_abandoned();
         if let Some(f) = self.in_flight.take() {
             for (index, carry) in std::mem::take(&mut self.scratch_cpu.carries) {
                 if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
                     s.carry = carry;
                 }
             }
-            self.probes_abandoned();
             if let (Some(ring), Some(slot)) = (self.timestamps.as_mut(), f.timestamp_slot) {
                 ring.abandon(slot);
             }

@@ -19,7 +19,7 @@ mod footstep;
 mod frame;
 mod meshes;
 pub(crate) mod plan;
-mod probe;
+pub(crate) mod probe;
 mod readback;
 mod snapshot;
 
@@ -31,7 +31,7 @@ pub(crate) use plan::FramePlan;
 pub use probe::{
     MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus, ProbeTicket,
 };
-pub use snapshot::SurfaceSnapshot;
+pub use snapshot::{SnapshotRead, SurfaceSnapshot};
 
 use crate::accumulate::AccumulatePipelines;
 use crate::capture::{self, CaptureMesh, CapturePipelines};
@@ -279,6 +279,16 @@ impl SnowWorld {
         self.profiling = on;
     }
 
+    /// The device the world runs on.
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The queue the world submits to.
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
     /// Whether per-stage GPU times can be measured on this device.
     pub fn has_timestamps(&self) -> bool {
         self.timestamps.is_some()
@@ -287,9 +297,28 @@ impl SnowWorld {
     /// Add a surface; its heightmap starts untouched. Fails with [`SnowError::PoolExhausted`] when
     /// the pool has no room (a normal state: remove a surface or give the pool more bytes).
     pub fn add_surface(&mut self, desc: SurfaceDesc) -> Result<SurfaceId> {
+        self.add_surface_with(desc, None)
+    }
+
+    /// [`SnowWorld::add_surface`], its slot cleared in `enc`'s order when given (after what the
+    /// encoder recorded before, such as the page-out of the slot's last owner), else with the
+    /// next submission.
+    pub(crate) fn add_surface_with(
+        &mut self,
+        desc: SurfaceDesc,
+        enc: Option<&mut wgpu::CommandEncoder>,
+    ) -> Result<SurfaceId> {
         desc.validate()?;
         let layout = SurfaceLayout::for_size_capped(desc.size, self.config.max_resolution);
         let slot = self.reserve_slot(&desc.name, &layout, None)?;
+        match enc {
+            Some(enc) => enc.clear_buffer(&self.pool, slot.offset, Some(slot.bytes)),
+            // Cleared with the next submission (before its command buffers), no encoder needed.
+            None => {
+                self.queue
+                    .write_buffer(&self.pool, slot.offset, &vec![0u8; slot.bytes as usize])
+            }
+        }
         Ok(self.insert_state(SurfaceState {
             desc,
             layout,
@@ -298,7 +327,8 @@ impl SnowWorld {
         }))
     }
 
-    /// A cleared slot for a surface of `layout`: first fit, or at `at` in the pool.
+    /// A slot for a surface of `layout`: first fit, or at `at` in the pool (its bytes are the
+    /// caller's to write).
     fn reserve_slot(
         &mut self,
         name: &str,
@@ -306,7 +336,7 @@ impl SnowWorld {
         at: Option<u64>,
     ) -> Result<Slot> {
         let needed = self.config.format.slot_bytes(layout.width, layout.height);
-        let slot = match at {
+        match at {
             Some(offset) => self.alloc.alloc_at(offset, needed),
             None => self.alloc.alloc(needed),
         }
@@ -315,11 +345,7 @@ impl SnowWorld {
             needed,
             free: self.alloc.largest_free(),
             budget: self.alloc.budget(),
-        })?;
-        // Cleared with the next submission (before its command buffers), no encoder needed.
-        let zeros = vec![0u8; slot.bytes as usize];
-        self.queue.write_buffer(&self.pool, slot.offset, &zeros);
-        Ok(slot)
+        })
     }
 
     fn insert_state(&mut self, state: SurfaceState) -> SurfaceId {

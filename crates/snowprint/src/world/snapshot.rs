@@ -3,6 +3,7 @@
 use super::{SnowWorld, SurfaceState};
 use crate::error::{Result, SnowError};
 use crate::gpu::readback;
+use crate::gpu::resources::write_in_order;
 use crate::heightmap::Heightmap;
 use crate::pool::PoolFormat;
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
@@ -51,39 +52,131 @@ impl SurfaceSnapshot {
     }
 }
 
+/// Snapshots recorded into an encoder by [`SnowWorld::encode_snapshot`], read once it has run.
+#[derive(Debug)]
+#[must_use = "call submitted() after submitting the encoder, then try_take() or wait()"]
+pub struct SnapshotRead {
+    metas: Vec<SurfaceSnapshot>,
+    sizes: Vec<u64>,
+    read: Option<readback::RangeRead>,
+}
+
+impl SnapshotRead {
+    /// The encoder was submitted: start mapping the staging buffer.
+    pub fn submitted(&self) {
+        if let Some(r) = &self.read {
+            r.submitted();
+        }
+    }
+
+    /// Whether the snapshots have arrived (the device must have been polled since submitting).
+    pub fn is_ready(&self) -> bool {
+        self.read.as_ref().is_none_or(readback::RangeRead::is_ready)
+    }
+
+    /// The snapshots, in the order asked, if they have arrived; never waits. Taken once.
+    pub fn try_take(&mut self) -> Option<Result<Vec<SurfaceSnapshot>>> {
+        match &self.read {
+            None => Some(Ok(std::mem::take(&mut self.metas))),
+            Some(r) => {
+                let bytes = r.try_take()?;
+                Some(bytes.map(|b| self.split(&b)))
+            }
+        }
+    }
+
+    /// The snapshots, waiting for the GPU (after the encoder was submitted).
+    pub fn wait(mut self, device: &wgpu::Device) -> Result<Vec<SurfaceSnapshot>> {
+        match self.read.take() {
+            None => Ok(self.metas),
+            Some(r) => {
+                let bytes = r.wait(device)?;
+                Ok(self.split(&bytes))
+            }
+        }
+    }
+
+    /// The snapshots, waiting for the GPU, without taking them (they are still given by
+    /// [`SnapshotRead::try_take`] or [`SnapshotRead::wait`]).
+    pub fn peek(&self, device: &wgpu::Device) -> Result<Vec<SurfaceSnapshot>> {
+        let bytes = match &self.read {
+            None => Vec::new(),
+            Some(r) => r.peek(device)?,
+        };
+        Ok(self.split_into(self.metas.clone(), &bytes))
+    }
+
+    /// The surfaces' descriptions, in the order asked.
+    pub fn surfaces(&self) -> impl Iterator<Item = &SurfaceDesc> {
+        self.metas.iter().map(|m| &m.desc)
+    }
+
+    fn split(&mut self, bytes: &[u8]) -> Vec<SurfaceSnapshot> {
+        let metas = std::mem::take(&mut self.metas);
+        self.split_into(metas, bytes)
+    }
+
+    fn split_into(&self, metas: Vec<SurfaceSnapshot>, bytes: &[u8]) -> Vec<SurfaceSnapshot> {
+        let mut at = 0usize;
+        metas
+            .into_iter()
+            .zip(&self.sizes)
+            .map(|(meta, &size)| {
+                let words = bytemuck::cast_slice(&bytes[at..at + size as usize]).to_vec();
+                at += size as usize;
+                SurfaceSnapshot { words, ..meta }
+            })
+            .collect()
+    }
+}
+
 impl SnowWorld {
     /// Copy the stored state of surfaces to the CPU in one GPU round trip: their slots' words
     /// (heights, and normals when the pool keeps them) and the replenishment carried between
     /// updates. What paging and saves keep of a surface; [`SnowWorld::restore_surface`] puts it
-    /// back bit for bit.
+    /// back bit for bit. Waits for the GPU: [`SnowWorld::encode_snapshot`] does not.
     pub fn snapshot_surfaces(&self, ids: &[SurfaceId]) -> Result<Vec<SurfaceSnapshot>> {
-        let mut spans = Vec::with_capacity(ids.len());
-        let mut total = 0u64;
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        let read = self.encode_snapshot(&mut enc, ids)?;
+        self.queue.submit([enc.finish()]);
+        read.wait(&self.device)
+    }
+
+    /// [`SnowWorld::snapshot_surfaces`] recorded into the caller's `encoder`: the slots are
+    /// copied where the encoder stands (after what it recorded before), into a staging buffer
+    /// that is mapped once [`SnapshotRead::submitted`] is called, and read without waiting by
+    /// [`SnapshotRead::try_take`]. The description and carry are taken now.
+    pub fn encode_snapshot(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ids: &[SurfaceId],
+    ) -> Result<SnapshotRead> {
+        let mut metas = Vec::with_capacity(ids.len());
+        let mut ranges = Vec::with_capacity(ids.len());
         for &id in ids {
             let s = self.state(id)?;
             let bytes = self.payload_bytes(&s.layout);
-            spans.push((s, total, bytes));
-            total += bytes;
-        }
-        if total == 0 {
-            return Ok(Vec::new());
-        }
-        let ranges: Vec<(u64, u64)> = spans
-            .iter()
-            .map(|&(s, _, bytes)| (s.slot.offset, bytes))
-            .collect();
-        let data = readback::download_ranges(&self.device, &self.queue, &self.pool, &ranges)?;
-        Ok(spans
-            .into_iter()
-            .map(|(s, at, bytes)| SurfaceSnapshot {
+            ranges.push((s.slot.offset, bytes));
+            metas.push(SurfaceSnapshot {
                 desc: s.desc.clone(),
                 width: s.layout.width,
                 height: s.layout.height,
                 format: self.config.format,
                 carry: s.carry,
-                words: bytemuck::cast_slice(&data[at as usize..(at + bytes) as usize]).to_vec(),
-            })
-            .collect())
+                words: Vec::new(),
+            });
+        }
+        let read = readback::RangeRead::record(&self.device, encoder, &self.pool, &ranges);
+        Ok(SnapshotRead {
+            metas,
+            sizes: ranges.iter().map(|r| r.1).collect(),
+            read,
+        })
+    }
+
+    /// Bytes a snapshot of surface `id` copies.
+    pub(crate) fn payload_bytes_of(&self, id: SurfaceId) -> Result<u64> {
+        Ok(self.payload_bytes(&self.state(id)?.layout))
     }
 
     /// Bytes of a slot that hold data (heights, then normals when kept): what a snapshot copies.
@@ -157,14 +250,38 @@ impl SnowWorld {
         snapshot: &SurfaceSnapshot,
         at: Option<u64>,
     ) -> Result<SurfaceId> {
+        self.restore_surface_with(snapshot, at, None)
+    }
+
+    /// [`SnowWorld::restore_surface`], its words written in `enc`'s order when given (after what
+    /// the encoder recorded before), else with the next submission.
+    pub(crate) fn restore_surface_with(
+        &mut self,
+        snapshot: &SurfaceSnapshot,
+        at: Option<u64>,
+        enc: Option<&mut wgpu::CommandEncoder>,
+    ) -> Result<SurfaceId> {
         let layout = self.check_snapshot(snapshot)?;
         let desc = &snapshot.desc;
         let slot = self.reserve_slot(&desc.name, &layout, at)?;
-        self.queue.write_buffer(
-            &self.pool,
-            slot.offset,
-            bytemuck::cast_slice(&snapshot.words),
-        );
+        let words: &[u8] = bytemuck::cast_slice(&snapshot.words);
+        let rest = slot.bytes.saturating_sub(words.len() as u64);
+        match enc {
+            Some(enc) => {
+                write_in_order(&self.device, enc, &self.pool, slot.offset, words);
+                if rest > 0 {
+                    enc.clear_buffer(&self.pool, slot.offset + words.len() as u64, Some(rest));
+                }
+            }
+            None => {
+                self.queue.write_buffer(&self.pool, slot.offset, words);
+                if rest > 0 {
+                    let zeros = vec![0u8; rest as usize];
+                    self.queue
+                        .write_buffer(&self.pool, slot.offset + words.len() as u64, &zeros);
+                }
+            }
+        }
         Ok(self.insert_state(SurfaceState {
             desc: desc.clone(),
             layout,

@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use super::surface::{ByUse, Rank};
-use super::{ManagedId, PAGED, Planner, RESIDENT, ResidencyChange, WANTED};
+use super::{ARRIVING, ManagedId, PAGED, Planner, RESIDENT, ResidencyChange, WANTED};
 use crate::pool::{Slot, SlotAllocator};
 
 impl Planner {
@@ -21,7 +21,7 @@ impl Planner {
         let mut best: Option<ByUse> = None;
         for &i in &self.active {
             let s = &self.status[i as usize];
-            if s.has(RESIDENT) {
+            if s.has(RESIDENT) || s.has(ARRIVING) {
                 continue;
             }
             let r = ByUse(self.rank(i, now, focus));

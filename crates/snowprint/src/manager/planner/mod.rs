@@ -30,7 +30,7 @@ mod surface;
 mod tick;
 
 pub(crate) use state::PlannerState;
-use surface::{LISTED, PAGED, REMOVED, RESIDENT, SNOWFALL, WANTED};
+use surface::{ARRIVING, LISTED, PAGED, REMOVED, RESIDENT, SNOWFALL, WANTED};
 use surface::{Managed, Rank, Status, TouchVolume};
 
 use std::collections::{HashMap, VecDeque};
@@ -389,6 +389,33 @@ impl Planner {
         {
             self.release(id.0, true, false);
             self.evicted_between.pop();
+        }
+    }
+
+    /// Surface `id`'s page is on its way from the GPU: it is not admitted until
+    /// [`Planner::page_arrived`].
+    pub(crate) fn page_arriving(&mut self, id: ManagedId) {
+        if let Some(st) = self.status.get_mut(id.0 as usize) {
+            st.set(ARRIVING, true);
+        }
+    }
+
+    /// Surface `id`'s page has arrived in the page store.
+    pub(crate) fn page_arrived(&mut self, id: ManagedId) {
+        if let Some(st) = self.status.get_mut(id.0 as usize) {
+            st.set(ARRIVING, false);
+        }
+    }
+
+    /// Surface `id`'s page will never arrive (its tick was abandoned): it holds untouched snow
+    /// from now on.
+    pub(crate) fn page_lost(&mut self, id: ManagedId) {
+        if let Some(st) = self.status.get_mut(id.0 as usize) {
+            st.set(ARRIVING, false);
+            if st.has(PAGED) {
+                st.set(PAGED, false);
+                self.paged_bound -= st.bytes as u64;
+            }
         }
     }
 

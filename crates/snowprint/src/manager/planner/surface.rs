@@ -89,6 +89,9 @@ pub(super) const SNOWFALL: u8 = 8;
 pub(super) const PAGED: u8 = 16;
 /// Resident when its zone was unloaded: paged back in as soon as the zone loads and there is room.
 pub(super) const WANTED: u8 = 32;
+/// Its page is on its way from the GPU (paged out in a tick not yet read back): not admitted
+/// until it has arrived.
+pub(super) const ARRIVING: u8 = 64;
 
 /// What the per-tick passes over touched, active and waiting surfaces read and write, in one cache
 /// line per surface: a city with hundreds of surfaces waiting for memory is walked several times a

@@ -12,8 +12,11 @@ use crate::mesh::Mesh;
 use crate::world::SurfaceSnapshot;
 
 impl SnowManager {
-    /// The whole snow state as the bytes of a save (see the module docs).
+    /// The whole snow state as the bytes of a save (see the module docs). Pages still on their
+    /// way from the GPU are waited for; refused with [`SnowError::FramePending`] while a tick is
+    /// recorded and not submitted.
     pub fn to_save_bytes(&self) -> Result<Vec<u8>> {
+        self.not_pending()?;
         let conf = to_json(&SavedConfig::of(self.planner.config()))?;
         let plan = to_json(&self.planner.state())?;
         // Meshes: the manager's, and the earlier posings that queues still name.
@@ -53,6 +56,9 @@ impl SnowManager {
             .collect();
         for (i, page) in self.pages.iter() {
             surfaces.push((i, None, page.decompress()?));
+        }
+        for (id, snap) in self.arriving_snapshots()? {
+            surfaces.push((id.0, None, snap));
         }
         surfaces.sort_by_key(|s| s.0);
         let mut out = Vec::new();

@@ -3,55 +3,38 @@
 
 use std::sync::atomic::Ordering;
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Quat, Vec3};
 
 use super::{
-    GROUND_SLACK, MAP_DONE, MAP_FAILED, MAP_PENDING, PointInfo, ProbeQuery, Probes, Request, Share,
+    MAP_DONE, MAP_FAILED, MAP_PENDING, PointInfo, ProbeQuery, Probes, Request, Share, cpu,
 };
 use crate::surface::SurfaceId;
 use crate::world::SnowWorld;
 
 impl SnowWorld {
-    /// The surface under a point (see [`ProbeSample::surface`]): its query and what decodes it.
+    /// The surface under a point (see [`super::ProbeSample::surface`]): the topmost whose
+    /// rectangle holds it and whose ground is not above it; its query and what decodes it.
     fn surface_under(&self, point: Vec3) -> Option<(ProbeQuery, PointInfo)> {
-        let format = self.config.format;
-        let mut best: Option<(f32, ProbeQuery, PointInfo)> = None;
+        let precision = self.config.format.precision;
+        let mut best: Option<(f32, usize)> = None;
         for (i, s) in self.surfaces.iter().enumerate() {
             let Some(s) = s else { continue };
-            let d = &s.desc;
-            let ground = d.center.y;
-            if ground > point.y + GROUND_SLACK || best.as_ref().is_some_and(|b| b.0 >= ground) {
-                continue;
+            match cpu::over(&s.desc, point) {
+                Some(ground) if best.is_none_or(|b| b.0 < ground) => best = Some((ground, i)),
+                _ => {}
             }
-            let local = d.world_to_local().transform_point3(point);
-            let half = d.size * 0.5;
-            if !Vec2::new(local.x, local.z).abs().cmple(half).all() {
-                continue;
-            }
-            let (w, h) = (s.layout.width, s.layout.height);
-            let texel = d.size / Vec2::new(w as f32, h as f32);
-            let column = (((local.x + half.x) / texel.x).floor() as i64).clamp(0, w as i64 - 1);
-            let row = (((local.z + half.y) / texel.y).floor() as i64).clamp(0, h as i64 - 1);
-            let query = ProbeQuery {
-                base: s.slot.heights_word(),
-                width: w,
-                height: h,
-                texel: column as u32 | (row as u32) << 16,
-                bits: format.precision.bits(),
-                texel_x: texel.x,
-                texel_z: texel.y,
-                snow_depth: d.snow_depth,
-            };
-            let info = PointInfo {
-                point,
-                surface: Some(SurfaceId(i as u32, self.generations[i])),
-                snow_depth: d.snow_depth,
-                rotation: d.rotation(),
-                channel_max: format.precision.channel_max() as f64,
-            };
-            best = Some((ground, query, info));
         }
-        best.map(|(_, q, i)| (q, i))
+        let i = best?.1;
+        let s = self.surfaces[i].as_ref()?;
+        let id = SurfaceId(i as u32, self.generations[i]);
+        Some(cpu::query(
+            &s.desc,
+            &s.layout,
+            precision,
+            s.slot.heights_word(),
+            Some(id),
+            point,
+        ))
     }
 
     /// Record the queued probes as one batch into a free ring slot (the slot was kept free when

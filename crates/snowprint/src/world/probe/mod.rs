@@ -29,6 +29,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 use glam::{Quat, Vec3};
 
 mod batch;
+pub(crate) mod cpu;
 
 use super::SnowWorld;
 use super::footstep::Footstep;
@@ -368,6 +369,11 @@ fn decode(info: &PointInfo, raw: [u32; 4]) -> ProbeSample {
     if info.surface.is_none() {
         return ProbeSample::outside(info.point);
     }
+    decode_over(info, raw)
+}
+
+/// A sample from a point's raw result over a surface (`info.surface` is only named).
+fn decode_over(info: &PointInfo, raw: [u32; 4]) -> ProbeSample {
     let metres = |v: u32| (v as f64 / info.channel_max * info.snow_depth as f64) as f32;
     let depression_m = metres(raw[0]).min(info.snow_depth);
     let (dx, dz) = (f32::from_bits(raw[2]), f32::from_bits(raw[3]));
@@ -445,6 +451,19 @@ impl SnowWorld {
     /// already back stay in flight until the next poll). Does nothing when none are queued.
     pub fn send_probes(&mut self) {
         self.flush_probes(None);
+    }
+
+    /// Record the probes queued so far into `enc` (the manager's tick, before its residency
+    /// changes); they are mapped once [`SnowWorld::submitted`] or [`SnowWorld::probes_sent`] says
+    /// the encoder was submitted.
+    pub(crate) fn encode_probes(&mut self, enc: &mut wgpu::CommandEncoder) {
+        self.flush_probes(Some(enc));
+    }
+
+    /// The encoder that [`SnowWorld::encode_probes`] recorded into was submitted (without a
+    /// world frame in it).
+    pub(crate) fn probes_sent(&mut self) {
+        self.probes_submitted();
     }
 
     /// Probe batches in flight (at most [`PROBE_RING`]).

@@ -1,0 +1,128 @@
+//! The probe pass on the CPU: where a point falls on a surface, and the sample `probe.wgsl` reads
+//! there, from a heightmap's channels as stored. The manager answers probes over paged-out
+//! surfaces with it, and the tests hold the GPU pass to it.
+
+use glam::{Vec2, Vec3};
+
+use super::{GROUND_SLACK, PointInfo, ProbeQuery, ProbeSample, decode_over};
+use crate::pool::Precision;
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+
+/// Whether a point is over a surface: inside its rectangle and not below its ground (1 cm of
+/// slack). Returns the surface's ground height.
+pub(crate) fn over(desc: &SurfaceDesc, point: Vec3) -> Option<f32> {
+    let ground = desc.center.y;
+    if ground > point.y + GROUND_SLACK {
+        return None;
+    }
+    let local = desc.world_to_local().transform_point3(point);
+    let half = desc.size * 0.5;
+    Vec2::new(local.x, local.z)
+        .abs()
+        .cmple(half)
+        .all()
+        .then_some(ground)
+}
+
+/// The texel under a point over a surface (clamped to the heightmap) and the texel's sides,
+/// metres.
+pub(crate) fn texel_under(
+    desc: &SurfaceDesc,
+    layout: &SurfaceLayout,
+    point: Vec3,
+) -> ([u32; 2], Vec2) {
+    let local = desc.world_to_local().transform_point3(point);
+    let half = desc.size * 0.5;
+    let (w, h) = (layout.width, layout.height);
+    let texel = desc.size / Vec2::new(w as f32, h as f32);
+    let column = (((local.x + half.x) / texel.x).floor() as i64).clamp(0, w as i64 - 1);
+    let row = (((local.z + half.y) / texel.y).floor() as i64).clamp(0, h as i64 - 1);
+    ([column as u32, row as u32], texel)
+}
+
+/// What the probe pass needs of a point over a surface whose heights start at `base` (a word of
+/// the pool), and what decodes its result.
+pub(super) fn query(
+    desc: &SurfaceDesc,
+    layout: &SurfaceLayout,
+    precision: Precision,
+    base: u32,
+    surface: Option<SurfaceId>,
+    point: Vec3,
+) -> (ProbeQuery, PointInfo) {
+    let ([column, row], texel) = texel_under(desc, layout, point);
+    let query = ProbeQuery {
+        base,
+        width: layout.width,
+        height: layout.height,
+        texel: column | row << 16,
+        bits: precision.bits(),
+        texel_x: texel.x,
+        texel_z: texel.y,
+        snow_depth: desc.snow_depth,
+    };
+    let info = PointInfo {
+        point,
+        surface,
+        snow_depth: desc.snow_depth,
+        rotation: desc.rotation(),
+        channel_max: precision.channel_max() as f64,
+    };
+    (query, info)
+}
+
+/// The sample `probe.wgsl` gives for a point over a surface whose channels (depression, then
+/// displaced, row-major, at `precision`) are given: the same texel, the same central differences,
+/// in the same f32 arithmetic. `surface` is what the sample names.
+pub(crate) fn sample(
+    desc: &SurfaceDesc,
+    layout: &SurfaceLayout,
+    precision: Precision,
+    channels: (&[u32], &[u32]),
+    surface: Option<SurfaceId>,
+    point: Vec3,
+) -> ProbeSample {
+    let (q, info) = query(desc, layout, precision, 0, surface, point);
+    let (w, h) = (q.width, q.height);
+    let (x, y) = (q.texel & 0xffff, q.texel >> 16);
+    let at = |x: u32, y: u32| (y * w + x) as usize;
+    let max = precision.channel_max() as f32;
+    let top = |x: u32, y: u32| q.snow_depth * (1.0 - channels.0[at(x, y)] as f32 / max);
+    let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+    let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+    let dx = if x1 > x0 {
+        (top(x1, y) - top(x0, y)) / ((x1 - x0) as f32 * q.texel_x)
+    } else {
+        0.0
+    };
+    let dz = if y1 > y0 {
+        (top(x, y1) - top(x, y0)) / ((y1 - y0) as f32 * q.texel_z)
+    } else {
+        0.0
+    };
+    let raw = [
+        channels.0[at(x, y)],
+        channels.1[at(x, y)],
+        dx.to_bits(),
+        dz.to_bits(),
+    ];
+    decode_over(&info, raw)
+}
+
+/// The sample over a surface that never held a heightmap: untouched snow, its normal the
+/// surface's up.
+pub(crate) fn untouched(desc: &SurfaceDesc, point: Vec3) -> ProbeSample {
+    ProbeSample {
+        point,
+        surface: None,
+        snow_depth_m: desc.snow_depth,
+        depression_m: 0.0,
+        displaced_m: 0.0,
+        normal: desc.rotation() * Vec3::Y,
+    }
+}
+
+/// The sample of a point over no surface.
+pub(crate) fn outside(point: Vec3) -> ProbeSample {
+    ProbeSample::outside(point)
+}
