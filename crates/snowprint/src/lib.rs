@@ -48,8 +48,10 @@ mod extract;
 mod gpu;
 mod heightmap;
 pub mod manager;
+mod material;
 mod mesh;
 mod pool;
+mod relax;
 pub mod render;
 pub mod scene;
 mod surface;
@@ -68,6 +70,7 @@ pub use heightmap::Heightmap;
 pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
 };
+pub use material::Material;
 pub use mesh::{
     MAX_GLTF_DEPTH, MAX_GLTF_FILE_BYTES, MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_GLTF_VERTICES,
     Mesh, MeshId,
@@ -105,6 +108,10 @@ pub mod reference {
     pub mod tessellate {
         pub use crate::render::tessellate::cpu::*;
     }
+    /// The relaxation of materials with an angle of repose: one step, and the slope's threshold.
+    pub mod relax {
+        pub use crate::relax::cpu::*;
+    }
 }
 
 /// The pieces an engine or a tool may need that are not the everyday API: the world's frame plan,
@@ -125,6 +132,10 @@ pub mod low_level {
             PRIM_CAPSULE, decode_depth, encode, encode_depth, mesh_substeps, pack_atlas,
             pack_atlas_compact, push_mesh_draws, push_primitives, substeps,
         };
+    }
+    /// The relaxation pass: its records, plan, pipelines and `encode`.
+    pub mod relax {
+        pub use crate::relax::{RelaxBuffers, RelaxPipelines, RelaxPlan, RelaxRecord, encode};
     }
     /// The accumulation passes: pipelines and `encode`.
     pub mod accumulate {

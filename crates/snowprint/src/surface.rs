@@ -10,6 +10,7 @@
 use glam::{Mat4, Quat, Vec2, Vec3};
 
 use crate::error::{Result, SnowError};
+use crate::material::Material;
 
 /// Smallest texel side, metres (the talk's "1/4 x surface size in cm").
 pub const MIN_TEXEL_SIZE: f32 = 0.04;
@@ -31,6 +32,10 @@ pub struct SurfaceDesc {
     pub snow_depth: f32,
     /// Fraction of the snow depth refilled per second while it snows (0 = no snowfall).
     pub replenish_rate: f32,
+    /// What it is made of: how prints move after they are made ([`Material::snow`] by default:
+    /// they keep their walls).
+    #[serde(default)]
+    pub material: Material,
 }
 
 impl SurfaceDesc {
@@ -43,6 +48,7 @@ impl SurfaceDesc {
             yaw_degrees: 0.0,
             snow_depth,
             replenish_rate: 0.0,
+            material: Material::snow(),
         }
     }
 
@@ -84,7 +90,7 @@ impl SurfaceDesc {
         if !self.yaw_degrees.is_finite() {
             return bad("yaw_degrees", self.yaw_degrees.to_string(), "finite");
         }
-        Ok(())
+        self.material.validate(&self.name)
     }
 
     /// Heightmap layout of this surface (resolution and texel size).

@@ -68,6 +68,19 @@ pub fn encode(
     b: &AccumulateBuffers<'_>,
     queries: &mut StageQueries<'_>,
 ) {
+    encode_update(device, enc, pipes, plan, b, queries);
+    encode_normals(device, enc, pipes, plan, b, queries);
+}
+
+/// The heights' part of [`encode`]: fused, or blur then merge.
+pub fn encode_update(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipes: &AccumulatePipelines,
+    plan: &AccumulatePlan,
+    b: &AccumulateBuffers<'_>,
+    queries: &mut StageQueries<'_>,
+) {
     let (max_w, max_h) = (plan.max_width, plan.max_height);
     let records = plan.records.len() as u32;
     if plan.fused {
@@ -153,6 +166,19 @@ pub fn encode(
             );
         }
     }
+}
+
+/// The normals' part of [`encode`], when the pool keeps them: normals of every record's new top.
+pub fn encode_normals(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipes: &AccumulatePipelines,
+    plan: &AccumulatePlan,
+    b: &AccumulateBuffers<'_>,
+    queries: &mut StageQueries<'_>,
+) {
+    let (max_w, max_h) = (plan.max_width, plan.max_height);
+    let records = plan.records.len() as u32;
     if plan.normals {
         let normals_bg = bind_group(
             device,

@@ -16,7 +16,7 @@
 pub(crate) mod cpu;
 mod encode;
 
-pub use encode::{AccumulateBuffers, AccumulatePlan, encode};
+pub use encode::{AccumulateBuffers, AccumulatePlan, encode, encode_normals, encode_update};
 
 use crate::pool::Precision;
 

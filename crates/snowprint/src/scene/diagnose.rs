@@ -160,6 +160,7 @@ fn expectation(key: &str) -> Option<(&'static str, &'static str)> {
         "yaw_degrees" => ("a number of degrees", "yaw_degrees = 0.0"),
         "snow_depth" => ("a number of metres", "snow_depth = 0.3"),
         "replenish_rate" => ("a number", "replenish_rate = 0.0"),
+        "material" => ("a string", "material = \"sand\""),
         "shape" => ("a string", "shape = \"sphere\""),
         "radius" => ("a number of metres", "radius = 0.06"),
         "half_height" => ("a number of metres", "half_height = 0.08"),

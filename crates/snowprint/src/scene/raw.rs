@@ -72,6 +72,7 @@ pub(super) struct RawSurface {
     pub yaw_degrees: Option<Num>,
     pub snow_depth: Option<Num>,
     pub replenish_rate: Option<Num>,
+    pub material: Option<Str>,
     pub zone: Option<Spanned<i64>>,
 }
 
@@ -117,6 +118,7 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "yaw_degrees",
             "snow_depth",
             "replenish_rate",
+            "material",
             "zone",
         ],
     ),

@@ -23,6 +23,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("normals", "accumulate/normals.wgsl", true),
     ("fused", "accumulate/fused.wgsl", true),
     ("seal", "accumulate/seal.wgsl", true),
+    // Materials that slump to their angle of repose.
+    ("relax", "relax/relax.wgsl", true),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe/probe.wgsl", true),
     // The renderer.

@@ -76,12 +76,19 @@ pub struct StageTimes {
     pub normals_ms: f64,
     /// The fused blur + merge dispatch (when [`PassMode::Fused`]).
     pub fused_ms: f64,
+    /// The relaxation of slumping materials (see [`crate::Material`]).
+    pub relax_ms: f64,
 }
 
 impl StageTimes {
     /// Sum of the stages.
     pub fn total_ms(&self) -> f64 {
-        self.capture_ms + self.blur_ms + self.merge_ms + self.normals_ms + self.fused_ms
+        self.capture_ms
+            + self.blur_ms
+            + self.merge_ms
+            + self.normals_ms
+            + self.fused_ms
+            + self.relax_ms
     }
 }
 

@@ -14,6 +14,7 @@ use crate::error::{Result, SnowError};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::gpu::timestamps::StageQueries;
 use crate::pool::SurfaceRecord;
+use crate::relax::{self, RelaxBuffers};
 
 /// A frame recorded into a caller's command encoder by [`SnowWorld::encode_update`] or
 /// [`SnowWorld::encode_step`], waiting for the caller's `queue.submit`. Give it back with
@@ -142,6 +143,7 @@ impl SnowWorld {
             ..FrameStats::default()
         };
         self.scratch_cpu.carries.clear();
+        self.scratch_cpu.settles.clear();
         // The ring is taken out while the layers borrow its query set.
         let ring = self.timestamps.take();
         // A frame is measured only while a readback slot is free: times are never waited for.
@@ -159,6 +161,7 @@ impl SnowWorld {
                 remember_captures(&mut self.scratch_cpu.captured, &plan);
             }
             self.keep_carries(&plan.carries);
+            self.keep_settles(&plan.settles);
             self.scratch_cpu.plan = plan;
         }
         let stages = queries.stages().to_vec();
@@ -187,6 +190,19 @@ impl SnowWorld {
             stats,
             start,
         })
+    }
+
+    /// Keep the settle counters a layer leaves (remembering the first for an abandoned frame).
+    fn keep_settles(&mut self, settles: &[(usize, u32)]) {
+        for &(index, settle) in settles {
+            if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
+                let before = &mut self.scratch_cpu.settles;
+                if !before.iter().any(|&(i, _)| i == index) {
+                    before.push((index, s.settle));
+                }
+                s.settle = settle;
+            }
+        }
     }
 
     /// Keep the carries a layer leaves, remembering each surface's carry before the frame so
@@ -222,6 +238,7 @@ impl SnowWorld {
             })?;
         self.in_flight = None;
         self.scratch_cpu.carries.clear();
+        self.scratch_cpu.settles.clear();
         self.probes_submitted();
         std::mem::swap(&mut self.last.captured, &mut self.scratch_cpu.captured);
         self.free_deferred();
@@ -248,6 +265,11 @@ impl SnowWorld {
             for (index, carry) in std::mem::take(&mut self.scratch_cpu.carries) {
                 if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
                     s.carry = carry;
+                }
+            }
+            for (index, settle) in std::mem::take(&mut self.scratch_cpu.settles) {
+                if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
+                    s.settle = settle;
                 }
             }
             if let (Some(ring), Some(slot)) = (self.timestamps.as_mut(), f.timestamp_slot) {
@@ -334,6 +356,7 @@ impl SnowWorld {
                 carry: s.carry,
                 elapsed: u.elapsed,
                 deformers: u.deformers,
+                settle: s.settle,
             })
         });
         let meshes = &self.meshes;
@@ -371,6 +394,14 @@ impl SnowWorld {
             uniform_blocks(blocks, &c.draws, 0);
             self.draws.ensure(device, sizes.draws);
             write(&self.draws.buffer, blocks);
+        }
+        if !plan.relax.is_empty() {
+            self.relax.records.ensure(device, sizes.relax_records);
+            write(
+                &self.relax.records.buffer,
+                bytemuck::cast_slice(&plan.relax.records),
+            );
+            self.relax.scratch.ensure(device, sizes.relax_scratch);
         }
         self.scratch.ensure(device, sizes.scratch);
         self.capture.ensure(device, sizes.capture);
@@ -416,7 +447,28 @@ impl SnowWorld {
             tiles: &self.tiles.buffer,
             tile_list: &self.tile_list.buffer,
         };
-        accumulate::encode(
+        accumulate::encode_update(
+            &self.device,
+            enc,
+            &self.acc,
+            &plan.accumulate,
+            &accumulate_buffers,
+            queries,
+        );
+        let relax_buffers = RelaxBuffers {
+            records: &self.relax.records.buffer,
+            pool: &self.pool,
+            scratch: &self.relax.scratch.buffer,
+        };
+        relax::encode(
+            &self.device,
+            enc,
+            &self.relax.pipes,
+            &plan.relax,
+            &relax_buffers,
+            queries,
+        );
+        accumulate::encode_normals(
             &self.device,
             enc,
             &self.acc,
@@ -455,6 +507,7 @@ fn stage_times(times: &[(&'static str, f64)]) -> StageTimes {
             "blur" => t.blur_ms += ms,
             "merge" => t.merge_ms += ms,
             "normals" => t.normals_ms += ms,
+            "relax" => t.relax_ms += ms,
             _ => t.fused_ms += ms,
         }
     }

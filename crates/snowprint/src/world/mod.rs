@@ -48,6 +48,9 @@ struct SurfaceState {
     slot: Slot,
     /// Replenishment not yet applied, units (fraction kept between frames).
     carry: f64,
+    /// Updates a slumping material still relaxes for (see [`crate::Material`]); not kept by
+    /// snapshots (a surface paged back in has settled).
+    settle: u32,
 }
 
 /// What the last frame did, for debug readbacks.
@@ -68,6 +71,8 @@ struct FrameScratch {
     blocks: Vec<u8>,
     /// A pending frame's carries and captures, given back when it is submitted.
     carries: Vec<(usize, f64)>,
+    /// The settle counters before a pending frame (see `carries`).
+    settles: Vec<(usize, u32)>,
     captured: Vec<(usize, SurfaceRecord)>,
 }
 
@@ -88,6 +93,7 @@ pub struct SnowWorld {
     config: WorldConfig,
     capture_pipes: CapturePipelines,
     acc: AccumulatePipelines,
+    relax: crate::relax::RelaxGpu,
     pool: wgpu::Buffer,
     alloc: SlotAllocator,
     surfaces: Vec<Option<SurfaceState>>,
@@ -202,6 +208,7 @@ impl SnowWorld {
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
             acc: AccumulatePipelines::new(&device, config.format.precision),
+            relax: crate::relax::RelaxGpu::new(&device, config.format.precision),
             probes: probe::Probes::new(&device),
             records: Growable::new(
                 &device,
@@ -324,6 +331,7 @@ impl SnowWorld {
             layout,
             slot,
             carry: 0.0,
+            settle: 0,
         }))
     }
 

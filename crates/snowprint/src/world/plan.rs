@@ -22,6 +22,7 @@ use crate::mesh::MeshId;
 use crate::pool::{
     MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
 };
+use crate::relax::{RelaxPlan, RelaxRecord};
 use crate::surface::{SurfaceDesc, SurfaceLayout};
 
 #[cfg(test)]
@@ -79,6 +80,8 @@ pub struct PlanSurface<'a> {
     pub elapsed: f32,
     /// Everything that touched it since then.
     pub deformers: &'a [Deformer],
+    /// Updates it still slumps for after the last that pressed it (see [`crate::Material`]).
+    pub settle: u32,
 }
 
 /// A surface the plan updates.
@@ -111,6 +114,10 @@ pub struct BufferSizes {
     pub tiles: u64,
     /// The tile list with its header.
     pub tile_list: u64,
+    /// Relaxation records.
+    pub relax_records: u64,
+    /// Relaxation scratch (a u32 a texel of every relaxing surface).
+    pub relax_scratch: u64,
 }
 
 /// One surface's work while the plan is built.
@@ -121,6 +128,8 @@ struct Job {
     half_size: Vec2,
     prims: Range<u32>,
     draws: Range<u32>,
+    /// Relaxation steps this update (0: none) and the material's repose angle, degrees.
+    relax: (u32, f32),
 }
 
 /// Everything one update records, decided on the CPU. Kept by the world and rebuilt each frame
@@ -136,6 +145,10 @@ pub struct FramePlan {
     /// The replenishment carry of every surface planned (updated or not), to keep once the frame
     /// is submitted: `(index, carry)`.
     pub carries: Vec<(usize, f64)>,
+    /// What the relaxation runs over.
+    pub relax: RelaxPlan,
+    /// The updates each surface planned still slumps for after this one: `(index, settle)`.
+    pub settles: Vec<(usize, u32)>,
     /// What each per-frame buffer must hold.
     pub sizes: BufferSizes,
     jobs: Vec<Job>,
@@ -195,6 +208,8 @@ impl FramePlan {
         self.capture.clear();
         self.accumulate.clear();
         self.carries.clear();
+        self.relax.clear();
+        self.settles.clear();
         self.sizes = BufferSizes::default();
         self.jobs.clear();
         self.rects.clear();
@@ -237,7 +252,16 @@ impl FramePlan {
         }
         let (p1, d1) = (prims.len() as u32, draws.len() as u32);
         let captured = p1 > p0 || d1 > d0;
-        if !captured && units == 0 {
+        // A slumping material relaxes in every update that presses it and for `settle_updates`
+        // after the last.
+        let material = &s.desc.material;
+        let (relaxes, settle) = match (material.slumps(), captured) {
+            (false, _) => (false, 0),
+            (true, true) => (true, material.settle_updates),
+            (true, false) => (s.settle > 0, s.settle.saturating_sub(1)),
+        };
+        self.settles.push((s.index, settle));
+        if !captured && units == 0 && !relaxes {
             return;
         }
         let texel = s.desc.size / Vec2::new(s.layout.width as f32, s.layout.height as f32);
@@ -271,6 +295,11 @@ impl FramePlan {
             half_size: volume.half_size,
             prims: p0..p1,
             draws: d0..d1,
+            relax: if relaxes {
+                (material.steps(), material.repose_degrees.unwrap_or(90.0))
+            } else {
+                (0, 90.0)
+            },
         });
     }
 
@@ -358,6 +387,24 @@ impl FramePlan {
         if self.jobs.is_empty() {
             return;
         }
+        let max = settings.format.precision.channel_max();
+        for job in self.jobs.iter().filter(|j| j.relax.0 > 0) {
+            let r = &job.record;
+            let (steps, repose) = job.relax;
+            let threshold = |texel| crate::relax::cpu::threshold(repose, texel, r.snow_depth, max);
+            self.relax.push(
+                RelaxRecord {
+                    heights: r.heights,
+                    width: r.width,
+                    height: r.height,
+                    scratch: 0,
+                    threshold_x: threshold(r.texel_x),
+                    threshold_z: threshold(r.texel_z),
+                    _pad: [0; 2],
+                },
+                steps,
+            );
+        }
         let texels = c.texels.max(1) as u64 * 4;
         self.sizes = BufferSizes {
             records: (a.records.len() * std::mem::size_of::<SurfaceRecord>()) as u64,
@@ -370,6 +417,8 @@ impl FramePlan {
             winding: c.winding_texels() as u64 * 4,
             tiles: c.tile_flags.max(1) as u64 * 4,
             tile_list: (TILE_LIST_HEADER + 2 * c.tile_flags as u64) * 4,
+            relax_records: std::mem::size_of_val(self.relax.records.as_slice()) as u64,
+            relax_scratch: self.relax.scratch_words as u64 * 4,
         };
     }
 }

@@ -287,6 +287,7 @@ impl SnowWorld {
             layout,
             slot,
             carry: snapshot.carry,
+            settle: 0,
         }))
     }
 }

@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3};
 use toml::Spanned;
 
 use crate::error::Result;
+use crate::material::Material;
 use crate::scene::diagnose::Source;
 use crate::scene::raw::{RawCapture, RawSurface};
 use crate::surface::SurfaceDesc;
@@ -183,6 +184,16 @@ pub(super) fn surface(
         None => 0.0,
     };
 
+    let material = match &s.material {
+        Some(m) => Material::named(m.get_ref()).ok_or_else(|| {
+            src.error(
+                &m.span(),
+                format!("{who} has material {}", src.quote(&m.span())),
+                "material must be one of \"snow\", \"packed_snow\", \"powder\", \"sand\", \"mud\"",
+            )
+        })?,
+        None => Material::snow(),
+    };
     let desc = SurfaceDesc {
         name: name.into_inner(),
         center: Vec3::from(center),
@@ -190,6 +201,7 @@ pub(super) fn surface(
         yaw_degrees,
         snow_depth,
         replenish_rate,
+        material,
     };
     desc.validate()
         .map_err(|e| src.error(&table, e, "fix this [[surface]] table"))?;

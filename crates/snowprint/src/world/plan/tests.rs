@@ -33,6 +33,7 @@ fn inputs<'a>(
                 carry: 0.0,
                 elapsed,
                 deformers,
+                settle: 0,
             };
             word += layout.width * layout.height;
             s
@@ -315,4 +316,46 @@ fn rebuilding_reuses_the_plan() {
     assert_eq!(plan.capture, first.capture);
     assert_eq!(plan.accumulate, first.accumulate);
     assert_eq!(plan.surfaces, first.surfaces);
+}
+
+/// A sand surface relaxes in the update that presses it and for `settle_updates` after, by its
+/// own threshold; snow and a settled surface plan no relaxation (and no update).
+#[test]
+fn slumping_materials_relax_while_they_settle() {
+    let mut sand = still("sand", 0.0);
+    sand.material = crate::Material::sand();
+    let descs = [sand, still("snow", 10.0)];
+    let pressed = vec![
+        vec![sphere_at([0.5, 0.1, 0.5])],
+        vec![sphere_at([10.5, 0.1, 0.5])],
+    ];
+    let plan = FramePlan::build(&settings(), inputs(&descs, &pressed, 0.1), no_meshes);
+    let m = crate::Material::sand();
+    assert_eq!(plan.settles, vec![(0, m.settle_updates), (1, 0)]);
+    assert_eq!(plan.relax.records.len(), 1, "only the sand relaxes");
+    assert_eq!(plan.relax.steps, m.steps());
+    let r = plan.relax.records[0];
+    // 34 degrees over a 4 cm texel in 0.3 m of snow at 16 bits, less 7 units.
+    let rise = (34f64.to_radians().tan() * 0.04 / 0.3 * 65_535.0).floor() as u32;
+    assert_eq!((r.threshold_x, r.threshold_z), (rise - 7, rise - 7));
+    assert_eq!((r.width, r.height, r.scratch), (100, 100, 0));
+    assert_eq!(plan.sizes.relax_scratch, 100 * 100 * 4);
+
+    // Nothing touches them now: the sand settles (one update fewer to go), the snow is left.
+    let idle = vec![vec![], vec![]];
+    let mut surfaces = inputs(&descs, &idle, 0.1);
+    surfaces[0].settle = 3;
+    let plan = FramePlan::build(&settings(), surfaces.clone(), no_meshes);
+    assert_eq!(plan.settles, vec![(0, 2), (1, 0)]);
+    assert_eq!(
+        plan.surfaces,
+        vec![PlannedSurface {
+            index: 0,
+            captured: false
+        }]
+    );
+    assert_eq!(plan.relax.records.len(), 1);
+    surfaces[0].settle = 0;
+    let plan = FramePlan::build(&settings(), surfaces, no_meshes);
+    assert!(plan.is_empty() && plan.relax.is_empty());
 }

@@ -1,0 +1,217 @@
+//! The relaxation pass: surfaces of a material with an angle of repose slump back toward it after
+//! the accumulation (`relax.wgsl`; CPU reference [`cpu`]; the rule in [`crate::Material`]).
+//!
+//! The world's frame plan lists the surfaces that relax this update ([`RelaxPlan`]); the pass runs
+//! after the fused (or merge) pass and before the normals, so that kept normals see the slumped
+//! top. Each step is one dispatch over every listed surface (`z` is the record), alternating
+//! between the pool and a scratch buffer, an even number of steps in all.
+
+pub(crate) mod cpu;
+
+use crate::gpu::resources::bind_group;
+use crate::gpu::timestamps::StageQueries;
+use crate::pool::Precision;
+
+/// One relaxing surface, as `RelaxRecord` in relax.wgsl (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct RelaxRecord {
+    /// Word offset of the heights region in the pool.
+    pub heights: u32,
+    /// Heightmap texels along local x and z.
+    pub width: u32,
+    /// See `width`.
+    pub height: u32,
+    /// First u32 of the surface's depressions in the scratch buffer.
+    pub scratch: u32,
+    /// Largest top difference between x neighbours that stands, channel units.
+    pub threshold_x: u32,
+    /// The same between z neighbours.
+    pub threshold_z: u32,
+    /// Padding to 32 bytes.
+    pub _pad: [u32; 2],
+}
+
+/// What the relaxation runs over in one update.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RelaxPlan {
+    /// The relaxing surfaces.
+    pub records: Vec<RelaxRecord>,
+    /// Steps this update (even; the most any listed material asks for).
+    pub steps: u32,
+    /// u32 words of scratch (every listed surface's texels).
+    pub scratch_words: u32,
+    /// Largest width and height of the listed surfaces (the dispatch grid).
+    pub max_width: u32,
+    /// See `max_width`.
+    pub max_height: u32,
+}
+
+impl RelaxPlan {
+    /// List no surface.
+    pub fn clear(&mut self) {
+        *self = Self {
+            records: std::mem::take(&mut self.records),
+            ..Self::default()
+        };
+        self.records.clear();
+    }
+
+    /// List a surface that relaxes `steps` steps this update.
+    pub fn push(&mut self, mut record: RelaxRecord, steps: u32) {
+        record.scratch = self.scratch_words;
+        self.scratch_words += record.width * record.height;
+        self.max_width = self.max_width.max(record.width);
+        self.max_height = self.max_height.max(record.height);
+        self.steps = self.steps.max(steps);
+        self.records.push(record);
+    }
+
+    /// Whether nothing relaxes.
+    pub fn is_empty(&self) -> bool {
+        self.records.is_empty() || self.steps == 0
+    }
+}
+
+/// The two entry points and their layout.
+pub struct RelaxPipelines {
+    from_pool: wgpu::ComputePipeline,
+    to_pool: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl RelaxPipelines {
+    /// Compile the pass for heightmaps of `precision`.
+    pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
+        let shader = &crate::wgsl::RELAX;
+        let layout = shader.bind_group_layout(device, "relax", 0);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("relax"),
+            source: wgpu::ShaderSource::Wgsl(shader.source.into()),
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("relax"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let constants = [("PRECISION", precision.bits() as f64)];
+        let make = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    zero_initialize_workgroup_memory: false,
+                },
+                cache: None,
+            })
+        };
+        Self {
+            from_pool: make("relax_from_pool"),
+            to_pool: make("relax_to_pool"),
+            layout,
+        }
+    }
+}
+
+/// What a world keeps for the pass: its pipelines, and the records and scratch it grows.
+pub(crate) struct RelaxGpu {
+    pub(crate) pipes: RelaxPipelines,
+    pub(crate) records: crate::gpu::resources::Growable,
+    pub(crate) scratch: crate::gpu::resources::Growable,
+}
+
+impl RelaxGpu {
+    pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> Self {
+        use crate::gpu::resources::Growable;
+        use wgpu::BufferUsages as U;
+        Self {
+            pipes: RelaxPipelines::new(device, precision),
+            records: Growable::new(device, "relax records", U::STORAGE | U::COPY_DST, 32 * 16),
+            scratch: Growable::new(device, "relax scratch", U::STORAGE, 4 * 4096),
+        }
+    }
+}
+
+/// The buffers the pass binds.
+pub struct RelaxBuffers<'a> {
+    /// The plan's records.
+    pub records: &'a wgpu::Buffer,
+    /// The heightmap pool.
+    pub pool: &'a wgpu::Buffer,
+    /// At least `plan.scratch_words` u32.
+    pub scratch: &'a wgpu::Buffer,
+}
+
+/// Record the plan's steps: one compute pass, one dispatch a step.
+pub fn encode(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipes: &RelaxPipelines,
+    plan: &RelaxPlan,
+    b: &RelaxBuffers<'_>,
+    queries: &mut StageQueries<'_>,
+) {
+    if plan.is_empty() {
+        return;
+    }
+    let bg = bind_group(
+        device,
+        "relax",
+        &pipes.layout,
+        &[
+            b.records.as_entire_binding(),
+            b.pool.as_entire_binding(),
+            b.scratch.as_entire_binding(),
+        ],
+    );
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some("relax"),
+        timestamp_writes: queries.compute("relax"),
+    });
+    pass.set_bind_group(0, &bg, &[]);
+    let wg = crate::wgsl::consts::WORKGROUP;
+    let (gx, gy, gz) = (
+        plan.max_width.div_ceil(wg),
+        plan.max_height.div_ceil(wg),
+        plan.records.len() as u32,
+    );
+    for k in 0..plan.steps {
+        // Units of two texels at 8 bits only matter when writing the pool; a grid over texels
+        // covers them.
+        pass.set_pipeline(if k % 2 == 0 {
+            &pipes.from_pool
+        } else {
+            &pipes.to_pool
+        });
+        pass.dispatch_workgroups(gx, gy, gz);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `RelaxRecord` here and in relax.wgsl: same fields in order, 4 bytes each, 32 bytes.
+    #[test]
+    fn record_layout_matches_wgsl() {
+        let module = naga::front::wgsl::parse_str(crate::wgsl::RELAX.source).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let (handle, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some("RelaxRecord"))
+            .unwrap();
+        let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+            panic!("RelaxRecord is not a struct")
+        };
+        assert_eq!(
+            layouter[handle].size as usize,
+            std::mem::size_of::<super::RelaxRecord>()
+        );
+        for (i, m) in members.iter().enumerate() {
+            assert_eq!(m.offset as usize, i * 4, "{:?}", m.name);
+        }
+    }
+}

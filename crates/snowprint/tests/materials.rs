@@ -1,0 +1,187 @@
+//! Materials that move like themselves: a sand print slumps toward its angle of repose on the GPU
+//! exactly as the CPU reference says, keeping the volume pressed out to the unit, and ends with no
+//! step between neighbours steeper than the repose, its rim slumped into a wider pit; the talk's snow does not move; scene files
+//! name materials and refuse unknown ones with one sentence.
+
+mod common;
+
+use std::path::Path;
+
+use snowprint::reference::relax;
+use snowprint::{
+    Deformer, Material, PoolFormat, Pose, Precision, Shape, SnowWorld, SurfaceDesc, SurfaceId,
+    WorldConfig,
+};
+
+const DT: f32 = 1.0 / 60.0;
+const DEPTH: f32 = 0.2;
+
+fn world(precision: Precision) -> SnowWorld {
+    SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            format: PoolFormat::new(precision),
+            pool_bytes: 4 << 20,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+}
+
+/// A 1 m square yard of `material` (25 x 25 texels of 4 cm), 0.2 m deep.
+fn yard(w: &mut SnowWorld, material: Material) -> SurfaceId {
+    let mut desc = SurfaceDesc::new("yard", [0.0, 0.0, 0.0], [1.0, 1.0], DEPTH);
+    desc.material = material;
+    w.add_surface(desc).unwrap()
+}
+
+/// A ball pressed 0.15 m deep off the yard's centre: steep walls.
+fn press() -> Deformer {
+    Deformer::new(
+        Shape::Sphere { radius: 0.2 },
+        Pose::at([0.1, DEPTH - 0.15 + 0.2, -0.05]),
+    )
+}
+
+fn sum(v: &[u32]) -> u64 {
+    v.iter().map(|&x| x as u64).sum()
+}
+
+/// The relaxation's thresholds for the yard at `precision`.
+fn thresholds(material: &Material, precision: Precision) -> [u32; 2] {
+    let t = relax::threshold(
+        material.repose_degrees.unwrap(),
+        0.04,
+        DEPTH,
+        precision.channel_max(),
+    );
+    [t, t]
+}
+
+#[test]
+fn sand_slumps_as_the_cpu_reference_says_keeping_its_volume() {
+    let sand = Material::sand();
+    for precision in Precision::ALL {
+        // Snow keeps the print as pressed: what sand starts from before it slumps.
+        let mut snow = world(precision);
+        let mut sandy = world(precision);
+        let (s, d) = (yard(&mut snow, Material::snow()), yard(&mut sandy, sand));
+        snow.step(DT, &[press()]).unwrap();
+        sandy.step(DT, &[press()]).unwrap();
+        let (pressed, displaced) = snow.read_channels(s).unwrap();
+        let max = precision.channel_max();
+        let t = thresholds(&sand, precision);
+        let mut expect = pressed.clone();
+        // Three updates: the one that pressed, and two that only settle.
+        for update in 0..3 {
+            if update > 0 {
+                sandy.step(DT, &[]).unwrap();
+            }
+            for _ in 0..sand.steps() {
+                expect = relax::step(&expect, 25, 25, max, t);
+            }
+            let (got, got_displaced) = sandy.read_channels(d).unwrap();
+            assert_eq!(
+                got, expect,
+                "{precision:?}, update {update}: GPU against CPU"
+            );
+            assert_eq!(
+                got_displaced, displaced,
+                "the displaced channel is left as it is"
+            );
+            assert_eq!(
+                sum(&got),
+                sum(&pressed),
+                "{precision:?}: the volume pressed out is kept"
+            );
+        }
+        assert_ne!(expect, pressed, "{precision:?}: the print slumped");
+        // The snow did not move while the sand settled.
+        snow.step(DT, &[]).unwrap();
+        assert_eq!(snow.read_channels(s).unwrap().0, pressed);
+    }
+}
+
+/// Left to settle, the sand print ends with no step between neighbours steeper than 34 degrees
+/// (measured in metres between texel centres 4 cm apart), on the GPU, and the pit is wider.
+#[test]
+fn settled_sand_stands_at_its_angle_of_repose() {
+    let sand = Material::sand();
+    let mut w = world(Precision::Bits16);
+    let id = yard(&mut w, sand);
+    w.step(DT, &[press()]).unwrap();
+    let first = w.read_channels(id).unwrap().0;
+    for _ in 0..sand.settle_updates {
+        w.step(DT, &[]).unwrap();
+    }
+    let settled = w.read_channels(id).unwrap().0;
+    assert_eq!(sum(&settled), sum(&first));
+    let metres = |units: u32| units as f64 / 65_535.0 * DEPTH as f64;
+    let steepest = steepest_step(&settled, 25, 25);
+    let tan = metres(steepest) / 0.04;
+    let repose = 34f64.to_radians().tan();
+    assert!(
+        tan <= repose,
+        "steepest slope {tan:.3} against tan 34 = {repose:.3}"
+    );
+    // As pressed (in snow, which does not slump), the print's walls were far steeper.
+    let mut snow = world(Precision::Bits16);
+    let s = yard(&mut snow, Material::snow());
+    snow.step(DT, &[press()]).unwrap();
+    let pressed = metres(steepest_step(&snow.read_channels(s).unwrap().0, 25, 25)) / 0.04;
+    assert!(
+        pressed > 1.5 * repose,
+        "the print was pressed steep: {pressed:.3}"
+    );
+    // The rim slumped in: the same volume is spread over a wider pit.
+    let pressed_texels = |d: &[u32]| d.iter().filter(|&&v| v > 0).count();
+    assert!(
+        pressed_texels(&settled) > pressed_texels(&first),
+        "{} texels pressed after settling, {} before",
+        pressed_texels(&settled),
+        pressed_texels(&first)
+    );
+    // Settled: one more update that relaxes changes nothing.
+    w.step(DT, &[press()]).unwrap();
+    let after_press = w.read_channels(id).unwrap().0;
+    let mut again = after_press.clone();
+    for _ in 0..sand.steps() * 200 {
+        again = relax::step(&again, 25, 25, 65_535, thresholds(&sand, Precision::Bits16));
+    }
+    let fixed = relax::step(&again, 25, 25, 65_535, thresholds(&sand, Precision::Bits16));
+    assert_eq!(fixed, again, "the CPU rule reaches a fixed point");
+}
+
+fn steepest_step(d: &[u32], w: usize, h: usize) -> u32 {
+    let mut m = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if x + 1 < w {
+                m = m.max(d[y * w + x].abs_diff(d[y * w + x + 1]));
+            }
+            if y + 1 < h {
+                m = m.max(d[y * w + x].abs_diff(d[(y + 1) * w + x]));
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn scene_files_name_materials_and_refuse_unknown_ones() {
+    let scene = |material: &str| {
+        format!(
+            "version = 1\n[[surface]]\nname = \"beach\"\ncenter = [0.0, 0.0, 0.0]\nsize = [4.0, 4.0]\nsnow_depth = 0.2\nmaterial = \"{material}\"\n"
+        )
+    };
+    let ok = snowprint::scene::Scene::parse(&scene("sand"), Path::new("beach.toml")).unwrap();
+    assert_eq!(ok.surfaces[0].material, Material::sand());
+    let err = snowprint::scene::Scene::parse(&scene("gravel"), Path::new("beach.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with("beach.toml:7:"), "{err}");
+    assert!(
+        err.contains("\"gravel\"") && err.contains("\"sand\""),
+        "{err}"
+    );
+}
