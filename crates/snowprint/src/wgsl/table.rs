@@ -23,6 +23,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("normals", "accumulate/normals.wgsl", true),
     ("fused", "accumulate/fused.wgsl", true),
     ("seal", "accumulate/seal.wgsl", true),
+    // Skinned mesh deformers: the bind pose blended by the joints into the capture's vertices.
+    ("skin", "skin/skin.wgsl", true),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe.wgsl", true),
     // The renderer.
