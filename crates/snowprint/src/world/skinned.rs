@@ -191,13 +191,13 @@ impl SnowWorld {
     /// # Errors
     ///
     /// [`SnowError::StaleHandle`] for a mesh that is not a live skinned mesh of this world,
-    /// [`SnowError::PoseMismatch`] when the number of matrices is not the mesh's joint count,
+    /// [`SnowError::JointCount`] when the number of matrices is not the mesh's joint count,
     /// [`SnowError::InvalidMesh`] for a matrix that is not finite.
     pub fn skin_meshes(&mut self, poses: &[(MeshId, &[Mat4])]) -> Result<()> {
         for &(id, joints) in poses {
             let skin = self.skin(id)?;
             if joints.len() != skin.gpu.joint_count() {
-                return Err(SnowError::PoseMismatch {
+                return Err(SnowError::JointCount {
                     mesh: id.0,
                     got: joints.len(),
                     expected: skin.gpu.joint_count(),
