@@ -426,15 +426,16 @@ fn read_animation(
             MAX_ANIMATION_KEYS,
         )
         .map_err(|e| format!("{what} has an input accessor that {e}"))?;
-        if let Some(w) = times.windows(2).find(|w| !(w[1] > w[0])) {
-            return Err(format!(
-                "{what} has key times {} then {}; key times must increase strictly, so export the animation again",
-                w[0], w[1]
-            ));
-        }
         if let Some(t) = times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
             return Err(format!(
                 "{what} has key time {t}; key times must be finite seconds, 0 or more"
+            ));
+        }
+        // Finite now, so `<=` is the negation of `>`.
+        if let Some(w) = times.windows(2).find(|w| w[1] <= w[0]) {
+            return Err(format!(
+                "{what} has key times {} then {}; key times must increase strictly, so export the animation again",
+                w[0], w[1]
             ));
         }
         let (dims, types, norm, expect): (_, &[DataType], _, _) = match property {

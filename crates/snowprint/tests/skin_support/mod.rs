@@ -57,7 +57,7 @@ struct Bin {
 impl Bin {
     /// Append bytes (4-aligned) as a new bufferView; its index.
     fn view(&mut self, data: &[u8]) -> usize {
-        while self.bytes.len() % 4 != 0 {
+        while !self.bytes.len().is_multiple_of(4) {
             self.bytes.push(0);
         }
         self.views.push(json!({
@@ -172,10 +172,10 @@ pub fn glb(gltf: &[u8]) -> Vec<u8> {
     let mut bin = decode_data_uri(&uri);
     doc["buffers"][0].as_object_mut().unwrap().remove("uri");
     let mut text = serde_json::to_vec(&doc).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();
