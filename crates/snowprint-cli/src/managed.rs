@@ -134,9 +134,11 @@ pub fn simulate(
     let (mut snow, ids) = start(&ctx, scene, config, persist.load.as_deref())?;
     // Frames continue from the save's clock.
     let first = snow.planner().next_frame();
-    let shapes = crate::simulate::scene_shapes(scene, |name, mesh| match snow.mesh_named(name) {
+    // The manager registers meshes as they are: an animated mesh presses in its bind pose here
+    // (skinning runs in the plain `simulate`, without [budget]).
+    let shapes = crate::simulate::scene_shapes(scene, |d, mesh| match snow.mesh_named(&d.name) {
         Some(id) if persist.load.is_some() => Ok(id),
-        _ => snow.add_mesh(name, mesh),
+        _ => snow.add_mesh(&d.name, mesh),
     })?;
     let mut progress = Progress::new(frames as u64, "simulate (managed)", "frames")?;
     let mut failure = None;

@@ -180,10 +180,14 @@ pub fn partial_note(done: &Done, dump: &Path, written: Result<(), String>) -> St
     }
 }
 
-/// The library shape of each scene deformer, registering meshes through `add_mesh`.
+/// The library shape of each scene deformer, registering meshes through `add_mesh` (given the
+/// deformer, so that an animated one can be registered as a skinned mesh).
 pub fn scene_shapes(
     scene: &Scene,
-    mut add_mesh: impl FnMut(&str, &snowprint::Mesh) -> snowprint::Result<snowprint::MeshId>,
+    mut add_mesh: impl FnMut(
+        &snowprint::scene::SceneDeformer,
+        &snowprint::Mesh,
+    ) -> snowprint::Result<snowprint::MeshId>,
 ) -> Result<Vec<Shape>, String> {
     scene
         .deformers
@@ -202,7 +206,7 @@ pub fn scene_shapes(
                     half_extents: *half_extents,
                 },
                 SceneShape::Mesh { mesh, .. } => {
-                    Shape::Mesh(add_mesh(&d.name, mesh).map_err(|e| e.to_string())?)
+                    Shape::Mesh(add_mesh(d, mesh).map_err(|e| e.to_string())?)
                 }
             })
         })
@@ -239,7 +243,10 @@ pub fn simulate(
     for s in &scene.surfaces {
         ids.push(world.add_surface(s.clone()).map_err(|e| e.to_string())?);
     }
-    let shapes = scene_shapes(scene, |name, mesh| world.add_mesh(name, mesh))?;
+    let shapes = scene_shapes(scene, |d, mesh| match &d.animation {
+        Some(a) => world.add_skinned_mesh(&d.name, &a.skinned),
+        None => world.add_mesh(&d.name, mesh),
+    })?;
     let mut progress = Progress::new(frames as u64, "simulate", "frames")?;
     let mut failure = None;
     let mut frames_done = 0;
@@ -251,7 +258,20 @@ pub fn simulate(
             .zip(&shapes)
             .map(|(d, &shape)| Deformer::moving(shape, d.pose_at(t - dt), d.pose_at(t)))
             .collect();
-        if let Err(e) = world.step(dt, &deformers) {
+        // Animated meshes are skinned for this frame's time before the step draws them.
+        let animations: Vec<snowprint::MeshAnimation> = scene
+            .deformers
+            .iter()
+            .zip(&shapes)
+            .filter_map(|(d, shape)| match (&d.animation, shape) {
+                (Some(a), Shape::Mesh(id)) => Some(a.at(*id, t)),
+                _ => None,
+            })
+            .collect();
+        let stepped = world
+            .animate_meshes(&animations)
+            .and_then(|()| world.step(dt, &deformers));
+        if let Err(e) = stepped {
             failure = Some(frame_error(scene, f, dt, &e));
             break;
         }

@@ -235,6 +235,18 @@ pub enum SnowError {
         /// Vertices of the mesh.
         expected: usize,
     },
+    /// Joint matrices given for a skinned mesh do not match its joints.
+    #[error(
+        "joint matrices for skinned mesh {mesh}: got {got}, the mesh has {expected} joints; give one matrix a joint, as SkinnedMesh::pose computes them"
+    )]
+    JointCount {
+        /// Mesh index.
+        mesh: u32,
+        /// Matrices given.
+        got: usize,
+        /// Joints of the mesh.
+        expected: usize,
+    },
     /// A surface was listed twice in one update.
     #[error("surface {index} is listed twice in one update; list each surface once")]
     DuplicateUpdate {

@@ -54,6 +54,7 @@ mod pool;
 mod relax;
 pub mod render;
 pub mod scene;
+mod skin;
 mod surface;
 mod view;
 pub mod wgsl;
@@ -77,12 +78,22 @@ pub use mesh::{
 };
 pub use pool::{PoolFormat, Precision};
 pub use render::gpu::SurfaceUniform;
+pub use skin::{Playback, SkinnedMesh};
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
-    CaptureConfig, CaptureMode, FrameStats, MemoryReport, PassMode, PendingFrame, SnapshotRead,
-    SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
+    CaptureConfig, CaptureMode, FrameStats, MemoryReport, MeshAnimation, PassMode, PendingFrame,
+    SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
+
+/// What a [`SkinnedMesh`] holds besides its triangles: joints and influences, the node hierarchy,
+/// animations and their channels.
+pub mod skeleton {
+    pub use crate::skin::{
+        Animation, Channel, Influence, Interpolation, Joint, MAX_ANIMATION_KEYS, MAX_SKIN_JOINTS,
+        Node, Property, Trs,
+    };
+}
 pub use world::{
     Footstep, MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus,
     ProbeTicket,
@@ -111,6 +122,10 @@ pub mod reference {
     /// The relaxation of materials with an angle of repose: one step, and the slope's threshold.
     pub mod relax {
         pub use crate::relax::cpu::*;
+    }
+    /// Skinning: a skeleton posed at an animation's time, joint matrices, skinned vertices.
+    pub mod skin {
+        pub use crate::skin::cpu::*;
     }
 }
 
@@ -173,6 +188,10 @@ pub mod low_level {
         pub use crate::gpu::readback::*;
         pub use crate::gpu::timestamps::*;
         pub use crate::gpu::{REQUIRED_DOWNLEVEL, check_device, describe, missing_capabilities};
+    }
+    /// The skinning pass's bind-pose vertex as uploaded, and its workgroup size.
+    pub mod skin {
+        pub use crate::skin::{GpuBindVertex, SKIN_WORKGROUP};
     }
     /// The manager's per-surface imprint queue (merging, bounding).
     pub mod queue {

@@ -10,6 +10,7 @@
 //! run (`docs/RELIABILITY.md`, "Fuzzing: scene parser and glTF loader").
 
 mod fuzz_support;
+mod skin_support;
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -19,7 +20,7 @@ use fuzz_support::{Edit, Watchdog, apply, cases, config, edit, finish};
 use proptest::prelude::*;
 use proptest::test_runner::TestRunner;
 use serde_json::Value;
-use snowprint::{Mesh, SnowError};
+use snowprint::{Mesh, SkinnedMesh, SnowError};
 
 /// Time one input may take (loading is microseconds; this only catches hangs).
 const LIMIT: Duration = Duration::from_secs(10);
@@ -101,6 +102,10 @@ fn seeds() -> &'static [Vec<u8>] {
                 }
             }
         }
+        // Skinned seeds, read by both loaders: the hand-built two-joint file (skin, three kinds
+        // of channel) and RiggedFigure.
+        seeds.push(skin_support::two_joints(&skin_support::TwoJoints::default()));
+        seeds.push(std::fs::read(skin_support::rigged_figure()).expect("read RiggedFigure"));
         seeds
     })
 }
@@ -110,7 +115,17 @@ fn seeds() -> &'static [Vec<u8>] {
 fn load_one(bytes: Vec<u8>) -> Result<(), String> {
     let (sub, root) = folders();
     let name = sub.join("fuzz.gltf");
-    match Mesh::from_gltf_slice(&bytes, &name, Some((sub, root))) {
+    // The skinned loader reads the same file with its skins and animations: the same promise.
+    let skinned = SkinnedMesh::from_gltf_slice(&bytes, &name, Some((sub, root)))
+        .map(|s| s.mesh)
+        .and_then(|m| m.validate("fuzzed skinned").map(|()| m));
+    check_answer(skinned)?;
+    check_answer(Mesh::from_gltf_slice(&bytes, &name, Some((sub, root))))
+}
+
+/// A loaded mesh must be valid and hold triangles, an error be one line of the loader's kinds.
+fn check_answer(answer: snowprint::Result<Mesh>) -> Result<(), String> {
+    match answer {
         Ok(mesh) => {
             mesh.validate("fuzzed")
                 .map_err(|e| format!("a loaded mesh is not valid: {e}"))?;

@@ -1191,3 +1191,86 @@ mod manager_keys {
         assert!(e.contains("m.toml:7:") && e.contains("zone -1"), "{e}");
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Animated (skinned) mesh deformers
+
+#[test]
+fn skinned_walker_names_its_animation() {
+    let scene =
+        Scene::load(&scenes_dir().join("skinned_walker.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let figure = &scene.deformers[0];
+    let a = figure.animation.as_ref().expect("animated");
+    assert_eq!(a.index, 0);
+    assert_eq!(a.name, "0");
+    assert_eq!(a.speed, 1.0);
+    assert_eq!(a.playback, snowprint::Playback::Loop);
+    assert_eq!(a.skinned.joints.len(), 19);
+    // The figure's time: scene seconds times the speed.
+    // Any handle: `at` only carries it.
+    let id = mesh_handle();
+    assert_eq!(a.at(id, 2.0).time, 2.0);
+    assert_eq!(a.at(id, 2.0).animation, Some(0));
+}
+
+/// A mesh handle for [`snowprint::scene::SceneAnimation::at`], from a world-free path: handles are
+/// serializable, so one is read from its saved form.
+fn mesh_handle() -> snowprint::MeshId {
+    serde_json::from_str("0").expect("a MeshId is its index")
+}
+
+/// A scene in `scenes/` (so that `RiggedFigure.gltf` is beside it) with one figure deformer whose
+/// extra lines are `extra`.
+fn figure_scene(extra: &str) -> String {
+    format!(
+        "version = 1\n\n[[surface]]\nname = \"roof\"\ncenter = [0, 10, 0]\nsize = [8, 3]\nsnow_depth = 0.3\n\n\
+         [[deformer]]\nname = \"figure\"\nshape = \"mesh\"\npath = \"RiggedFigure.gltf\"\n{extra}\n\
+         keys = [{{ t = 0, position = [0, 10.05, 0] }}]\n"
+    )
+}
+
+fn figure_error(text: &str) -> String {
+    match Scene::parse(text, &scenes_dir().join("figure.toml")) {
+        Err(SnowError::Scene(msg)) => msg,
+        other => panic!("expected a scene error, got {other:?}"),
+    }
+}
+
+#[test]
+fn animation_keys_are_checked_with_file_and_line() {
+    // An animation the file does not have: the line of `animation`, the names it has.
+    let text = figure_scene("animation = \"walk\"");
+    let msg = figure_error(&text);
+    let line = line_of(&text, "animation =");
+    assert!(msg.contains(&format!("figure.toml:{line}: ")), "{msg}");
+    assert!(msg.contains("has animation \"walk\""), "{msg}");
+    assert!(msg.contains("\"0\" (unnamed)"), "{msg}");
+    // A speed that is not above 0.
+    let text = figure_scene("animation = \"0\"\nanimation_speed = 0");
+    let msg = figure_error(&text);
+    assert!(
+        msg.contains(&format!(":{}: ", line_of(&text, "animation_speed"))),
+        "{msg}"
+    );
+    assert!(msg.contains("animation_speed must be"), "{msg}");
+    // loop without an animation.
+    let text = figure_scene("loop = false");
+    let msg = figure_error(&text);
+    assert!(msg.contains("has loop false but no animation"), "{msg}");
+    // An animation on a sphere.
+    let text = minimal_plus(
+        "[[deformer]]\nname = \"ball\"\nshape = \"sphere\"\nradius = 0.1\nanimation = \"0\"\nkeys = [{ t = 0, position = [0, 0, 0] }]\n",
+    );
+    let msg = error_of(&text);
+    assert!(msg.contains("animation only applies to meshes"), "{msg}");
+    // loop = false holds the last pose; a speed scales time.
+    let text = figure_scene("animation = \"0\"\nanimation_speed = 0.5\nloop = false");
+    let scene =
+        Scene::parse(&text, &scenes_dir().join("figure.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let a = scene.deformers[0].animation.as_ref().unwrap();
+    assert_eq!(a.playback, snowprint::Playback::Clamp);
+    assert_eq!(a.at(mesh_handle(), 3.0).time, 1.5);
+    // Without `animation` the mesh is static, as before.
+    let scene = Scene::parse(&figure_scene(""), &scenes_dir().join("figure.toml")).unwrap();
+    assert!(scene.deformers[0].animation.is_none());
+}

@@ -2,7 +2,7 @@
 //! convention). The capture relies on that winding to fill what lies below the ground (see
 //! `capture/capture.wgsl`).
 
-mod gltf_file;
+pub(crate) mod gltf_file;
 
 use glam::{Mat4, Vec3};
 

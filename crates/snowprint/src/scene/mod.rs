@@ -123,8 +123,38 @@ pub struct SceneDeformer {
     pub keys: Vec<Key>,
     /// Whether it is the player (`player = true`): the manager updates the player's surface first.
     pub player: bool,
+    /// For a mesh with `animation = "NAME"`: the skinned mesh and how its animation plays.
+    pub animation: Option<SceneAnimation>,
     /// Line of its `[[deformer]]` table in the scene file (for messages; 0 when built by hand).
     pub line: usize,
+}
+
+/// A mesh deformer's animation (`animation`, `animation_speed`, `loop`): the file read as a
+/// skinned mesh, posed each frame at the scene's time times the speed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneAnimation {
+    /// The file read with its skeleton and animations.
+    pub skinned: crate::skin::SkinnedMesh,
+    /// The animation's index in [`crate::SkinnedMesh::animations`].
+    pub index: usize,
+    /// The name as written in the scene.
+    pub name: String,
+    /// Animation seconds per scene second (`animation_speed`, default 1).
+    pub speed: f32,
+    /// Whether it starts again at its end (`loop`, default true) or holds its last pose.
+    pub playback: crate::skin::Playback,
+}
+
+impl SceneAnimation {
+    /// The pose of the deformer's mesh at scene time `t`, for [`crate::SnowWorld::animate_meshes`].
+    pub fn at(&self, mesh: crate::MeshId, t: f32) -> crate::MeshAnimation {
+        crate::MeshAnimation {
+            mesh,
+            animation: Some(self.index),
+            time: t * self.speed,
+            playback: self.playback,
+        }
+    }
 }
 
 /// The geometry of a scene deformer, in its own frame.
@@ -326,6 +356,7 @@ mod tests {
             shape: SceneShape::Sphere { radius: 0.1 },
             keys,
             player: false,
+            animation: None,
             line: 0,
         }
     }

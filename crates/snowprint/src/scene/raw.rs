@@ -88,6 +88,10 @@ pub(super) struct RawDeformer {
     pub path: Option<Str>,
     pub player: Option<Spanned<bool>>,
     pub keys: Option<Spanned<Vec<Spanned<RawKey>>>>,
+    pub animation: Option<Str>,
+    pub animation_speed: Option<Num>,
+    #[serde(rename = "loop")]
+    pub looping: Option<Spanned<bool>>,
 }
 
 /// One key of a deformer, inline (`keys = [{ ... }]`) or as `[[deformer.keys]]`.
@@ -133,6 +137,9 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "path",
             "player",
             "keys",
+            "animation",
+            "animation_speed",
+            "loop",
         ],
     ),
     ("in a deformer key", &["t", "position", "rotation_degrees"]),

@@ -57,3 +57,5 @@ const LIGHT_TAPS: u32 = 16u;
 const AO_DIRECTIONS: u32 = 8u;
 // Least receptivity of a texel to banks (at the bottom of trails), so that no pushed snow is lost.
 const RECEPTIVITY_FLOOR: f32 = 0.001;
+// Vertices a workgroup of the skinning pass (skin/skin.wgsl) skins.
+const SKIN_WORKGROUP: u32 = 64u;

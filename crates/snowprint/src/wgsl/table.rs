@@ -25,6 +25,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("seal", "accumulate/seal.wgsl", true),
     // Materials that slump to their angle of repose.
     ("relax", "relax/relax.wgsl", true),
+    // Skinned mesh deformers: the bind pose blended by the joints into the capture's vertices.
+    ("skin", "skin/skin.wgsl", true),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe/probe.wgsl", true),
     // The renderer.

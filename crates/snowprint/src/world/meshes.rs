@@ -78,6 +78,7 @@ impl SnowWorld {
                 index: id.0,
             })?;
         self.probes.forget_mesh(id.0 as usize);
+        self.skins.forget(id.0 as usize);
         Ok(())
     }
 }

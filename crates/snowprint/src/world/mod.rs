@@ -12,7 +12,8 @@
 //! [`crate::accumulate::encode`] into an encoder (the caller's, with
 //! [`SnowWorld::encode_update`]), and once it is submitted keep the plan's replenishment carries
 //! ([`SnowWorld::submitted`]). The rest of the world is its surfaces and pool slots (here), mesh
-//! deformers (`meshes.rs`), snapshots (`snapshot.rs`) and readbacks (`readback.rs`).
+//! deformers (`meshes.rs`; skinned ones in `skinned.rs`), snapshots (`snapshot.rs`) and readbacks
+//! (`readback.rs`).
 
 mod config;
 mod footstep;
@@ -21,6 +22,7 @@ mod meshes;
 pub(crate) mod plan;
 pub(crate) mod probe;
 mod readback;
+mod skinned;
 mod snapshot;
 
 pub use crate::capture::{CaptureConfig, CaptureMode};
@@ -31,6 +33,7 @@ pub(crate) use plan::FramePlan;
 pub use probe::{
     MAX_PROBE_POINTS, MAX_UNCLAIMED_ANSWERS, PROBE_RING, ProbeSample, ProbeStatus, ProbeTicket,
 };
+pub use skinned::MeshAnimation;
 pub use snapshot::{SnapshotRead, SurfaceSnapshot};
 
 use crate::accumulate::AccumulatePipelines;
@@ -101,6 +104,8 @@ pub struct SnowWorld {
     /// handles to the slot are refused (see [`SurfaceId`]).
     generations: Vec<u32>,
     meshes: Vec<Option<CaptureMesh>>,
+    /// Skinned meshes' skeletons and GPU state, by mesh index (`skinned.rs`).
+    skins: skinned::Skins,
     atlases: Vec<(u32, wgpu::Texture, wgpu::TextureView)>,
     records: Growable,
     views: Growable,
@@ -263,6 +268,7 @@ impl SnowWorld {
             surfaces: Vec::new(),
             generations: Vec::new(),
             meshes: Vec::new(),
+            skins: skinned::Skins::default(),
             atlases: Vec::new(),
             last: LastFrame::default(),
             scratch_cpu: FrameScratch::default(),

@@ -79,7 +79,7 @@ pub(super) fn elements<'a>(
     }
 }
 
-pub(super) fn read_positions(
+pub(crate) fn read_positions(
     accessor: &gltf::Accessor<'_>,
     buffers: &[Vec<u8>],
 ) -> std::result::Result<Vec<Vec3>, String> {
@@ -107,7 +107,7 @@ pub(super) fn read_positions(
         .collect())
 }
 
-pub(super) fn read_indices(
+pub(crate) fn read_indices(
     accessor: &gltf::Accessor<'_>,
     buffers: &[Vec<u8>],
 ) -> std::result::Result<Vec<u32>, String> {
@@ -152,4 +152,69 @@ pub(super) fn read_indices(
             }
         })
         .collect())
+}
+
+/// Every component of an accessor as `f32`, `dims` components an element: floats as stored;
+/// integers divided by their type's maximum when the accessor is `normalized` (glTF's rule, signed
+/// ones clamped at -1), as stored when not. `what` names the expected content in messages (e.g.
+/// `"VEC4 of FLOAT or normalized UNSIGNED_BYTE or UNSIGNED_SHORT"`), `types` the component types
+/// accepted, `normalized` whether integers must be normalized (`Some(true)`), must not be
+/// (`Some(false)`), or may be either. At most `max_count` elements are read.
+pub(crate) fn read_components(
+    accessor: &gltf::Accessor<'_>,
+    buffers: &[Vec<u8>],
+    dims: gltf::accessor::Dimensions,
+    types: &[gltf::accessor::DataType],
+    normalized: Option<bool>,
+    what: &str,
+    max_count: usize,
+) -> std::result::Result<Vec<f32>, String> {
+    use gltf::accessor::DataType;
+    let ty = accessor.data_type();
+    let integer = ty != DataType::F32;
+    let wrong_norm = integer && normalized.is_some_and(|n| n != accessor.normalized());
+    if accessor.dimensions() != dims || !types.contains(&ty) || wrong_norm {
+        let norm = if accessor.normalized() {
+            " normalized"
+        } else {
+            ""
+        };
+        return Err(format!(
+            "holds {:?} of{norm} {:?}, but must hold {what}; export it again with that type",
+            accessor.dimensions(),
+            ty
+        ));
+    }
+    if accessor.count() > max_count {
+        return Err(format!(
+            "has {} elements, more than the {max_count} snowprint reads; simplify the file",
+            accessor.count()
+        ));
+    }
+    let n = dims.multiplicity();
+    let size = ty.size();
+    let e = elements(accessor, buffers, n * size)?;
+    let norm = accessor.normalized();
+    let mut out = Vec::with_capacity(e.count * n);
+    for i in 0..e.count {
+        let b = e.get(i);
+        for c in b.chunks_exact(size) {
+            let v = match ty {
+                DataType::F32 => f32::from_le_bytes([c[0], c[1], c[2], c[3]]),
+                DataType::U8 if norm => f32::from(c[0]) / 255.0,
+                DataType::U8 => f32::from(c[0]),
+                DataType::I8 if norm => (f32::from(c[0] as i8) / 127.0).max(-1.0),
+                DataType::I8 => f32::from(c[0] as i8),
+                DataType::U16 if norm => f32::from(u16::from_le_bytes([c[0], c[1]])) / 65535.0,
+                DataType::U16 => f32::from(u16::from_le_bytes([c[0], c[1]])),
+                DataType::I16 if norm => {
+                    (f32::from(i16::from_le_bytes([c[0], c[1]])) / 32767.0).max(-1.0)
+                }
+                DataType::I16 => f32::from(i16::from_le_bytes([c[0], c[1]])),
+                DataType::U32 => u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f32,
+            };
+            out.push(v);
+        }
+    }
+    Ok(out)
 }

@@ -19,7 +19,7 @@ use glam::Mat4;
 use super::Mesh;
 use crate::error::{Result, SnowError};
 
-mod accessors;
+pub(crate) mod accessors;
 #[cfg(test)]
 mod tests;
 mod uri;
@@ -64,34 +64,8 @@ impl Mesh {
     ///
     /// As [`Mesh::load_gltf`]; also [`SnowError::MeshFile`] when `path` itself is outside `root`.
     pub fn load_gltf_within(path: &Path, root: &Path) -> Result<Mesh> {
-        let err = |reason: String, source: Option<std::io::Error>| SnowError::MeshFile {
-            path: path.to_owned(),
-            reason,
-            source,
-        };
-        let canonical_root = canonical_folder(root).map_err(|e| {
-            let reason = format!(
-                "its allowed folder {} cannot be opened ({e}); check that the folder exists",
-                root.display()
-            );
-            err(reason, Some(e))
-        })?;
-        let canonical = path.canonicalize().map_err(|e| {
-            let reason = format!("cannot be opened ({e}); check the path and that the file exists");
-            err(reason, Some(e))
-        })?;
-        if !canonical.starts_with(&canonical_root) {
-            return Err(err(
-                format!(
-                    "lies outside {}, the only folder meshes may be read from here; move the file into that folder",
-                    canonical_root.display()
-                ),
-                None,
-            ));
-        }
-        let bytes = read_bounded(&canonical).map_err(|(reason, source)| err(reason, source))?;
-        let folder = parent_folder(&canonical);
-        parse(&bytes, path, Some((&folder, &canonical_root)))
+        let (bytes, folder, root) = read_within(path, root)?;
+        parse(&bytes, path, Some((&folder, &root)))
     }
 
     /// Load a glTF or GLB file given as bytes. `name` names it in messages. `files` is `None` to read
@@ -106,21 +80,45 @@ impl Mesh {
         name: &Path,
         files: Option<(&Path, &Path)>,
     ) -> Result<Mesh> {
-        match files {
-            None => parse(bytes, name, None),
-            Some((folder, root)) => {
-                let root = canonical_folder(root).map_err(|e| SnowError::MeshFile {
-                    path: name.to_owned(),
-                    reason: format!(
-                        "its allowed folder {} cannot be opened ({e}); check that the folder exists",
-                        root.display()
-                    ),
-                    source: Some(e),
-                })?;
-                parse(bytes, name, Some((folder, &root)))
-            }
-        }
+        let files = canonical_files(name, files)?;
+        parse(
+            bytes,
+            name,
+            files.as_ref().map(|(f, r)| (f.as_path(), r.as_path())),
+        )
     }
+}
+
+/// A glTF or GLB file that must lie under `root`: its bytes, its (canonical) folder and the
+/// canonical root, for the readers of meshes and of skinned meshes.
+pub(crate) fn read_within(path: &Path, root: &Path) -> Result<(Vec<u8>, PathBuf, PathBuf)> {
+    let err = |reason: String, source: Option<std::io::Error>| SnowError::MeshFile {
+        path: path.to_owned(),
+        reason,
+        source,
+    };
+    let canonical_root = canonical_folder(root).map_err(|e| {
+        let reason = format!(
+            "its allowed folder {} cannot be opened ({e}); check that the folder exists",
+            root.display()
+        );
+        err(reason, Some(e))
+    })?;
+    let canonical = path.canonicalize().map_err(|e| {
+        let reason = format!("cannot be opened ({e}); check the path and that the file exists");
+        err(reason, Some(e))
+    })?;
+    if !canonical.starts_with(&canonical_root) {
+        return Err(err(
+            format!(
+                "lies outside {}, the only folder meshes may be read from here; move the file into that folder",
+                canonical_root.display()
+            ),
+            None,
+        ));
+    }
+    let bytes = read_bounded(&canonical).map_err(|(reason, source)| err(reason, source))?;
+    Ok((bytes, parent_folder(&canonical), canonical_root))
 }
 
 /// The folder of a file, `.` for a bare file name.
@@ -180,12 +178,41 @@ pub(super) fn read_bounded(path: &Path) -> std::result::Result<Vec<u8>, ReadFail
     Ok(bytes)
 }
 
-fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mesh> {
-    let err = |reason: String| SnowError::MeshFile {
+/// The canonical form of `files`' root (see [`Mesh::from_gltf_slice`]).
+pub(crate) fn canonical_files(
+    name: &Path,
+    files: Option<(&Path, &Path)>,
+) -> Result<Option<(PathBuf, PathBuf)>> {
+    let Some((folder, root)) = files else {
+        return Ok(None);
+    };
+    let root = canonical_folder(root).map_err(|e| SnowError::MeshFile {
+        path: name.to_owned(),
+        reason: format!(
+            "its allowed folder {} cannot be opened ({e}); check that the folder exists",
+            root.display()
+        ),
+        source: Some(e),
+    })?;
+    Ok(Some((folder.to_owned(), root)))
+}
+
+/// A [`SnowError::MeshFile`] without an I/O source.
+pub(crate) fn file_error(path: &Path, reason: String) -> SnowError {
+    SnowError::MeshFile {
         path: path.to_owned(),
         reason,
         source: None,
-    };
+    }
+}
+
+/// Parse a glTF or GLB file, validate it and read its buffers (bounded, URIs kept under the root).
+pub(crate) fn open(
+    bytes: &[u8],
+    path: &Path,
+    files: Option<(&Path, &Path)>,
+) -> Result<(gltf::Document, Vec<Vec<u8>>)> {
+    let err = |reason: String| file_error(path, reason);
     let not_gltf = |e: &dyn std::fmt::Display| {
         let e = e.to_string();
         let e = e.split_whitespace().collect::<Vec<_>>().join(" ");
@@ -244,6 +271,13 @@ fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mes
         buffers.push(data);
     }
 
+    Ok((gltf.document, buffers))
+}
+
+fn parse(bytes: &[u8], path: &Path, files: Option<(&Path, &Path)>) -> Result<Mesh> {
+    let err = |reason: String| file_error(path, reason);
+    let (doc, buffers) = open(bytes, path, files)?;
+    let doc = &doc;
     let scene = doc
         .default_scene()
         .or_else(|| doc.scenes().next())
@@ -350,7 +384,7 @@ fn validate(root: &gltf::json::Root) -> std::result::Result<(), String> {
 
 /// Nodes form trees: no node is its own child or ancestor, none has two parents, none lies deeper
 /// than [`MAX_GLTF_DEPTH`], and there are at most [`MAX_GLTF_NODES`].
-fn check_node_trees(doc: &gltf::Document) -> std::result::Result<(), String> {
+pub(crate) fn check_node_trees(doc: &gltf::Document) -> std::result::Result<(), String> {
     let n = doc.nodes().len();
     if n > MAX_GLTF_NODES {
         return Err(format!(

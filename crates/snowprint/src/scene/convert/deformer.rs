@@ -11,9 +11,10 @@ use crate::deformer::{Deformer, MAX_DEFORMER_SIZE, Shape};
 use crate::error::Result;
 use crate::scene::diagnose::Source;
 use crate::scene::raw::{Num, RawDeformer, RawKey, Str};
-use crate::scene::{Key, SceneDeformer, SceneShape};
+use crate::scene::{Key, SceneAnimation, SceneDeformer, SceneShape};
+use crate::skin::Playback;
 
-use super::mesh::mesh;
+use super::mesh::{mesh, skinned_mesh};
 use super::{finite, number, required, unique, vector};
 
 /// The shapes, as written in `shape = "..."`.
@@ -74,6 +75,7 @@ pub(super) fn deformer(
     let kind = shape_kind(src, shape, &who)?;
     refuse_foreign(src, &d, kind, &who)?;
     let shape = scene_shape(src, &table, &d, kind, &who, dir)?;
+    let animation = animation(src, &d, &who, dir)?;
     let keys = keys(src, &table, d.keys, &who)?;
     check_analytic(src, &table, &shape, &keys, name.get_ref())?;
 
@@ -82,6 +84,7 @@ pub(super) fn deformer(
         shape,
         keys,
         player: d.player.is_some_and(|p| *p.get_ref()),
+        animation,
         line,
     })
 }
@@ -128,6 +131,24 @@ fn refuse_foreign(src: &Source<'_>, d: &RawDeformer, kind: Kind, who: &str) -> R
         (
             d.path.as_ref().map(Spanned::span),
             "path",
+            "meshes",
+            &[Kind::Mesh][..],
+        ),
+        (
+            d.animation.as_ref().map(Spanned::span),
+            "animation",
+            "meshes",
+            &[Kind::Mesh][..],
+        ),
+        (
+            d.animation_speed.as_ref().map(Spanned::span),
+            "animation_speed",
+            "meshes",
+            &[Kind::Mesh][..],
+        ),
+        (
+            d.looping.as_ref().map(Spanned::span),
+            "loop",
             "meshes",
             &[Kind::Mesh][..],
         ),
@@ -239,6 +260,74 @@ fn scene_shape(
         }
     };
     Ok(shape)
+}
+
+/// A mesh's `animation`, `animation_speed` and `loop`: the file read again as a skinned mesh,
+/// the animation found by name.
+fn animation(
+    src: &Source<'_>,
+    d: &RawDeformer,
+    who: &str,
+    dir: &Path,
+) -> Result<Option<SceneAnimation>> {
+    let Some(name) = &d.animation else {
+        let lone = [
+            (
+                "animation_speed",
+                d.animation_speed.as_ref().map(Spanned::span),
+            ),
+            ("loop", d.looping.as_ref().map(Spanned::span)),
+        ];
+        if let Some((key, Some(span))) = lone.into_iter().find(|(_, s)| s.is_some()) {
+            return Err(src.error(
+                &span,
+                format!("{who} has {key} {} but no animation", src.quote(&span)),
+                format!(
+                    "add animation = \"NAME\" (an animation of the mesh file), or remove {key}"
+                ),
+            ));
+        }
+        return Ok(None);
+    };
+    // `path` is there: the shape was read first.
+    let Some(path) = &d.path else {
+        return Ok(None);
+    };
+    let skinned = skinned_mesh(src, path, who, dir)?;
+    let Some(index) = skinned.animation_index(name.get_ref()) else {
+        return Err(src.error(
+            &name.span(),
+            format!(
+                "{who} has animation {}, but {} has no animation of that name (it has: {})",
+                src.quote(&name.span()),
+                path.get_ref(),
+                skinned.animation_names()
+            ),
+            "name one of the file's animations (an unnamed one by its index, as \"0\")",
+        ));
+    };
+    let speed = match &d.animation_speed {
+        Some(v) => number(
+            src,
+            v,
+            who,
+            "animation_speed",
+            |x| x > 0.0 && x <= 1000.0,
+            "animation_speed must be a finite number of animation seconds per second, above 0 and at most 1000",
+        )?,
+        None => 1.0,
+    };
+    let playback = match d.looping.as_ref().map(|l| *l.get_ref()) {
+        Some(false) => Playback::Clamp,
+        _ => Playback::Loop,
+    };
+    Ok(Some(SceneAnimation {
+        skinned,
+        index,
+        name: name.get_ref().clone(),
+        speed,
+        playback,
+    }))
 }
 
 /// Backstop: the library's own checks of analytic deformers, at every key.

@@ -1,15 +1,40 @@
 //! A mesh deformer's file: resolved within the scene's folder and loaded.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Result, SnowError};
 use crate::mesh::Mesh;
 use crate::scene::SceneShape;
 use crate::scene::diagnose::Source;
 use crate::scene::raw::Str;
+use crate::skin::SkinnedMesh;
 
 /// Resolve and load a mesh deformer's file.
 pub(super) fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<SceneShape> {
+    let (resolved, root) = resolve(src, path, who, dir)?;
+    let mesh = Mesh::load_gltf_within(&resolved, &root)
+        .map_err(|e| load_error(src, path, who, &resolved, e))?;
+    Ok(SceneShape::Mesh {
+        path: resolved,
+        mesh,
+    })
+}
+
+/// Resolve and load an animated mesh deformer's file as a skinned mesh.
+pub(super) fn skinned_mesh(
+    src: &Source<'_>,
+    path: &Str,
+    who: &str,
+    dir: &Path,
+) -> Result<SkinnedMesh> {
+    let (resolved, root) = resolve(src, path, who, dir)?;
+    SkinnedMesh::load_gltf_within(&resolved, &root)
+        .map_err(|e| load_error(src, path, who, &resolved, e))
+}
+
+/// A mesh path resolved against the scene's folder and checked to stay under it: the file and the
+/// folder it may read from.
+fn resolve(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<(PathBuf, PathBuf)> {
     let span = path.span();
     let written = path.get_ref();
     if written.trim().is_empty() {
@@ -87,51 +112,51 @@ pub(super) fn mesh(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Resul
     if !inside {
         return Err(outside());
     }
-    let mesh = Mesh::load_gltf_within(&resolved, root).map_err(|e| {
-        if let SnowError::MeshUri {
-            what,
-            uri,
-            problem,
-            fix,
-            ..
-        } = &e
-        {
-            return src.error(
-                &span,
-                format!(
-                    "{who} has path {}, but in {} {what} has uri {uri:?}, which {problem}",
-                    src.quote(&span),
-                    resolved.display()
-                ),
-                fix.replace("the mesh's folder", "the scene's folder"),
-            );
-        }
-        let reason = match e {
-            SnowError::MeshFile { reason, .. } | SnowError::InvalidMesh { reason, .. } => reason,
-            other => other.to_string(),
-        };
-        let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
-        // The loader's reasons end with what to do after "; ": make that the hint.
-        let (reason, fix) = match reason.split_once("; ") {
-            Some((reason, fix)) => (reason.to_owned(), fix.to_owned()),
-            None => (
-                reason,
-                "give it a valid glTF (.gltf) or GLB (.glb) file holding a closed triangle mesh"
-                    .to_owned(),
-            ),
-        };
-        src.error(
+    Ok((resolved, root.to_path_buf()))
+}
+
+/// The loader's error as the scene's sentence, at the path's line.
+fn load_error(src: &Source<'_>, path: &Str, who: &str, resolved: &Path, e: SnowError) -> SnowError {
+    let span = path.span();
+    if let SnowError::MeshUri {
+        what,
+        uri,
+        problem,
+        fix,
+        ..
+    } = &e
+    {
+        return src.error(
             &span,
             format!(
-                "{who} has path {}, but {} cannot be used as a mesh ({reason})",
+                "{who} has path {}, but in {} {what} has uri {uri:?}, which {problem}",
                 src.quote(&span),
                 resolved.display()
             ),
-            fix,
-        )
-    })?;
-    Ok(SceneShape::Mesh {
-        path: resolved,
-        mesh,
-    })
+            fix.replace("the mesh's folder", "the scene's folder"),
+        );
+    }
+    let reason = match e {
+        SnowError::MeshFile { reason, .. } | SnowError::InvalidMesh { reason, .. } => reason,
+        other => other.to_string(),
+    };
+    let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
+    // The loader's reasons end with what to do after "; ": make that the hint.
+    let (reason, fix) = match reason.split_once("; ") {
+        Some((reason, fix)) => (reason.to_owned(), fix.to_owned()),
+        None => (
+            reason,
+            "give it a valid glTF (.gltf) or GLB (.glb) file holding a closed triangle mesh"
+                .to_owned(),
+        ),
+    };
+    src.error(
+        &span,
+        format!(
+            "{who} has path {}, but {} cannot be used as a mesh ({reason})",
+            src.quote(&span),
+            resolved.display()
+        ),
+        fix,
+    )
 }
