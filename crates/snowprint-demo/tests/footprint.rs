@@ -139,15 +139,18 @@ fn ends(p: &[(f32, f32)], level: f32) -> (f32, f32) {
     (back, front)
 }
 
-/// The walker's steps (its gait, `GaitStyle::trudge`) onto 35 cm of snow whose ground is 10 cm
-/// under the soles, so that no part of the print is cut flat by the ground. By hand, from
-/// `skeleton::foot_mesh` (ankle frame, sole 8 cm under the ankle):
+/// The walker's steps (its gait, `GaitStyle::trudge`, whose flat sole stops 7 cm above the gait's
+/// ground) onto 35 cm of snow whose ground is 10 cm under the gait's, so that no part of the print
+/// is cut flat by the ground. By hand, from `skeleton::foot_mesh` (ankle frame, sole 8 cm under
+/// the ankle):
 ///
-/// * the heel block (-11 to 0 cm) is flat from about -9 to -2 cm: the flat sole leaves 35 - 10 =
-///   25 cm of the 35 pressed (0.714), the heel strike 2 cm more (0.771), centred at -5.5 cm;
-/// * the ball and toes (+7 to +21 cm) are flat from about +9 to +19 cm, pressed as deep;
+/// * the heel block (-11 to 0 cm) is flat from about -9 to -2 cm: the flat sole, 17 cm above the
+///   ground, leaves 35 - 17 = 18 cm of the 35 pressed (0.514), the heel strike 2 cm more (0.571),
+///   centred at -5.5 cm;
+/// * the ball and toes (+7 to +21 cm) are flat from about +9 to +19 cm, pressed as deep (2 cm
+///   deeper at the push-off);
 /// * between the heel's front (0) and the ball's back (+7 cm) only the upper reaches down, to
-///   9 cm above the sole: 25 - 9 = 16 cm of 35 (0.457).
+///   9 cm above the sole: 18 - 9 = 9 cm of 35 (0.257).
 ///
 /// The capture's blur spreads each over about a texel (4 cm), which lowers the narrow heel and
 /// lifts the arch a little; positions are checked to within a texel.
@@ -169,8 +172,12 @@ fn a_walking_print_has_a_heel_and_a_ball_with_the_arch_between() {
             .iter()
             .filter(|(x, _)| *x > heel.0 && *x < ball.0)
             .fold((f32::NAN, 2.0), |a, &b| if b.1 < a.1 { b } else { a });
-        // Two maxima with a shallower minimum between them, each at least 3.5 cm of snow apart.
-        assert!(heel.1 - arch.1 > 0.1 && ball.1 - arch.1 > 0.1, "{}", show());
+        // Two maxima with a shallower minimum between them, each at least 5 cm of snow apart.
+        assert!(
+            heel.1 - arch.1 > 0.15 && ball.1 - arch.1 > 0.15,
+            "{}",
+            show()
+        );
         // Where the geometry puts them.
         assert!(
             (heel.0 - -0.055).abs() <= 0.04,
@@ -192,19 +199,19 @@ fn a_walking_print_has_a_heel_and_a_ball_with_the_arch_between() {
         );
         // As deep as the geometry presses, less what the blur takes off a narrow heel.
         assert!(
-            (0.6..=0.78).contains(&heel.1),
+            (0.45..=0.58).contains(&heel.1),
             "heel {}: {}",
             heel.1,
             show()
         );
         assert!(
-            (0.66..=0.78).contains(&ball.1),
+            (0.47..=0.58).contains(&ball.1),
             "ball {}: {}",
             ball.1,
             show()
         );
         assert!(
-            (0.43..=0.56).contains(&arch.1),
+            (0.23..=0.34).contains(&arch.1),
             "arch {}: {}",
             arch.1,
             show()
@@ -226,8 +233,8 @@ fn a_walking_print_has_a_heel_and_a_ball_with_the_arch_between() {
 }
 
 /// The runner's steps (`GaitStyle::run`) on the same snow: the foot skids 12 cm from its heel
-/// strike and digs the ball 6 cm deeper at the push-off, its flat sole 6 cm higher than the
-/// walker's. By hand: flat 35 - 16 = 19 cm of 35 pressed (0.543) at the heel, the ball at 25 cm
+/// strike and digs the ball 6 cm deeper at the push-off, its flat sole 6 cm above the gait's
+/// ground. By hand: flat 35 - 16 = 19 cm of 35 pressed (0.543) at the heel, the ball at 25 cm
 /// (0.714); the print longer at the back.
 #[test]
 fn a_running_print_is_longer_and_deeper_at_the_toe() {

@@ -1,6 +1,6 @@
 //! The rendered demo's people trudge (`trudge::Crowd`, driven by `scene::rooftops`): with the demo
 //! world's own roofs and walker on the GPU, a walker in the walk roof's 0.25 m of snow falls behind
-//! the same walk over 5 cm of snow and over bare ground, and sinks; its prints in the snow are
+//! the same walk over 10 cm of snow and over bare ground, and sinks; its prints in the snow are
 //! those of its own clock; two runs give the same clocks and the same snow bit for bit.
 
 mod common;
@@ -8,7 +8,7 @@ mod common;
 use glam::Vec3;
 use snowprint::{Heightmap, MeshId, SnowWorld, SurfaceDesc, SurfaceId, WorldConfig};
 use snowprint_demo::anim::Action;
-use snowprint_demo::trudge::{Crowd, Trudge, pace, sunk_pose};
+use snowprint_demo::trudge::{Crowd, Trudge, pace, sink, sunk_pose};
 use snowprint_demo::world::surface;
 use snowprint_demo::{DemoSurface, DemoWorld, PART_COUNT, Part, Person};
 
@@ -35,14 +35,14 @@ fn moved(p: &Person, name: &'static str, surface: usize, offset: Vec3) -> Person
 }
 
 /// The demo world with its walker alone, and two copies of the walk: over a copy of the walk roof
-/// with 5 cm of snow, and over nothing.
+/// with 10 cm of snow, and over nothing.
 fn three_walks() -> DemoWorld {
     let mut demo = DemoWorld::build();
     let walker = demo.person("walker").expect("walker").clone();
     let mut shallow = demo.surfaces[surface::WALK_ROOF].clone();
     shallow.desc.name = "shallow".into();
     shallow.desc.center += SHALLOW;
-    shallow.desc.snow_depth = 0.05;
+    shallow.desc.snow_depth = 0.1;
     demo.surfaces.push(DemoSurface { ..shallow });
     let shallow_index = demo.surfaces.len() - 1;
     demo.people = vec![
@@ -141,16 +141,16 @@ fn a_walker_in_deep_snow_falls_behind_and_sinks() {
     }
     // The snow is never deeper than the surface's, so the pace never drops below its pace; the
     // walk in 0.25 m loses more than a second in 4.5 s (an average depth above 0.1 m), the one in
-    // 5 cm some (at most what its pace bound allows).
+    // 10 cm some (at most what its pace bound allows).
     assert!(deep.clock >= elapsed * pace(0.25), "{}", deep.clock);
     assert!(deep.clock < elapsed - 1.0, "{}", deep.clock);
-    assert!(shallow.clock >= elapsed * pace(0.05), "{}", shallow.clock);
+    assert!(shallow.clock >= elapsed * pace(0.1), "{}", shallow.clock);
     assert!(shallow.clock < elapsed - 0.2, "{}", shallow.clock);
     assert!(deep.clock < shallow.clock - 0.5);
     // Sunk: the pelvis lower than the scripted walk's at the same clock, by the sink, and more in
     // deep snow than in shallow.
-    assert!(deep.sink > 0.05 && deep.sink <= 0.125, "{}", deep.sink);
-    assert!(shallow.sink < 0.025 && shallow.sink < deep.sink);
+    assert!(deep.sink > 0.05 && deep.sink <= sink(0.25), "{}", deep.sink);
+    assert!(shallow.sink <= sink(0.1) && shallow.sink < deep.sink);
     let pelvis = parts[Part::Pelvis.index()].pose.position;
     let upright = demo.people[0].pose_at(deep.clock).root;
     assert!((upright.y - pelvis.y - deep.sink).abs() < 1e-5);
@@ -159,8 +159,9 @@ fn a_walker_in_deep_snow_falls_behind_and_sinks() {
         sunk_pose(&demo.people[0], deep.clock, deep.sink).root
     );
     // The snow shows the trudging walk: every print struck by the walker's own clock (a frame
-    // for its weight to arrive) is in the snow, and none of those the script would have struck
-    // by now.
+    // for its weight to arrive) is in the snow (the flat boot stops 7 cm above the roof: 0.72 of
+    // the 0.25 m, less the blur's share at the edges), and none of those the script would have
+    // struck by now.
     let walker = &demo.people[0];
     let footfalls = walker.footfalls();
     let made: Vec<_> = footfalls
@@ -179,7 +180,7 @@ fn a_walker_in_deep_snow_falls_behind_and_sinks() {
     );
     for f in made {
         let d = pressed_near(&run, f.print_center(), 0.06);
-        assert!(d > 0.8, "print at {} only {d} deep", f.strike);
+        assert!(d > 0.45, "print at {} only {d} deep", f.strike);
     }
     for f in not_yet {
         let d = pressed_near(&run, f.print_center(), 0.06);

@@ -135,7 +135,8 @@ pub struct GaitStyle {
 
 impl GaitStyle {
     /// Trudging through deep snow: short steps, knees high so that each foot leaves the
-    /// ankle-high zone between prints.
+    /// ankle-high zone between prints. The weight stops on 7 cm of compacted snow, so that the
+    /// boot's heel, arch and ball show in the print rather than one hole to the ground.
     pub fn trudge() -> Self {
         Self {
             hip_height: 0.88,
@@ -148,7 +149,7 @@ impl GaitStyle {
             heel_dig: 0.02,
             toe_dig: 0.02,
             slip: 0.0,
-            sole: 0.0,
+            sole: 0.07,
             arm_swing: 0.9,
             elbow: 0.35,
             guard: false,
