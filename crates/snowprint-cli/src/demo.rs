@@ -146,11 +146,11 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let mut world = SnowWorld::new(&ctx, WorldConfig::default()).map_err(|e| e.to_string())?;
     let mut renderer =
         Renderer::new(&ctx, settings.render_config(args)).map_err(|e| e.to_string())?;
-    let scene = build_scene(&args.scene, &mut world, &mut renderer)?;
+    let mut scene = build_scene(&args.scene, &mut world, &mut renderer)?;
     let clip = Clip::new(scene.as_ref(), args, settings.frames)?;
     let mut demo = Demo {
         args,
-        scene: scene.as_ref(),
+        scene: scene.as_mut(),
         world: &mut world,
         renderer: &mut renderer,
         staging: &mut staging,
@@ -314,7 +314,7 @@ struct Measured {
 /// A run of the rendered demo: the scene, the world it presses, the renderer and the output set.
 struct Demo<'a> {
     args: &'a Args,
-    scene: &'a dyn DemoScene,
+    scene: &'a mut dyn DemoScene,
     world: &'a mut SnowWorld,
     renderer: &'a mut Renderer,
     staging: &'a mut OutputSet,
@@ -372,12 +372,15 @@ impl Demo<'_> {
                 .ok_or_else(|| format!("camera {:?} has no view at {t} s", args.camera))?;
             let instances = self.scene.instances(t);
             m.instances_count = instances.len();
+            // Copies, so that the frame borrows nothing of `self` (the scene is advanced through
+            // it, and `compare_tiers` renders through it).
+            let (surfaces, lights) = (self.scene.surfaces().to_vec(), self.scene.lights().to_vec());
             let frame = RenderFrame {
                 camera,
                 time: t,
-                surfaces: self.scene.surfaces(),
+                surfaces: &surfaces,
                 instances: &instances,
-                lights: self.scene.lights(),
+                lights: &lights,
                 environment: self.scene.environment(),
                 snowfall: !args.no_snowfall,
             };

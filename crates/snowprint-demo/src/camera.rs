@@ -60,7 +60,21 @@ fn flythrough(t: f32) -> Camera {
 /// A camera by name at time `t`.
 pub fn camera(world: &DemoWorld, name: &str, t: f32) -> Option<Camera> {
     let t = t.clamp(0.0, world.duration);
-    let root = |who: &str| -> Option<Vec3> { Some(world.person(who)?.pose_at(t).root) };
+    camera_following(world, name, t, &|who: &str| {
+        Some(world.person(who)?.pose_at(t).root)
+    })
+}
+
+/// A camera by name at time `t`, the cameras that follow someone (`closeup` the walker, `run` the
+/// runner) following the pelvis that `root(name)` gives: the scripted one for [`camera`], a
+/// trudging person's own ([`crate::trudge::Crowd`]) for the rendered demo.
+pub fn camera_following(
+    world: &DemoWorld,
+    name: &str,
+    t: f32,
+    root: &dyn Fn(&str) -> Option<Vec3>,
+) -> Option<Camera> {
+    let t = t.clamp(0.0, world.duration);
     let ground = |who: &str| -> Option<f32> {
         let p = world.person(who)?;
         Some(world.surfaces.get(p.surface)?.desc.center.y)

@@ -169,7 +169,8 @@ impl DemoWorld {
     /// The deformers of [`DemoWorld::deformers_at`] sorted by surface, ready for
     /// [`snowprint::SnowWorld::update`]: for each surface (index into [`DemoWorld::surfaces`]), the
     /// parts whose bounding ball reaches into its capture volume (the snow plus `ankle_height`)
-    /// and that moved during the frame. A part at rest presses nothing it has not already pressed,
+    /// and that moved during the frame (in the first frame, from `t - dt <= 0`, every one of them).
+    /// A part at rest presses nothing it has not already pressed,
     /// so a lying body stops costing updates; surfaces that replenish keep their resting parts and
     /// are listed even when nobody is on them. Surfaces left out need no update this frame.
     pub fn surface_deformers(
@@ -179,8 +180,29 @@ impl DemoWorld {
         part_mesh_ids: &[MeshId],
         ankle_height: f32,
     ) -> Vec<(usize, Vec<Deformer>)> {
-        let before = self.parts_at(t - dt);
-        let now = self.parts_at(t);
+        // The first frame presses everything: a foot standing still from the start has pressed
+        // nothing yet.
+        self.deformers_by_surface(
+            &self.parts_at(t - dt),
+            &self.parts_at(t),
+            part_mesh_ids,
+            ankle_height,
+            t - dt <= 0.0,
+        )
+    }
+
+    /// [`DemoWorld::surface_deformers`] for any two sets of part poses (in
+    /// [`DemoWorld::parts_at`] order), the parts moving from `before` to `now`: what a caller that
+    /// poses the people itself (a [`trudge::Crowd`]) presses the snow with. `first`: the first
+    /// frame, where parts at rest press too (nothing has pressed the snow before it).
+    pub fn deformers_by_surface(
+        &self,
+        before: &[PartPose],
+        now: &[PartPose],
+        part_mesh_ids: &[MeshId],
+        ankle_height: f32,
+        first: bool,
+    ) -> Vec<(usize, Vec<Deformer>)> {
         let radius: Vec<f32> = self.part_meshes.iter().map(Mesh::bounding_radius).collect();
         let mut out = Vec::new();
         for (index, surface) in self.surfaces.iter().enumerate() {
@@ -191,7 +213,7 @@ impl DemoWorld {
             let top = desc.snow_depth + ankle_height;
             let deformers: Vec<Deformer> = before
                 .iter()
-                .zip(&now)
+                .zip(now)
                 .filter_map(|(a, b)| {
                     let id = *part_mesh_ids.get(b.part)?;
                     let r = radius.get(b.part).copied().unwrap_or(0.0);
@@ -201,7 +223,7 @@ impl DemoWorld {
                         && c.y >= -r
                         && c.y <= top + r;
                     let moved = a.pose != b.pose;
-                    (over && (moved || replenishes))
+                    (over && (moved || replenishes || first))
                         .then(|| Deformer::moving(Shape::Mesh(id), a.pose, b.pose))
                 })
                 .collect();
@@ -334,6 +356,11 @@ mod tests {
             let desc = &d.surfaces[p.surface].desc;
             let snow_top = desc.center.y + desc.snow_depth;
             let footfalls = p.footfalls();
+            // A foot that skids on landing touches down `slip` behind its print's centre.
+            let slip = match &p.motion.segments[0].action {
+                Action::Gait(g) => g.style.slip,
+                _ => 0.0,
+            };
             for t in frames(&d) {
                 for part in d.parts_at(t).iter().filter(|q| q.person == index) {
                     let low = lowest_point(&d, part.part, &part.pose);
@@ -347,7 +374,7 @@ mod tests {
                     };
                     let planted = footfalls.iter().any(|f| {
                         let c = f.print_center();
-                        f.side == side && Vec2::new(c.x - low.x, c.z - low.z).length() < 0.2
+                        f.side == side && Vec2::new(c.x - low.x, c.z - low.z).length() < 0.2 + slip
                     });
                     assert!(
                         planted,

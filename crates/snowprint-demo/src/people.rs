@@ -447,6 +447,10 @@ fn fighters() -> [Person; 2] {
     ]
 }
 
+/// People whose actions are timed against each other (the brawler's shove meets the thug at
+/// `SHOVE`): a trudging crowd ([`crate::trudge::Crowd`]) gives each pair one clock.
+pub const PARTNERS: &[(&str, &str)] = &[("brawler", "thug")];
+
 /// Everyone, in a fixed order.
 pub fn cast() -> Vec<Person> {
     let mut out = vec![walker(), runner(), faller(), angel(), slider()];

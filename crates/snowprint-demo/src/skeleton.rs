@@ -272,10 +272,10 @@ pub mod dims {
     pub const HEEL_BACK: f32 = 0.06;
     /// Ball contact point ahead of the ankle (the pivot of the toe roll).
     pub const BALL_FORWARD: f32 = 0.15;
-    /// Foot length, heel to toe tip.
-    pub const FOOT_LENGTH: f32 = 0.30;
+    /// Foot length, heel to toe tip (the boot of `foot_mesh`).
+    pub const FOOT_LENGTH: f32 = 0.335;
     /// Widest part of the foot (the ball).
-    pub const FOOT_WIDTH: f32 = 0.12;
+    pub const FOOT_WIDTH: f32 = 0.096;
     /// Half the depth of the torso (chest to back) at the lower back, where a body lying on its
     /// back rests.
     pub const BACK_DEPTH: f32 = 0.11;
@@ -422,45 +422,74 @@ fn limb(y0: f32, y1: f32, radius: f32, squash: Vec3) -> Mesh {
     ))
 }
 
-/// The boot, in the ankle's frame: a heel block under the ankle, a narrow arch raised well above
-/// the sole, and a broad ball and toe. Pressed flat into snow it leaves a heel and a ball with
-/// shallow snow between them.
+/// A flattened ellipsoid with semi-axes `r` centred at `c`: elliptic seen from above, flat at the
+/// top and the bottom with rounded edges (the superellipsoid of revolution `(x^2 + z^2)^(p/2) +
+/// |y|^p = 1`, scaled; `p = 2` is the ellipsoid). Each vertex of a unit sphere keeps its direction
+/// about `Y` while its distance from the axis and its height are raised to `2/p`, both increasing,
+/// so that the mesh stays closed and wound outward.
+fn flat_ellipsoid(c: Vec3, r: Vec3, p: f32, rings: u32, segments: u32) -> Mesh {
+    let mut m = Mesh::uv_sphere(1.0, rings, segments);
+    let e = 2.0 / p;
+    for v in &mut m.positions {
+        let rho = v.x.hypot(v.z);
+        let spread = if rho > 0.0 { rho.powf(e) / rho } else { 0.0 };
+        let bent = Vec3::new(v.x * spread, v.y.signum() * v.y.abs().powf(e), v.z * spread);
+        *v = c + bent * r;
+    }
+    m
+}
+
+/// The boot, in the ankle's frame (`+X` forward, the sole 8 cm under the ankle):
+///
+/// | piece | shape | along the foot (from the ankle) | bottom above the sole |
+/// |---|---|---|---|
+/// | heel block | flattened ellipsoid, 11 x 9 cm | -11 to 0 cm, flat from about -9 to -2 | 0 |
+/// | ankle | ellipsoid | -8 to +1 cm | 4 cm |
+/// | upper, over the arch | ellipsoid | -5 to +17 cm | 9 cm |
+/// | ball and toes | flattened ellipsoid, 14 x 9.6 cm | +7 to +21 cm, flat from about +9 to +19 | 0 |
+/// | toe cap | ellipsoid | +15.5 to +22.5 cm | 0.5 cm |
+///
+/// Pressed flat into snow it leaves a flat-bottomed heel and a flat-bottomed ball and toe, 7 cm
+/// apart, with the arch's snow, 9 cm shallower, between them. At the talk's 4 cm texels a heel
+/// much smaller than this one is lost in the capture's blur.
 pub fn foot_mesh() -> Mesh {
     let sole = -ANKLE_HEIGHT;
     let mut m = Mesh::default();
-    // Heel block: from 9 cm behind the ankle to under it, its bottom on the sole.
+    // Heel block: flat-bottomed, so that the heel's print is one depth with steep sides.
+    m.append(&flat_ellipsoid(
+        Vec3::new(-0.055, sole + 0.045, 0.0),
+        Vec3::new(0.055, 0.045, 0.045),
+        6.0,
+        12,
+        16,
+    ));
+    // Ankle: over the heel, up into the shin; its bottom 4 cm above the sole, so that it stays
+    // out of the arch's snow.
     m.append(&ellipsoid(
-        Vec3::new(-0.045, sole + 0.05, 0.0),
-        Vec3::new(0.045, 0.05, 0.048),
+        Vec3::new(-0.035, 0.02, 0.0),
+        Vec3::new(0.045, 0.06, 0.042),
         8,
         12,
     ));
-    // Ankle: over the heel, up into the shin.
+    // Upper: from the heel over the arch to the ball; its bottom 9 cm above the sole.
     m.append(&ellipsoid(
-        Vec3::new(-0.03, 0.0, 0.0),
-        Vec3::new(0.045, 0.06, 0.04),
-        8,
-        12,
-    ));
-    // Upper: from the heel over the arch to the ball; its bottom stays 6.5 cm above the sole
-    // under the arch, so that the arch leaves shallower snow between heel and ball.
-    m.append(&ellipsoid(
-        Vec3::new(0.06, sole + 0.1, 0.0),
+        Vec3::new(0.06, sole + 0.125, 0.0),
         Vec3::new(0.11, 0.035, 0.045),
         8,
         12,
     ));
-    // Ball of the foot: the widest part.
-    m.append(&ellipsoid(
-        Vec3::new(0.13, sole + 0.04, 0.0),
-        Vec3::new(0.06, 0.04, FOOT_WIDTH * 0.5),
-        8,
+    // Ball and toes: the widest part, flat-bottomed.
+    m.append(&flat_ellipsoid(
+        Vec3::new(0.14, sole + 0.035, 0.0),
+        Vec3::new(0.07, 0.035, FOOT_WIDTH * 0.5),
+        3.0,
         12,
+        16,
     ));
-    // Toes.
+    // Toe cap: rounds the front of the print.
     m.append(&ellipsoid(
-        Vec3::new(0.18, sole + 0.025, 0.0),
-        Vec3::new(0.04, 0.025, 0.05),
+        Vec3::new(0.19, sole + 0.035, 0.0),
+        Vec3::new(0.035, 0.03, 0.05),
         6,
         10,
     ));

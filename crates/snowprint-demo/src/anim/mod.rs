@@ -115,9 +115,13 @@ pub struct GaitStyle {
     pub heel_strike: f32,
     /// Pitch of the foot (heel up) when the toe leaves, radians.
     pub toe_off: f32,
-    /// How much deeper than the flat foot the heel presses at the strike and the ball at the
-    /// push-off, metres.
-    pub dig: f32,
+    /// How much deeper than the flat foot the heel presses at the strike, metres.
+    pub heel_dig: f32,
+    /// How much deeper than the flat foot the ball and toes press at the push-off, metres.
+    pub toe_dig: f32,
+    /// How far the foot skids forward from the heel strike until it is flat, metres: it touches
+    /// down this far behind where it comes to rest, so that a fast foot's print is longer.
+    pub slip: f32,
     /// Height of the flat sole above the ground under the snow, metres (how far the flat foot
     /// sinks).
     pub sole: f32,
@@ -131,7 +135,8 @@ pub struct GaitStyle {
 
 impl GaitStyle {
     /// Trudging through deep snow: short steps, knees high so that each foot leaves the
-    /// ankle-high zone between prints.
+    /// ankle-high zone between prints. The weight stops on 7 cm of compacted snow, so that the
+    /// boot's heel, arch and ball show in the print rather than one hole to the ground.
     pub fn trudge() -> Self {
         Self {
             hip_height: 0.88,
@@ -141,8 +146,10 @@ impl GaitStyle {
             lead: 0.62,
             heel_strike: 0.35,
             toe_off: 0.55,
-            dig: 0.02,
-            sole: 0.0,
+            heel_dig: 0.02,
+            toe_dig: 0.02,
+            slip: 0.0,
+            sole: 0.07,
             arm_swing: 0.9,
             elbow: 0.35,
             guard: false,
@@ -157,10 +164,14 @@ impl GaitStyle {
             lean: 0.22,
             swing_height: 0.5,
             lead: 0.88,
+            // A runner lands lightly on the heel, skids 12 cm, and pushes off hard from the ball:
+            // the flat foot stops 6 cm above the ground, the ball digs down to it.
             heel_strike: 0.2,
             toe_off: 0.7,
-            dig: 0.02,
-            sole: 0.0,
+            heel_dig: 0.0,
+            toe_dig: 0.06,
+            slip: 0.12,
+            sole: 0.06,
             arm_swing: 1.1,
             elbow: 1.5,
             guard: false,
@@ -177,7 +188,9 @@ impl GaitStyle {
             lead: 0.7,
             heel_strike: 0.15,
             toe_off: 0.35,
-            dig: 0.02,
+            heel_dig: 0.02,
+            toe_dig: 0.02,
+            slip: 0.0,
             sole: 0.02,
             arm_swing: 0.0,
             elbow: 2.1,
@@ -392,11 +405,19 @@ impl Gait {
         };
         if f.strike.is_finite() && t < f.strike + heel_roll {
             let u = smoothstep((t - f.strike) / heel_roll);
-            return about(heel, s.heel_strike * (1.0 - u), s.dig * (1.0 - u));
+            let (ankle, rot) = about(heel, s.heel_strike * (1.0 - u), s.heel_dig * (1.0 - u));
+            return (ankle - forward_of(f.yaw) * (s.slip * (1.0 - u)), rot);
         }
         if f.lift.is_finite() && t > f.lift - toe_roll {
-            let u = smoothstep((t - (f.lift - toe_roll)) / toe_roll);
-            return about(ball, -s.toe_off * u, s.dig * u);
+            let along = ((t - (f.lift - toe_roll)) / toe_roll).clamp(0.0, 1.0);
+            // The ball is pressed in fully by the first third of the roll and stays in while the
+            // heel rises, so that a frame samples the deepest push-off even in a runner's brief
+            // one (60 ms: two frames at 30 Hz).
+            return about(
+                ball,
+                -s.toe_off * smoothstep(along),
+                s.toe_dig * smoothstep(3.0 * along),
+            );
         }
         (f.ankle, yaw)
     }

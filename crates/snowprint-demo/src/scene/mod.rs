@@ -24,7 +24,7 @@ pub trait DemoScene {
     }
     /// Advance the snow of `world` from `t0` to `t1`: whatever presses the snow meanwhile, with
     /// its poses at both ends (by `SnowWorld::step`, or per surface by `SnowWorld::update`).
-    fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String>;
+    fn advance(&mut self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String>;
     /// Meshes to draw at time `t`.
     fn instances(&self, t: f32) -> Vec<Instance>;
     /// Names of the cameras.

@@ -1,15 +1,19 @@
 //! The demo world ([`crate::DemoWorld`]) as a [`DemoScene`] for the renderer:
 //! its surfaces go into the `SnowWorld`, its props and body-part meshes into the `Renderer`, and
-//! each step feeds the snow with the demo's per-surface deformers (`DemoWorld::surface_deformers`
-//! and `SnowWorld::update`, so a body at rest costs nothing). The demo world draws nothing and has
+//! each step moves the people as a trudging [`Crowd`]: every person on a clock of their own, slowed
+//! and lowered by the snow under their feet (read from the world's probes a fixed number of
+//! updates late, so that every run gives the same frames), pressing the snow with the per-surface
+//! deformers of what moved (`DemoWorld::deformers_by_surface` and `SnowWorld::update`, so a body
+//! at rest costs nothing). The demo world draws nothing and has
 //! no materials or lights of its own; this adapter picks a procedural material for each prop from
 //! its shape (buildings get brick facades with windows, parapets concrete, the rest gathers snow on
 //! top) and adds sodium street lamps along the street.
 
-use crate::DemoWorld;
+use crate::trudge::Crowd;
+use crate::{DemoWorld, PART_COUNT, Part};
 use glam::{Mat4, Vec3};
 use snowprint::render::{Instance, MeshMaterial, PointLight, RenderMeshId, Renderer};
-use snowprint::{Camera, GroundMaterial, Mesh, MeshId, SnowWorld, SurfaceId, SurfaceUpdate};
+use snowprint::{Camera, GroundMaterial, Mesh, MeshId, SnowWorld, SurfaceId};
 
 use super::DemoScene;
 
@@ -21,7 +25,8 @@ pub struct LibraryDemo {
     lights: Vec<PointLight>,
     part_world: Vec<MeshId>,
     part_render: Vec<RenderMeshId>,
-    ankle_height: f32,
+    /// The people, trudging; advanced by each step.
+    crowd: Crowd,
 }
 
 /// A closed cylinder along +Y from y = 0 to `height` (lamp poles).
@@ -168,13 +173,14 @@ impl LibraryDemo {
             }
         }
         Ok(Self {
-            demo,
             surfaces,
             statics,
             lights,
             part_world,
             part_render,
-            ankle_height: world.config().capture.ankle_height,
+            // Probe keys of their own, far from any a game beside the demo would pick.
+            crowd: Crowd::new(&demo, 1 << 40),
+            demo,
         })
     }
 }
@@ -193,30 +199,18 @@ impl DemoScene for LibraryDemo {
         &self.lights
     }
 
-    fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {
-        let dt = t1 - t0;
-        let per_surface = self
-            .demo
-            .surface_deformers(t1, dt, &self.part_world, self.ankle_height);
-        let updates: Vec<SurfaceUpdate<'_>> = per_surface
-            .iter()
-            .filter_map(|(index, deformers)| {
-                Some(SurfaceUpdate {
-                    surface: self.surfaces.get(*index)?.0,
-                    elapsed: dt,
-                    deformers,
-                })
-            })
-            .collect();
-        world
-            .update(&updates)
-            .map(|_| ())
+    fn advance(&mut self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {
+        let ids: Vec<SurfaceId> = self.surfaces.iter().map(|s| s.0).collect();
+        self.crowd
+            .step(&self.demo, world, t1 - t0, &ids, &self.part_world)
             .map_err(|e| e.to_string())
     }
 
-    fn instances(&self, t: f32) -> Vec<Instance> {
+    /// The scenery, and the people as the last [`DemoScene::advance`] left them (their own clocks
+    /// are not the world's time `t`).
+    fn instances(&self, _t: f32) -> Vec<Instance> {
         let mut v = self.statics.clone();
-        for p in self.demo.parts_at(t) {
+        for &p in self.crowd.parts() {
             if let Some(&mesh) = self.part_render.get(p.part) {
                 let mut inst = Instance::new(
                     mesh,
@@ -238,8 +232,19 @@ impl DemoScene for LibraryDemo {
         (0.0, self.demo.duration)
     }
 
+    /// The demo's cameras; those that follow the walker or the runner follow the trudging one.
     fn camera(&self, name: &str, t: f32) -> Option<Camera> {
-        self.demo.camera(name, t)
+        let parts = self.crowd.parts();
+        let root = |who: &str| {
+            let i = self.demo.person_index(who)?;
+            Some(
+                parts
+                    .get(i * PART_COUNT + Part::Pelvis.index())?
+                    .pose
+                    .position,
+            )
+        };
+        crate::camera::camera_following(&self.demo, name, t, &root)
     }
 }
 

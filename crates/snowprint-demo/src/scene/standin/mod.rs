@@ -74,7 +74,7 @@ impl DemoScene for StandIn {
         &self.lights
     }
 
-    fn advance(&self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {
+    fn advance(&mut self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {
         let mut out = Vec::new();
         for p in self.people.iter().filter(|p| p.present(t1)) {
             let a = p.act.skeleton(t0).shapes();
