@@ -392,6 +392,16 @@ fn read_influences(
 /// crate unwraps them when it follows them).
 fn check_skin_indices(json: &gltf::json::Root) -> std::result::Result<(), String> {
     let nodes = json.nodes.len();
+    for (k, node) in json.nodes.iter().enumerate() {
+        if let Some(skin) = node.skin.map(|s| s.value())
+            && skin >= json.skins.len()
+        {
+            return Err(format!(
+                "node {k} uses skin {skin}, but the file has {} skins; fix the node's skin",
+                json.skins.len()
+            ));
+        }
+    }
     for (k, skin) in json.skins.iter().enumerate() {
         let bad_node = skin
             .joints
@@ -421,6 +431,11 @@ fn check_indices(json: &gltf::json::Root, a: usize) -> std::result::Result<(), S
     let anim = &json.animations[a];
     let accessors = json.accessors.len();
     for (k, ch) in anim.channels.iter().enumerate() {
+        if !matches!(ch.target.path, gltf::json::validation::Checked::Valid(_)) {
+            return Err(format!(
+                "channel {k} has a target path that is not translation, rotation, scale or weights; fix the channel"
+            ));
+        }
         let node = ch.target.node.value();
         if node >= json.nodes.len() {
             return Err(format!(
