@@ -10,6 +10,7 @@ mod demo;
 mod inspect;
 mod managed;
 mod output;
+mod play;
 mod progress;
 mod report;
 mod simulate;
@@ -37,6 +38,9 @@ enum Command {
     Demo(demo::Args),
     /// Measure the deformation update per stage on the GPU, against a copy of the same bytes.
     Bench(bench::Args),
+    /// Open a window and walk a person through snow (WASD, Shift run, C slide, F fall, Space
+    /// throw, T tier, V debug view, drag to orbit).
+    Play(play::Args),
     /// Print what a save file holds (settings, clock, sections, surfaces), checking it whole.
     Inspect(inspect::Args),
 }
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => demo::run(&gpu, &args),
         Command::Bench(args) => bench::run(&gpu, &args),
         Command::Inspect(args) => inspect::run(&args),
+        Command::Play(args) => play::run(&gpu, args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
