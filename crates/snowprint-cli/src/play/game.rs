@@ -172,7 +172,9 @@ impl App {
                 path,
                 gfx.config.width,
                 gfx.config.height,
-                66,
+                // Every second frame: real time when the step is fixed.
+                args.dt
+                    .map_or(66, |dt| (2000.0 * dt).clamp(20.0, 200.0) as u32),
             )?),
             None => None,
         };

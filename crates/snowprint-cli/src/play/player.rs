@@ -530,9 +530,12 @@ mod tests {
             run(&mut p, 6.0, Intent::default());
             assert!(!p.is_down(), "{action}: still down");
             let moved = p.position().0 - before;
-            assert!(moved.x > 0.0, "{action} went {moved}");
             if action == "slide" {
-                assert!(moved.x > 1.5, "a slide goes further than a fall: {moved}");
+                // Feet first, on along the way the person walked.
+                assert!(moved.x > 1.5, "the slide went {moved}");
+            } else {
+                // Backwards, like a plank about the heels: the pelvis lands behind them.
+                assert!(moved.x < -0.5 && moved.x > -1.5, "the fall went {moved}");
             }
         }
     }
