@@ -28,6 +28,8 @@ const TRUDGE_KEYS: u64 = 1;
 /// Camera turn of the arrow keys, radians a second, and of a mouse drag, radians a pixel.
 const ARROW_TURN: f32 = 1.6;
 const DRAG_TURN: f32 = 0.006;
+/// The GIF keeps every third frame (a few megabytes a minute at 320x180).
+const GIF_EVERY: u32 = 3;
 /// Frames of the person's path kept for the report (an hour at 60 frames a second).
 const MAX_PATH: usize = 216_000;
 
@@ -392,7 +394,10 @@ impl Game {
         let last = args.frames.is_some_and(|n| self.frames + 1 >= n)
             || args.seconds.is_some_and(|s| self.time >= s)
             || script_end.is_some_and(|end| self.time >= end);
-        let shown = self.draw(dt, last || self.gif.is_some() && self.frames % 2 == 0)?;
+        let shown = self.draw(
+            dt,
+            last || self.gif.is_some() && self.frames % GIF_EVERY == 0,
+        )?;
         if let Some(image) = shown {
             if let Some(gif) = &mut self.gif {
                 gif.add(&image)?;

@@ -65,7 +65,7 @@ pub struct Args {
     /// find the trail in the screenshot.
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Write the frames shown to this GIF file (every second frame, at most 480 pixels wide).
+    /// Write the frames shown to this GIF file (every third frame, at most 480 pixels wide).
     #[arg(long)]
     pub gif: Option<PathBuf>,
 }
