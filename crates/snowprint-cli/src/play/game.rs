@@ -396,7 +396,7 @@ impl Game {
             || script_end.is_some_and(|end| self.time >= end);
         let shown = self.draw(
             dt,
-            last || self.gif.is_some() && self.frames % GIF_EVERY == 0,
+            last || self.gif.is_some() && self.frames.is_multiple_of(GIF_EVERY),
         )?;
         if let Some(image) = shown {
             if let Some(gif) = &mut self.gif {

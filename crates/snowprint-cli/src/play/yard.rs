@@ -44,7 +44,7 @@ impl Yard {
             .map_err(werr)?;
         // The demo's people wear the walker's clothes.
         let cast = snowprint_demo::people::cast();
-        let outfit = cast.first().map(|p| p.outfit.clone());
+        let outfit = cast.first().map(|p| p.outfit);
         let mut part_world = Vec::new();
         let mut part_render = Vec::new();
         let mut albedo = Vec::new();
