@@ -22,9 +22,9 @@ use crate::output::OutputSet;
 use crate::progress::Progress;
 
 #[path = "contact_sheet.rs"]
-mod contact_sheet;
+pub(crate) mod contact_sheet;
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("size {s:?} is not WIDTHxHEIGHT, such as 1280x720"))?;

@@ -10,6 +10,7 @@ mod demo;
 mod inspect;
 mod managed;
 mod output;
+mod play;
 mod progress;
 mod report;
 mod simulate;
@@ -37,6 +38,9 @@ enum Command {
     Demo(demo::Args),
     /// Measure the deformation update per stage on the GPU, against a copy of the same bytes.
     Bench(bench::Args),
+    /// Open a window and walk a person through snow (WASD, Shift run, C slide, F fall, Space
+    /// throw, T tier, V debug view, drag to orbit).
+    Play(play::Args),
     /// Print what a save file holds (settings, clock, sections, surfaces), checking it whole.
     Inspect(inspect::Args),
 }
@@ -46,7 +50,8 @@ fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_env("SNOWPRINT_LOG")
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+                // winit's warnings about a display without a size or settings (Xvfb) are no one's.
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,winit=error")),
         )
         .with_writer(std::io::stderr)
         .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
@@ -60,6 +65,7 @@ fn main() -> ExitCode {
         Command::Demo(args) => demo::run(&gpu, &args),
         Command::Bench(args) => bench::run(&gpu, &args),
         Command::Inspect(args) => inspect::run(&args),
+        Command::Play(args) => play::run(&gpu, args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
