@@ -200,7 +200,7 @@ impl App {
             renderer,
             yard,
             player,
-            trudge: Trudge::new(0.0, TRUDGE_KEYS),
+            trudge: Trudge::new(0.0, TRUDGE_KEYS, 2),
             orbit,
             held: HashSet::new(),
             pressed: Vec::new(),
@@ -374,9 +374,14 @@ impl Game {
         // The person's clock runs at the trudge pace of the snow under the feet (the probe
         // cache's answer of a frame or two ago; nothing waits).
         let before = self.trudge.clock;
+        // Only a gait slows: a slide or a fall keeps the world's time.
+        let walking = !self.player.is_down();
         let clock = self
             .trudge
-            .advance(&mut self.world, dt, self.player.feet())
+            .read(&mut self.world, dt, walking)
+            .map_err(|e| e.to_string())?;
+        self.trudge
+            .probe(&mut self.world, &self.player.feet())
             .map_err(|e| e.to_string())?;
         self.player
             .advance(clock - before, dt, self.trudge.sink, intent);
