@@ -374,3 +374,50 @@ fn a_walking_figure_prints_where_its_feet_are() {
         );
     }
 }
+
+/// In an engine's frame: the skinning recorded into the caller's encoder ahead of the step leaves
+/// the vertices and the print that `animate_meshes` then `step` leave; while the frame is pending
+/// another skinning is refused.
+#[test]
+fn skinning_recorded_into_the_callers_encoder_equals_the_wrapper() {
+    let gpu = common::gpu();
+    let m = figure();
+    let desc = SurfaceDesc::new("roof", [0.0, 0.0, 0.0], [3.0, 3.0], 0.3);
+    let mut results = Vec::new();
+    for encoded in [false, true] {
+        let mut w = world();
+        let id = w.add_skinned_mesh("figure", &m).unwrap();
+        let roof = w.add_surface(desc.clone()).unwrap();
+        let pose = MeshAnimation {
+            mesh: id,
+            animation: Some(0),
+            time: 0.4,
+            playback: Playback::Loop,
+        };
+        let foot = Deformer::new(Shape::Mesh(id), Pose::at([0.0, 0.1, 0.0]));
+        if encoded {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            w.encode_animate_meshes(&mut enc, &[pose]).unwrap();
+            let pending = w.encode_step(&mut enc, 1.0 / 60.0, &[foot]).unwrap();
+            assert!(matches!(
+                w.encode_animate_meshes(&mut enc, &[pose]),
+                Err(snowprint::SnowError::FramePending)
+            ));
+            gpu.queue.submit([enc.finish()]);
+            w.submitted(pending).unwrap();
+        } else {
+            w.animate_meshes(&[pose]).unwrap();
+            w.step(1.0 / 60.0, &[foot]).unwrap();
+        }
+        results.push((
+            w.read_skinned_vertices(id).unwrap(),
+            w.read_channels(roof).unwrap(),
+        ));
+    }
+    assert_eq!(results[0].0, results[1].0);
+    assert_eq!(results[0].1, results[1].1);
+    assert!(
+        results[0].1.0.iter().any(|&d| d > 0),
+        "the figure pressed the roof"
+    );
+}

@@ -154,13 +154,33 @@ impl SnowWorld {
 
     /// Pose skinned meshes at their animations' times: the skeletons are posed on the CPU and the
     /// vertices skinned on the GPU, in one compute pass submitted before this returns (so the next
-    /// step draws them).
+    /// step draws them). [`SnowWorld::encode_animate_meshes`] records it into an engine's encoder.
     ///
     /// # Errors
     ///
     /// [`SnowError::StaleHandle`] for a mesh that is not a live skinned mesh of this world,
     /// [`SnowError::InvalidMesh`] for an animation index the mesh does not have.
     pub fn animate_meshes(&mut self, poses: &[MeshAnimation]) -> Result<()> {
+        let mut enc = self.skin_encoder();
+        self.encode_animate_meshes(&mut enc, poses)?;
+        self.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
+    /// [`SnowWorld::animate_meshes`] recorded into the caller's `encoder`, ahead of the frame's
+    /// [`SnowWorld::encode_step`] in the same encoder (the joints are written with
+    /// `queue.write_buffer`, so they land with the caller's submit). Refused with
+    /// [`SnowError::FramePending`] while a frame is encoded and not submitted (its capture would
+    /// draw the new joints).
+    ///
+    /// # Errors
+    ///
+    /// As [`SnowWorld::animate_meshes`].
+    pub fn encode_animate_meshes(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        poses: &[MeshAnimation],
+    ) -> Result<()> {
         let mut joints = Vec::with_capacity(poses.len());
         for p in poses {
             let skin = self.skin(p.mesh)?;
@@ -182,7 +202,14 @@ impl SnowWorld {
             .zip(&joints)
             .map(|(p, j)| (p.mesh, j.as_slice()))
             .collect();
-        self.skin_meshes(&posed)
+        self.encode_skin_meshes(encoder, &posed)
+    }
+
+    fn skin_encoder(&self) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("skin"),
+            })
     }
 
     /// Skin meshes with joint matrices given by the caller (`global * inverse bind` of each joint,
@@ -194,6 +221,26 @@ impl SnowWorld {
     /// [`SnowError::JointCount`] when the number of matrices is not the mesh's joint count,
     /// [`SnowError::InvalidMesh`] for a matrix that is not finite.
     pub fn skin_meshes(&mut self, poses: &[(MeshId, &[Mat4])]) -> Result<()> {
+        let mut enc = self.skin_encoder();
+        self.encode_skin_meshes(&mut enc, poses)?;
+        self.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
+    /// [`SnowWorld::skin_meshes`] recorded into the caller's `encoder` (see
+    /// [`SnowWorld::encode_animate_meshes`] for where it goes).
+    ///
+    /// # Errors
+    ///
+    /// As [`SnowWorld::skin_meshes`], and [`SnowError::FramePending`].
+    pub fn encode_skin_meshes(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        poses: &[(MeshId, &[Mat4])],
+    ) -> Result<()> {
+        if self.in_flight.is_some() {
+            return Err(SnowError::FramePending);
+        }
         for &(id, joints) in poses {
             let skin = self.skin(id)?;
             if joints.len() != skin.gpu.joint_count() {
@@ -225,13 +272,7 @@ impl SnowWorld {
             }
             gpus.push(&skin.gpu);
         }
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("skin"),
-            });
-        crate::skin::record(&mut enc, pipe, &gpus);
-        self.queue.submit([enc.finish()]);
+        crate::skin::record(encoder, pipe, &gpus);
         Ok(())
     }
 
