@@ -12,7 +12,7 @@ use crate::gpu::resources::bind_group;
 use crate::gpu::timestamps::StageQueries;
 use crate::pool::Precision;
 
-/// One relaxing surface, as `RelaxRecord` in relax.wgsl (32 bytes).
+/// One relaxing surface, as `RelaxRecord` in relax.wgsl (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct RelaxRecord {
@@ -28,8 +28,75 @@ pub struct RelaxRecord {
     pub threshold_x: u32,
     /// The same between z neighbours.
     pub threshold_z: u32,
-    /// Padding to 32 bytes.
+    /// The rectangle that relaxes ([`Rect`]): first column, first row, columns, rows.
+    pub rect: [u32; 4],
+    /// Padding to 48 bytes.
     pub _pad: [u32; 2],
+}
+
+/// Where a surface of a slumping material may still move, kept by the world between updates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Settle {
+    /// Updates it still relaxes for after the last that pressed it.
+    pub updates: u32,
+    /// Texels that may be unsettled (empty once it has settled).
+    pub rect: Rect,
+}
+
+/// A rectangle of texels: first column and row, one past the last column and row.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Rect {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl Rect {
+    /// Whether it holds no texel.
+    pub fn is_empty(&self) -> bool {
+        self.x1 <= self.x0 || self.y1 <= self.y0
+    }
+
+    /// The smallest rectangle holding both (an empty one holds nothing).
+    pub fn union(self, other: Rect) -> Rect {
+        match (self.is_empty(), other.is_empty()) {
+            (true, _) => other,
+            (_, true) => self,
+            _ => Rect {
+                x0: self.x0.min(other.x0),
+                y0: self.y0.min(other.y0),
+                x1: self.x1.max(other.x1),
+                y1: self.y1.max(other.y1),
+            },
+        }
+    }
+
+    /// Grown by `n` texels on every side, within a `width` x `height` heightmap.
+    pub fn grown(self, n: u32, width: u32, height: u32) -> Rect {
+        if self.is_empty() {
+            return self;
+        }
+        Rect {
+            x0: self.x0.saturating_sub(n),
+            y0: self.y0.saturating_sub(n),
+            x1: self.x1.saturating_add(n).min(width),
+            y1: self.y1.saturating_add(n).min(height),
+        }
+    }
+
+    /// Columns and rows.
+    pub fn size(&self) -> (u32, u32) {
+        if self.is_empty() {
+            (0, 0)
+        } else {
+            (self.x1 - self.x0, self.y1 - self.y0)
+        }
+    }
 }
 
 /// What the relaxation runs over in one update.
@@ -57,12 +124,14 @@ impl RelaxPlan {
         self.records.clear();
     }
 
-    /// List a surface that relaxes `steps` steps this update.
+    /// List a surface that relaxes `steps` steps this update over its record's rectangle.
     pub fn push(&mut self, mut record: RelaxRecord, steps: u32) {
+        let [_, _, w, h] = record.rect;
         record.scratch = self.scratch_words;
-        self.scratch_words += record.width * record.height;
-        self.max_width = self.max_width.max(record.width);
-        self.max_height = self.max_height.max(record.height);
+        self.scratch_words += w * h;
+        // The grid covers the rectangle's texels, and at 8 bits one unit more.
+        self.max_width = self.max_width.max(w + 1);
+        self.max_height = self.max_height.max(h);
         self.steps = self.steps.max(steps);
         self.records.push(record);
     }
@@ -192,7 +261,7 @@ pub fn encode(
 
 #[cfg(test)]
 mod tests {
-    /// `RelaxRecord` here and in relax.wgsl: same fields in order, 4 bytes each, 32 bytes.
+    /// `RelaxRecord` here and in relax.wgsl: same fields in order, 4 bytes each, 48 bytes.
     #[test]
     fn record_layout_matches_wgsl() {
         let module = naga::front::wgsl::parse_str(crate::wgsl::RELAX.source).unwrap();

@@ -193,7 +193,7 @@ impl SnowWorld {
     }
 
     /// Keep the settle counters a layer leaves (remembering the first for an abandoned frame).
-    fn keep_settles(&mut self, settles: &[(usize, u32)]) {
+    fn keep_settles(&mut self, settles: &[(usize, crate::relax::Settle)]) {
         for &(index, settle) in settles {
             if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
                 let before = &mut self.scratch_cpu.settles;

@@ -51,9 +51,9 @@ struct SurfaceState {
     slot: Slot,
     /// Replenishment not yet applied, units (fraction kept between frames).
     carry: f64,
-    /// Updates a slumping material still relaxes for (see [`crate::Material`]); not kept by
-    /// snapshots (a surface paged back in has settled).
-    settle: u32,
+    /// How long and where a slumping material still relaxes (see [`crate::Material`]); not kept
+    /// by snapshots (a surface paged back in has settled).
+    settle: crate::relax::Settle,
 }
 
 /// What the last frame did, for debug readbacks.
@@ -74,8 +74,8 @@ struct FrameScratch {
     blocks: Vec<u8>,
     /// A pending frame's carries and captures, given back when it is submitted.
     carries: Vec<(usize, f64)>,
-    /// The settle counters before a pending frame (see `carries`).
-    settles: Vec<(usize, u32)>,
+    /// The settle states before a pending frame (see `carries`).
+    settles: Vec<(usize, crate::relax::Settle)>,
     captured: Vec<(usize, SurfaceRecord)>,
 }
 
@@ -337,7 +337,7 @@ impl SnowWorld {
             layout,
             slot,
             carry: 0.0,
-            settle: 0,
+            settle: Default::default(),
         }))
     }
 

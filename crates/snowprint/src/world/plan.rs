@@ -9,7 +9,7 @@
 
 use std::ops::Range;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
@@ -22,7 +22,7 @@ use crate::mesh::MeshId;
 use crate::pool::{
     MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
 };
-use crate::relax::{RelaxPlan, RelaxRecord};
+use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceLayout};
 
 #[cfg(test)]
@@ -80,8 +80,9 @@ pub struct PlanSurface<'a> {
     pub elapsed: f32,
     /// Everything that touched it since then.
     pub deformers: &'a [Deformer],
-    /// Updates it still slumps for after the last that pressed it (see [`crate::Material`]).
-    pub settle: u32,
+    /// How long and where it still slumps after the last update that pressed it (see
+    /// [`crate::Material`]).
+    pub settle: Settle,
 }
 
 /// A surface the plan updates.
@@ -128,8 +129,9 @@ struct Job {
     half_size: Vec2,
     prims: Range<u32>,
     draws: Range<u32>,
-    /// Relaxation steps this update (0: none) and the material's repose angle, degrees.
-    relax: (u32, f32),
+    /// Relaxation steps this update (0: none), the material's repose angle (degrees) and the
+    /// rectangle that relaxes.
+    relax: (u32, f32, Rect),
 }
 
 /// Everything one update records, decided on the CPU. Kept by the world and rebuilt each frame
@@ -147,8 +149,8 @@ pub struct FramePlan {
     pub carries: Vec<(usize, f64)>,
     /// What the relaxation runs over.
     pub relax: RelaxPlan,
-    /// The updates each surface planned still slumps for after this one: `(index, settle)`.
-    pub settles: Vec<(usize, u32)>,
+    /// How long and where each surface planned still slumps after this update: `(index, settle)`.
+    pub settles: Vec<(usize, Settle)>,
     /// What each per-frame buffer must hold.
     pub sizes: BufferSizes,
     jobs: Vec<Job>,
@@ -253,14 +255,45 @@ impl FramePlan {
         let (p1, d1) = (prims.len() as u32, draws.len() as u32);
         let captured = p1 > p0 || d1 > d0;
         // A slumping material relaxes in every update that presses it and for `settle_updates`
-        // after the last.
+        // after the last, over what may be unsettled (what it pressed, and what earlier updates
+        // left moving) grown by the update's steps: a step moves material one texel, so nothing
+        // outside that rectangle would move in a relaxation of the whole surface either.
         let material = &s.desc.material;
+        let (w, h) = (s.layout.width, s.layout.height);
+        let steps = material.steps();
+        let pressed = if d1 > d0 {
+            Rect {
+                x0: 0,
+                y0: 0,
+                x1: w,
+                y1: h,
+            }
+        } else {
+            pressed_rect(&prims[p0 as usize..p1 as usize], &volume, s.layout)
+        };
         let (relaxes, settle) = match (material.slumps(), captured) {
             (false, _) => (false, 0),
             (true, true) => (true, material.settle_updates),
-            (true, false) => (s.settle > 0, s.settle.saturating_sub(1)),
+            (true, false) => (s.settle.updates > 0, s.settle.updates.saturating_sub(1)),
         };
-        self.settles.push((s.index, settle));
+        let kept = if s.settle.updates > 0 {
+            s.settle.rect
+        } else {
+            Rect::default()
+        };
+        let rect = if relaxes {
+            kept.union(if captured { pressed } else { Rect::default() })
+                .grown(steps, w, h)
+        } else {
+            Rect::default()
+        };
+        self.settles.push((
+            s.index,
+            Settle {
+                updates: if relaxes { settle } else { 0 },
+                rect,
+            },
+        ));
         if !captured && units == 0 && !relaxes {
             return;
         }
@@ -295,10 +328,10 @@ impl FramePlan {
             half_size: volume.half_size,
             prims: p0..p1,
             draws: d0..d1,
-            relax: if relaxes {
-                (material.steps(), material.repose_degrees.unwrap_or(90.0))
+            relax: if relaxes && !rect.is_empty() {
+                (steps, material.repose_degrees.unwrap_or(90.0), rect)
             } else {
-                (0, 90.0)
+                (0, 90.0, Rect::default())
             },
         });
     }
@@ -390,7 +423,8 @@ impl FramePlan {
         let max = settings.format.precision.channel_max();
         for job in self.jobs.iter().filter(|j| j.relax.0 > 0) {
             let r = &job.record;
-            let (steps, repose) = job.relax;
+            let (steps, repose, rect) = job.relax;
+            let (rw, rh) = rect.size();
             let threshold = |texel| crate::relax::cpu::threshold(repose, texel, r.snow_depth, max);
             self.relax.push(
                 RelaxRecord {
@@ -400,6 +434,7 @@ impl FramePlan {
                     scratch: 0,
                     threshold_x: threshold(r.texel_x),
                     threshold_z: threshold(r.texel_z),
+                    rect: [rect.x0, rect.y0, rw, rh],
                     _pad: [0; 2],
                 },
                 steps,
@@ -420,6 +455,47 @@ impl FramePlan {
             relax_records: std::mem::size_of_val(self.relax.records.as_slice()) as u64,
             relax_scratch: self.relax.scratch_words as u64 * 4,
         };
+    }
+}
+
+/// The texels a surface's primitives (in its local frame) can press, with a margin for the
+/// capture's blur.
+fn pressed_rect(
+    prims: &[capture::GpuPrimitive],
+    volume: &CaptureVolume,
+    layout: SurfaceLayout,
+) -> Rect {
+    const BLUR_MARGIN: f32 = 3.0;
+    let (w, h) = (layout.width, layout.height);
+    let texel = volume.half_size * 2.0 / Vec2::new(w as f32, h as f32);
+    let mut lo = Vec2::splat(f32::INFINITY);
+    let mut hi = Vec2::splat(f32::NEG_INFINITY);
+    for p in prims {
+        let (a, b, r) = if p.kind[0] == capture::PRIM_BOX {
+            let c = Vec2::new(p.p0[0], p.p0[2]);
+            let r = Vec3::new(p.p1[3], p.p2[3], p.p3[3]).length();
+            (c, c, r)
+        } else {
+            (
+                Vec2::new(p.p0[0], p.p0[2]),
+                Vec2::new(p.p1[0], p.p1[2]),
+                p.p0[3],
+            )
+        };
+        lo = lo.min(a.min(b) - r);
+        hi = hi.max(a.max(b) + r);
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Rect::default();
+    }
+    let to_texel = |v: Vec2| (v + volume.half_size) / texel;
+    let (a, b) = (to_texel(lo) - BLUR_MARGIN, to_texel(hi) + BLUR_MARGIN);
+    let clamp = |v: f32, n: u32| v.clamp(0.0, n as f32) as u32;
+    Rect {
+        x0: clamp(a.x.floor(), w),
+        y0: clamp(a.y.floor(), h),
+        x1: clamp(b.x.ceil(), w),
+        y1: clamp(b.y.ceil(), h),
     }
 }
 

@@ -287,7 +287,7 @@ impl SnowWorld {
             layout,
             slot,
             carry: snapshot.carry,
-            settle: 0,
+            settle: Default::default(),
         }))
     }
 }

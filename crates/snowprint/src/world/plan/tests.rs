@@ -33,7 +33,7 @@ fn inputs<'a>(
                 carry: 0.0,
                 elapsed,
                 deformers,
-                settle: 0,
+                settle: Default::default(),
             };
             word += layout.width * layout.height;
             s
@@ -319,9 +319,11 @@ fn rebuilding_reuses_the_plan() {
 }
 
 /// A sand surface relaxes in the update that presses it and for `settle_updates` after, by its
-/// own threshold; snow and a settled surface plan no relaxation (and no update).
+/// own threshold, over what the press reached grown by the update's steps; snow and a settled
+/// surface plan no relaxation (and no update).
 #[test]
 fn slumping_materials_relax_while_they_settle() {
+    use crate::relax::{Rect, Settle};
     let mut sand = still("sand", 0.0);
     sand.material = crate::Material::sand();
     let descs = [sand, still("snow", 10.0)];
@@ -331,7 +333,28 @@ fn slumping_materials_relax_while_they_settle() {
     ];
     let plan = FramePlan::build(&settings(), inputs(&descs, &pressed, 0.1), no_meshes);
     let m = crate::Material::sand();
-    assert_eq!(plan.settles, vec![(0, m.settle_updates), (1, 0)]);
+    // The ball (radius 0.2 m) at local (0.5, 0.5) of a 4 m square of 4 cm texels: texel 62.5,
+    // 5 texels of radius, 3 of blur margin: columns and rows 54..71, grown by the 8 steps: 46..79.
+    let rect = Rect {
+        x0: 46,
+        y0: 46,
+        x1: 79,
+        y1: 79,
+    };
+    assert_eq!(m.steps(), 8);
+    assert_eq!(
+        plan.settles,
+        vec![
+            (
+                0,
+                Settle {
+                    updates: m.settle_updates,
+                    rect
+                }
+            ),
+            (1, Settle::default())
+        ]
+    );
     assert_eq!(plan.relax.records.len(), 1, "only the sand relaxes");
     assert_eq!(plan.relax.steps, m.steps());
     let r = plan.relax.records[0];
@@ -339,14 +362,34 @@ fn slumping_materials_relax_while_they_settle() {
     let rise = (34f64.to_radians().tan() * 0.04 / 0.3 * 65_535.0).floor() as u32;
     assert_eq!((r.threshold_x, r.threshold_z), (rise - 7, rise - 7));
     assert_eq!((r.width, r.height, r.scratch), (100, 100, 0));
-    assert_eq!(plan.sizes.relax_scratch, 100 * 100 * 4);
+    assert_eq!(r.rect, [46, 46, 33, 33]);
+    assert_eq!(plan.sizes.relax_scratch, 33 * 33 * 4);
 
-    // Nothing touches them now: the sand settles (one update fewer to go), the snow is left.
+    // Nothing touches them now: the sand settles (one update fewer to go) over its rectangle
+    // grown by the steps, the snow is left.
     let idle = vec![vec![], vec![]];
     let mut surfaces = inputs(&descs, &idle, 0.1);
-    surfaces[0].settle = 3;
+    surfaces[0].settle = Settle { updates: 3, rect };
     let plan = FramePlan::build(&settings(), surfaces.clone(), no_meshes);
-    assert_eq!(plan.settles, vec![(0, 2), (1, 0)]);
+    let grown = Rect {
+        x0: 38,
+        y0: 38,
+        x1: 87,
+        y1: 87,
+    };
+    assert_eq!(
+        plan.settles,
+        vec![
+            (
+                0,
+                Settle {
+                    updates: 2,
+                    rect: grown
+                }
+            ),
+            (1, Settle::default())
+        ]
+    );
     assert_eq!(
         plan.surfaces,
         vec![PlannedSurface {
@@ -354,8 +397,8 @@ fn slumping_materials_relax_while_they_settle() {
             captured: false
         }]
     );
-    assert_eq!(plan.relax.records.len(), 1);
-    surfaces[0].settle = 0;
+    assert_eq!(plan.relax.records[0].rect, [38, 38, 49, 49]);
+    surfaces[0].settle = Settle::default();
     let plan = FramePlan::build(&settings(), surfaces, no_meshes);
     assert!(plan.is_empty() && plan.relax.is_empty());
 }
