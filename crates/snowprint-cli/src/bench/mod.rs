@@ -12,8 +12,11 @@ use snowprint::{
     StageTimes, SurfaceDesc, SurfaceUpdate, WorldConfig,
 };
 
+mod baseline;
+
 use crate::output::OutputSet;
 use crate::progress::Progress;
+use baseline::{ComputeCopyTimer, CopyTimer};
 
 /// Arguments of `snowprint bench`.
 #[derive(clap::Args, Debug)]
@@ -62,6 +65,11 @@ pub struct Row {
     pub copy_us: f64,
     /// `update_us / copy_us`.
     pub ratio_to_copy: f64,
+    /// Median GPU time of a compute pass streaming the same bytes in and out with 16-byte loads
+    /// and stores, microseconds.
+    pub compute_copy_us: f64,
+    /// `update_us / compute_copy_us`.
+    pub ratio_to_compute_copy: f64,
     /// Pool bytes of the surfaces.
     pub pool_bytes: u64,
     /// Bytes per surface in the pool (both channels, slot alignment included).
@@ -96,100 +104,6 @@ fn median(v: &mut [f64]) -> f64 {
     } else {
         0.5 * (v[n / 2 - 1] + v[n / 2])
     }
-}
-
-/// Timing of a plain `copy_buffer_to_buffer`, with encoder timestamps when the device has them,
-/// else whole submissions timed on the CPU.
-struct CopyTimer {
-    src: wgpu::Buffer,
-    dst: wgpu::Buffer,
-    queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer, f32)>,
-}
-
-impl CopyTimer {
-    fn new(gpu: &GpuContext, bytes: u64) -> Self {
-        let make = |label, usage| {
-            gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(4),
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        use wgpu::BufferUsages as U;
-        let queries = gpu
-            .device
-            .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
-            .then(|| {
-                (
-                    gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-                        label: Some("copy timestamps"),
-                        ty: wgpu::QueryType::Timestamp,
-                        count: 2,
-                    }),
-                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("copy resolve"),
-                        size: 16,
-                        usage: U::QUERY_RESOLVE | U::COPY_SRC,
-                        mapped_at_creation: false,
-                    }),
-                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("copy readback"),
-                        size: 16,
-                        usage: U::MAP_READ | U::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
-                    gpu.queue.get_timestamp_period(),
-                )
-            });
-        Self {
-            src: make("copy source", U::COPY_SRC | U::STORAGE),
-            dst: make("copy destination", U::COPY_DST | U::STORAGE),
-            queries,
-        }
-    }
-
-    /// One copy, microseconds.
-    fn time(&self, gpu: &GpuContext) -> Result<f64, String> {
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        if let Some((set, _, _, _)) = &self.queries {
-            enc.write_timestamp(set, 0);
-        }
-        enc.copy_buffer_to_buffer(&self.src, 0, &self.dst, 0, self.src.size());
-        if let Some((set, resolve, readback, _)) = &self.queries {
-            enc.write_timestamp(set, 1);
-            enc.resolve_query_set(set, 0..2, resolve, 0);
-            enc.copy_buffer_to_buffer(resolve, 0, readback, 0, 16);
-        }
-        let start = Instant::now();
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait_idle().map_err(|e| e.to_string())?;
-        let wall = start.elapsed().as_secs_f64() * 1e6;
-        let Some((_, _, readback, period)) = &self.queries else {
-            return Ok(wall);
-        };
-        let slice = readback.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        gpu.wait_idle().map_err(|e| e.to_string())?;
-        rx.recv()
-            .map_err(|e| e.to_string())?
-            .map_err(|e| e.to_string())?;
-        let ticks: Vec<u64> =
-            bytemuck_cast(&slice.get_mapped_range().map_err(|e| format!("{e:?}"))?);
-        readback.unmap();
-        Ok(ticks[1].saturating_sub(ticks[0]) as f64 * *period as f64 * 1e-3)
-    }
-}
-
-fn bytemuck_cast(bytes: &[u8]) -> Vec<u64> {
-    bytes
-        .chunks_exact(8)
-        .map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-        .collect()
 }
 
 /// A deterministic scatter of moving spheres over a surface of side `side` metres at ground 0.
@@ -330,15 +244,19 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     }
     let bytes = c.surfaces as u64 * format.heights_bytes(c.resolution, c.resolution);
     let copy = CopyTimer::new(gpu, bytes);
-    let mut copies = Vec::new();
+    let compute_copy = ComputeCopyTimer::new(gpu, bytes);
+    let (mut copies, mut compute_copies) = (Vec::new(), Vec::new());
     for i in 0..args.warmup + args.frames {
         let t = copy.time(gpu)?;
+        let c = compute_copy.time(gpu)?;
         if i >= args.warmup {
             copies.push(t);
+            compute_copies.push(c);
         }
     }
     let update_us = median(&mut total);
     let copy_us = median(&mut copies);
+    let compute_copy_us = median(&mut compute_copies);
     Ok(Row {
         sweep: c.sweep,
         surfaces: c.surfaces,
@@ -359,6 +277,8 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         heightmap_bytes: bytes,
         copy_us,
         ratio_to_copy: update_us / copy_us,
+        compute_copy_us,
+        ratio_to_compute_copy: update_us / compute_copy_us,
         pool_bytes: world.memory().pool_used,
         bytes_per_surface: slot,
         memory: world.memory(),
@@ -510,7 +430,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         }
     );
     println!(
-        "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}",
+        "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7}",
         "sweep",
         "mode",
         "bits",
@@ -526,13 +446,15 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         "fused",
         "cpu_us",
         "copy_us",
-        "x_copy"
+        "x_copy",
+        "ccopy_us",
+        "x_ccopy"
     );
     for r in rows {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2}",
+            "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2}",
             r.sweep,
             if r.fused { "fused" } else { "split" },
             r.precision_bits,
@@ -548,7 +470,9 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
             f(s.map(|s| s.fused)),
             r.cpu_encode_us,
             r.copy_us,
-            r.ratio_to_copy
+            r.ratio_to_copy,
+            r.compute_copy_us,
+            r.ratio_to_compute_copy
         );
     }
 }
