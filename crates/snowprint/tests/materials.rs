@@ -185,3 +185,44 @@ fn scene_files_name_materials_and_refuse_unknown_ones() {
         "{err}"
     );
 }
+
+#[test]
+fn scene_files_define_their_own_materials() {
+    let scene = |tables: &str, material: &str| {
+        format!(
+            "version = 1\n{tables}[[surface]]\nname = \"dune\"\ncenter = [0.0, 0.0, 0.0]\nsize = [4.0, 4.0]\nsnow_depth = 0.2\nmaterial = \"{material}\"\n"
+        )
+    };
+    let parse = |text: String| snowprint::scene::Scene::parse(&text, Path::new("dune.toml"));
+    // A preset with keys changed.
+    let wet = "[[material]]\nname = \"wet_sand\"\nlike = \"sand\"\nrepose_degrees = 45.0\nrelax_steps = 2\n";
+    let s = parse(scene(wet, "wet_sand")).unwrap();
+    let expect = Material {
+        repose_degrees: Some(45.0),
+        relax_steps: 2,
+        ..Material::sand()
+    };
+    assert_eq!(s.surfaces[0].material, expect);
+    // From snow, a repose angle alone makes it slump with sand's steps.
+    let crumbly = "[[material]]\nname = \"crust\"\nrepose_degrees = 70.0\n";
+    let s = parse(scene(crumbly, "crust")).unwrap();
+    assert!(s.surfaces[0].material.slumps());
+    assert_eq!(s.surfaces[0].material.repose_degrees, Some(70.0));
+    // One sentence each, with the file and line, for what is wrong.
+    let err = |text: String| parse(text).unwrap_err().to_string();
+    let e = err(scene("[[material]]\nname = \"sand\"\n", "sand"));
+    assert!(e.starts_with("dune.toml:3:") && e.contains("preset"), "{e}");
+    let e = err(scene(
+        "[[material]]\nname = \"x\"\nrepose_degrees = 120.0\n",
+        "x",
+    ));
+    assert!(
+        e.starts_with("dune.toml:4:") && e.contains("0 to 90"),
+        "{e}"
+    );
+    let e = err(scene("[[material]]\nname = \"x\"\nrepose = 30.0\n", "x"));
+    assert!(e.contains("repose_degrees"), "did you mean: {e}");
+    let e = err(scene(wet, "dry_sand"));
+    assert!(e.contains("wet_sand") && e.contains("\"sand\""), "{e}");
+    assert!(!e.contains('\n'), "one line: {e}");
+}

@@ -24,6 +24,19 @@ pub(super) struct RawScene {
     pub deformer: Vec<Spanned<RawDeformer>>,
     pub budget: Option<Spanned<RawBudget>>,
     pub camera: Option<Spanned<RawCamera>>,
+    #[serde(default)]
+    pub material: Vec<Spanned<RawMaterial>>,
+}
+
+/// One `[[material]]`: a preset with some keys changed.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMaterial {
+    pub name: Option<Str>,
+    pub like: Option<Str>,
+    pub repose_degrees: Option<Num>,
+    pub relax_steps: Option<Spanned<i64>>,
+    pub settle_updates: Option<Spanned<i64>>,
 }
 
 /// `[budget]`: the surface manager's limits.
@@ -109,10 +122,20 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
     (
         "at the top level",
         &[
-            "version", "capture", "surface", "deformer", "budget", "camera",
+            "version", "capture", "surface", "deformer", "budget", "camera", "material",
         ],
     ),
     ("in [capture]", &["mode", "ankle_height", "mask_depth"]),
+    (
+        "in a [[material]] table",
+        &[
+            "name",
+            "like",
+            "repose_degrees",
+            "relax_steps",
+            "settle_updates",
+        ],
+    ),
     (
         "in a [[surface]] table",
         &[

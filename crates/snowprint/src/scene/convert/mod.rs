@@ -16,6 +16,7 @@ use crate::world::CaptureConfig;
 
 mod camera;
 mod deformer;
+mod material;
 mod mesh;
 mod surface;
 mod values;
@@ -53,12 +54,13 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
         None => CaptureConfig::default(),
     };
 
+    let materials = material::materials(src, raw.material)?;
     let mut names = HashMap::new();
     let surface_spans: Vec<Range<usize>> = raw.surface.iter().map(Spanned::span).collect();
     let (surfaces, zones): (Vec<SurfaceDesc>, Vec<u32>) = raw
         .surface
         .into_iter()
-        .map(|s| surface(src, s, &mut names))
+        .map(|s| surface(src, s, &mut names, &materials))
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .unzip();

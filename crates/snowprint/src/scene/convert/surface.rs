@@ -83,6 +83,7 @@ pub(super) fn surface(
     src: &Source<'_>,
     s: Spanned<RawSurface>,
     names: &mut HashMap<String, usize>,
+    materials: &HashMap<String, Material>,
 ) -> Result<(SurfaceDesc, u32)> {
     let table = s.span();
     let s = s.into_inner();
@@ -185,13 +186,7 @@ pub(super) fn surface(
     };
 
     let material = match &s.material {
-        Some(m) => Material::named(m.get_ref()).ok_or_else(|| {
-            src.error(
-                &m.span(),
-                format!("{who} has material {}", src.quote(&m.span())),
-                "material must be one of \"snow\", \"packed_snow\", \"powder\", \"sand\", \"mud\"",
-            )
-        })?,
+        Some(m) => super::material::named(src, m, &who, materials)?,
         None => Material::snow(),
     };
     let desc = SurfaceDesc {
