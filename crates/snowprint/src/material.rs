@@ -194,8 +194,8 @@ impl MaterialLook {
     /// Dry sand: warm, fine grained, with a lighter, drier (rougher) layer kicked up in prints.
     pub const fn sand() -> Self {
         Self {
-            albedo: [0.56, 0.44, 0.30],
-            disturbed_albedo: [0.70, 0.58, 0.42],
+            albedo: [0.50, 0.38, 0.24],
+            disturbed_albedo: [0.60, 0.47, 0.31],
             roughness: 0.88,
             wet_roughness: 0.95,
             grain: 0.8,
@@ -209,8 +209,8 @@ impl MaterialLook {
     /// Wet mud: dark brown, darker and glossy where pressed, water in prints deeper than 6 cm.
     pub const fn mud() -> Self {
         Self {
-            albedo: [0.22, 0.16, 0.11],
-            disturbed_albedo: [0.15, 0.10, 0.07],
+            albedo: [0.11, 0.08, 0.055],
+            disturbed_albedo: [0.075, 0.05, 0.035],
             roughness: 0.7,
             wet_roughness: 0.22,
             grain: 0.3,

@@ -324,7 +324,6 @@ fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f3
 }
 
 // Height above the ground of the water table (`grain.w` below the top), or -1 without water.
-// Must match `water_level` in cpu.rs.
 fn snow_water_level(s: SnowSurface) -> f32 {
     if s.grain.w <= 0.0 {
         return -1.0;
@@ -488,18 +487,18 @@ fn snow_grain_speckle(s: SnowSurface, q: vec2<f32>, pixel: f32) -> f32 {
     return 1.0 + s.grain.x * (0.35 * keep * fine + 0.3 * keep_coarse * coarse);
 }
 
-// Glints of single grains: each cell of a lattice fixed in the world (`q`, 1.2 cm) holds at most
+// Glints of single grains: each cell of a lattice fixed in the world (`q`, 2.5 cm) holds at most
 // one grain, at a random spot with a random facet tilted from the surface normal `n`; it flashes
 // when that facet mirrors the light `l` into the eye `v` (all local, unit). So the glints are view
 // dependent but fixed per grain: a still camera sees the same grains flash every frame, a moving
 // one sees them come and go as a real snowfield does. Cells smaller than a pixel fade out (no
 // screen-space noise). Returns the glint's intensity, to be multiplied by the light.
 fn snow_sparkle(q: vec2<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, pixel: f32) -> f32 {
-    let cell_size = 0.012;
+    let cell_size = 0.025;
     let p = q / cell_size;
     let cell = vec2<i32>(floor(p));
     let a = snow_hash2(cell);
-    if a > 0.25 {
+    if a > 0.4 {
         return 0.0;
     }
     let spot = vec2<f32>(snow_hash2(cell + vec2<i32>(7919, 0)), snow_hash2(cell + vec2<i32>(0, 7919)));
@@ -512,8 +511,8 @@ fn snow_sparkle(q: vec2<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, pixel: f
     );
     let facet = normalize(n + 0.9 * tilt);
     let h = normalize(l + v);
-    let mirror = smoothstep(0.97, 0.995, dot(facet, h));
-    let fade = 1.0 - smoothstep(0.5 * cell_size, 1.5 * cell_size, pixel);
+    let mirror = smoothstep(0.95, 0.99, dot(facet, h));
+    let fade = 1.0 - smoothstep(cell_size, 3.0 * cell_size, pixel);
     return 40.0 * mirror * dot_size * fade * max(dot(n, l), 0.0);
 }
 
@@ -521,7 +520,7 @@ fn snow_sparkle(q: vec2<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, pixel: f
 // `mirror`), tinted by the mud under it.
 fn snow_water(s: SnowSurface, hf: vec4<f32>) -> SnowSample {
     var m: SnowSample;
-    m.albedo = s.disturbed.xyz * 0.25;
+    m.albedo = s.disturbed.xyz * 0.5;
     m.roughness = 0.06;
     m.normal = vec3<f32>(0.0, 1.0, 0.0);
     m.f0 = 0.02;

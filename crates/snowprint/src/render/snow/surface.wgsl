@@ -192,6 +192,9 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
 fn deformable_view(shaded: vec3<f32>, m: SnowSample, depression: f32, taps: f32) -> vec3<f32> {
     switch frame.options.x {
         case DEBUG_MATERIALS: {
+            if m.mirror > 0.5 {
+                return vec3<f32>(0.0, 0.9, 1.0);   // water
+            }
             return mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
         }
         case DEBUG_DEPRESSION: {
