@@ -9,7 +9,7 @@
 mod common;
 mod golden_support;
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use golden_support::{bless, check, score, tolerance};
 use snowprint::render::{
     DebugView, Environment, PointLight, RenderConfig, RenderFrame, RenderOutput, Renderer, Tier,
@@ -136,7 +136,7 @@ fn print_pixels(at: [f32; 2], y: f32, scale: f32) -> ([f32; 2], [f32; 2]) {
             at[1] + sz * SOLE.z * scale,
             1.0,
         );
-        let clip = Mat4::from(view_proj) * p;
+        let clip = view_proj * p;
         let ndc = clip.truncate() / clip.w;
         let px = [
             (ndc.x * 0.5 + 0.5) * WIDTH as f32,

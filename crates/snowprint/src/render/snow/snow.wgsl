@@ -31,7 +31,8 @@
 //   let hf = snow_heightfield(s, snow_uv(s, hit.position.xz));
 //   let m = snow_deformable(s, hit, hf, face_normal, sky_tint, pixel);
 //   ... light m.albedo, m.roughness, m.normal (local frame), m.ao with your own lights, times
-//   hit.shadow ...
+//   hit.shadow; add the material's glints (m.sparkle, `snow_sparkle`) and, on water
+//   (m.mirror, hit.water), your sky mirrored through `snow_water_reflection` ...
 // or, for a surface nothing has pressed yet, the cheaper `snow_basic(s, local_position,
 // face_normal, sky_tint, pixel)`. Nothing here needs derivatives, so compute shaders may call it
 // too (a `discard` is a fragment shader's; a compute shader tests `hit.found` instead).
