@@ -71,7 +71,7 @@ pub use heightmap::Heightmap;
 pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
 };
-pub use material::Material;
+pub use material::{Material, MaterialLook};
 pub use mesh::{
     MAX_GLTF_DEPTH, MAX_GLTF_FILE_BYTES, MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_GLTF_VERTICES,
     Mesh, MeshId,

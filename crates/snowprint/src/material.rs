@@ -10,9 +10,13 @@
 
 use crate::error::{Result, SnowError};
 
-/// How a surface's material moves after it is pressed.
+/// How a surface's material moves after it is pressed, and how it looks.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Material {
+    /// How it looks: albedos, roughness, grain, sparkle, wetness and water (the renderer's
+    /// `snow.wgsl` reads them per surface). Absent from older saves: the talk's snow.
+    #[serde(default)]
+    pub look: MaterialLook,
     /// Steepest slope the material stands at, degrees above the horizontal (0 to 90); `None`:
     /// walls stand whatever their slope (the talk's snow, packed snow, mud).
     pub repose_degrees: Option<f32>,
@@ -34,20 +38,22 @@ impl Material {
     /// The talk's snow: prints keep their walls (no relaxation).
     pub const fn snow() -> Self {
         Self {
+            look: MaterialLook::snow(),
             repose_degrees: None,
             relax_steps: 0,
             settle_updates: 0,
         }
     }
 
-    /// Packed snow: crisp edges, no slumping.
+    /// Packed snow: crisp edges, no slumping; the look of the talk's snow.
     pub const fn packed_snow() -> Self {
         Self::snow()
     }
 
-    /// Fresh powder: walls steeper than 60 degrees crumble, slowly.
+    /// Fresh powder: walls steeper than 60 degrees crumble, slowly; it sparkles.
     pub const fn powder() -> Self {
         Self {
+            look: MaterialLook::powder(),
             repose_degrees: Some(60.0),
             relax_steps: 2,
             settle_updates: 30,
@@ -57,15 +63,19 @@ impl Material {
     /// Dry sand: slumps back into a print until its walls stand at 34 degrees.
     pub const fn sand() -> Self {
         Self {
+            look: MaterialLook::sand(),
             repose_degrees: Some(34.0),
             relax_steps: 8,
             settle_updates: 120,
         }
     }
 
-    /// Wet mud: keeps a sharp print.
+    /// Wet mud: keeps a sharp print; water gathers in the deep ones.
     pub const fn mud() -> Self {
-        Self::snow()
+        Self {
+            look: MaterialLook::mud(),
+            ..Self::snow()
+        }
     }
 
     /// The preset named `name` (`snow`, `packed_snow`, `powder`, `sand`, `mud`).
@@ -106,12 +116,147 @@ impl Material {
                 expected: "degrees from 0 to 90",
             });
         }
+        self.look.validate(name)?;
         if self.relax_steps > 64 {
             return Err(SnowError::InvalidSurface {
                 name: name.to_owned(),
                 what: "material relax_steps",
                 value: self.relax_steps.to_string(),
                 expected: "at most 64 steps an update",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// How a surface's material looks: what `snow.wgsl` blends by the depression at each point.
+/// "Undisturbed" is the untouched top; "disturbed" the material at the bottom of a print (blended
+/// in from 5 % to 80 % of the depth pressed). The defaults are the talk's snow, drawn bit for bit as
+/// before materials existed.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct MaterialLook {
+    /// Diffuse albedo of the untouched material (linear RGB, 0 to 1).
+    pub albedo: [f32; 3],
+    /// Diffuse albedo of the disturbed material at the bottom of prints.
+    pub disturbed_albedo: [f32; 3],
+    /// Perceptual roughness of the untouched (dry) material.
+    pub roughness: f32,
+    /// Perceptual roughness where pressed (wet, or compacted): blended in by the depression.
+    pub wet_roughness: f32,
+    /// Fine grain, 0 to 1: a per-grain speckle of the albedo and a fine normal, fixed in the world
+    /// (0 for snow, whose grain is the talk's detail normal).
+    pub grain: f32,
+    /// Glints of single crystals towards the moon, 0 to 1: view dependent, fixed per grain in the
+    /// world so that they do not shimmer from frame to frame.
+    pub sparkle: f32,
+    /// How wet the pressed material gets, 0 to 1: darker and more specular at the bottom of prints.
+    pub wetness: f32,
+    /// How much light passes through it, 0 to 1: the talk's fake subsurface scattering (the sky
+    /// tint of prints' walls) and the diffuse wrap. 1 for snow, 0 for sand and mud.
+    pub translucency: f32,
+    /// Depth below the untouched top, metres, of the water table: prints deeper than this fill
+    /// with a flat water surface up to it (mud); `None`: no water.
+    pub water_depth: Option<f32>,
+}
+
+impl Default for MaterialLook {
+    fn default() -> Self {
+        Self::snow()
+    }
+}
+
+impl MaterialLook {
+    /// The talk's snow: bright, faintly blue, greyer and smoother where packed; no sparkle.
+    pub const fn snow() -> Self {
+        Self {
+            albedo: [0.86, 0.89, 0.93],
+            disturbed_albedo: [0.66, 0.71, 0.78],
+            roughness: 0.62,
+            wet_roughness: 0.5,
+            grain: 0.0,
+            sparkle: 0.0,
+            wetness: 0.0,
+            translucency: 1.0,
+            water_depth: None,
+        }
+    }
+
+    /// Fresh powder: the snow's look, brighter where untouched, with glints.
+    pub const fn powder() -> Self {
+        Self {
+            albedo: [0.88, 0.91, 0.95],
+            sparkle: 0.8,
+            ..Self::snow()
+        }
+    }
+
+    /// Dry sand: warm, fine grained, with a lighter, drier (rougher) layer kicked up in prints.
+    pub const fn sand() -> Self {
+        Self {
+            albedo: [0.50, 0.38, 0.24],
+            disturbed_albedo: [0.60, 0.47, 0.31],
+            roughness: 0.88,
+            wet_roughness: 0.95,
+            grain: 0.8,
+            sparkle: 0.0,
+            wetness: 0.0,
+            translucency: 0.0,
+            water_depth: None,
+        }
+    }
+
+    /// Wet mud: dark brown, darker and glossy where pressed, water in prints deeper than 6 cm.
+    pub const fn mud() -> Self {
+        Self {
+            albedo: [0.11, 0.08, 0.055],
+            disturbed_albedo: [0.075, 0.05, 0.035],
+            roughness: 0.7,
+            wet_roughness: 0.22,
+            grain: 0.3,
+            sparkle: 0.0,
+            wetness: 0.9,
+            translucency: 0.0,
+            water_depth: Some(0.06),
+        }
+    }
+
+    /// Check every field, naming the first that is wrong (for surface `name`).
+    pub fn validate(&self, name: &str) -> Result<()> {
+        let unit = |what: &'static str, v: f32| {
+            if v.is_finite() && (0.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                Err(SnowError::InvalidSurface {
+                    name: name.to_owned(),
+                    what,
+                    value: v.to_string(),
+                    expected: "a number from 0 to 1",
+                })
+            }
+        };
+        for (what, c) in [
+            ("material albedo", self.albedo),
+            ("material disturbed_albedo", self.disturbed_albedo),
+        ] {
+            for v in c {
+                unit(what, v)?;
+            }
+        }
+        unit("material roughness", self.roughness)?;
+        unit("material wet_roughness", self.wet_roughness)?;
+        unit("material grain", self.grain)?;
+        unit("material sparkle", self.sparkle)?;
+        unit("material wetness", self.wetness)?;
+        unit("material translucency", self.translucency)?;
+        if let Some(d) = self.water_depth
+            && !(d.is_finite() && d > 0.0)
+        {
+            return Err(SnowError::InvalidSurface {
+                name: name.to_owned(),
+                what: "material water_depth",
+                value: d.to_string(),
+                expected: "metres above 0",
             });
         }
         Ok(())

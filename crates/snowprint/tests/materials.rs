@@ -226,3 +226,29 @@ fn scene_files_define_their_own_materials() {
     assert!(e.contains("wet_sand") && e.contains("\"sand\""), "{e}");
     assert!(!e.contains('\n'), "one line: {e}");
 }
+
+/// The looks are data: every preset's look is valid, snow's is the talk's constants (what
+/// `snow.wgsl` drew before materials, so the old goldens hold bit for bit), and a wrong field is
+/// refused by name.
+#[test]
+fn material_looks_are_valid_data_and_snow_keeps_the_talks_look() {
+    for name in ["snow", "packed_snow", "powder", "sand", "mud"] {
+        let m = Material::named(name).expect("preset");
+        m.validate(name).expect("valid preset");
+    }
+    let snow = Material::snow().look;
+    assert_eq!(snow.albedo, [0.86, 0.89, 0.93]);
+    assert_eq!(snow.disturbed_albedo, [0.66, 0.71, 0.78]);
+    assert_eq!((snow.roughness, snow.wet_roughness), (0.62, 0.5));
+    assert_eq!((snow.grain, snow.sparkle, snow.wetness), (0.0, 0.0, 0.0));
+    assert_eq!((snow.translucency, snow.water_depth), (1.0, None));
+    assert!(Material::mud().look.water_depth.is_some());
+    let mut bad = Material::sand();
+    bad.look.sparkle = 1.5;
+    let e = bad.validate("beach").expect_err("sparkle 1.5");
+    assert!(e.to_string().contains("sparkle"), "{e}");
+    let mut bad = Material::mud();
+    bad.look.water_depth = Some(-0.1);
+    let e = bad.validate("track").expect_err("negative water depth");
+    assert!(e.to_string().contains("water_depth"), "{e}");
+}

@@ -61,7 +61,7 @@ pub enum DebugView {
     /// The shaded frame.
     #[default]
     Shaded,
-    /// Basic material green; deformable orange, ground brown, transition blue.
+    /// Basic material green; deformable orange, ground brown, transition blue, water cyan.
     Materials,
     /// Depression of the heightmap at the hit.
     Depression,

@@ -20,6 +20,9 @@ pub const STATE_DEEPEST: u64 = 12;
 pub const BOX_VERTICES: u32 = 30;
 /// Alignment of uniform blocks addressed by offset.
 pub const UNIFORM_STRIDE: u64 = crate::gpu::resources::UNIFORM_STRIDE;
+/// Spacing of the per-surface [`SurfaceUniform`] blocks in the snow pass's buffer, bytes: two
+/// [`UNIFORM_STRIDE`]s, since the material's look made the struct outgrow one.
+pub const SURFACE_STRIDE: u64 = 2 * UNIFORM_STRIDE;
 /// Point lights the frame uniform holds.
 pub const MAX_POINT_LIGHTS: usize = crate::wgsl::consts::MAX_POINT_LIGHTS as usize;
 
@@ -115,6 +118,14 @@ pub struct SurfaceUniform {
     pub texel_x: f32,
     /// Texel side along local z, metres.
     pub texel_z: f32,
+    /// The material's look ([`crate::MaterialLook`]): untouched albedo (xyz), dry roughness (w).
+    pub albedo: [f32; 4],
+    /// Disturbed albedo at the bottom of prints (xyz), wet roughness (w).
+    pub disturbed: [f32; 4],
+    /// Grain, sparkle, wetness, water depth below the top in metres (0: no water).
+    pub grain: [f32; 4],
+    /// Translucency (x: the sky tint of prints' walls and the diffuse wrap); yzw unused.
+    pub translucency: [f32; 4],
 }
 
 impl SurfaceUniform {
@@ -147,6 +158,7 @@ impl SurfaceUniform {
         let texel_z = desc.size.y / layout.height as f32;
         let local_to_world = desc.local_to_world();
         let (search, look) = (&shading.search, &shading.look);
+        let m = &desc.material.look;
         Self {
             local_to_world: local_to_world.to_cols_array_2d(),
             world_to_local: local_to_world.inverse().to_cols_array_2d(),
@@ -182,7 +194,25 @@ impl SurfaceUniform {
             height: layout.height,
             texel_x,
             texel_z,
+            albedo: [m.albedo[0], m.albedo[1], m.albedo[2], m.roughness],
+            disturbed: [
+                m.disturbed_albedo[0],
+                m.disturbed_albedo[1],
+                m.disturbed_albedo[2],
+                m.wet_roughness,
+            ],
+            grain: [m.grain, m.sparkle, m.wetness, m.water_depth.unwrap_or(0.0)],
+            translucency: [m.translucency, 0.0, 0.0, 0.0],
         }
+    }
+
+    /// Block `index` of a buffer of these, [`SURFACE_STRIDE`] apart, as a binding.
+    pub(crate) fn block(buffer: &wgpu::Buffer, index: usize) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer,
+            offset: index as u64 * SURFACE_STRIDE,
+            size: std::num::NonZeroU64::new(std::mem::size_of::<Self>() as u64),
+        })
     }
 }
 
@@ -394,6 +424,13 @@ mod tests {
             ("search", std::mem::offset_of!(SurfaceUniform, search)),
             ("look", std::mem::offset_of!(SurfaceUniform, look)),
             ("pattern", std::mem::offset_of!(SurfaceUniform, pattern)),
+            ("albedo", std::mem::offset_of!(SurfaceUniform, albedo)),
+            ("disturbed", std::mem::offset_of!(SurfaceUniform, disturbed)),
+            ("grain", std::mem::offset_of!(SurfaceUniform, grain)),
+            (
+                "translucency",
+                std::mem::offset_of!(SurfaceUniform, translucency),
+            ),
         ];
         for (name, offset) in offsets {
             let m = members
@@ -432,7 +469,11 @@ mod tests {
             width,
             height,
             texel_x,
-            texel_z
+            texel_z,
+            albedo,
+            disturbed,
+            grain,
+            translucency
         );
         for (source, name) in [
             (&engine, "snowprint_Surface"),
@@ -450,7 +491,7 @@ mod tests {
                 assert_eq!((*field, *offset), (member.as_str(), *at as usize), "{name}");
             }
         }
-        assert!(std::mem::size_of::<SurfaceUniform>() as u64 <= UNIFORM_STRIDE);
+        assert!(std::mem::size_of::<SurfaceUniform>() as u64 <= SURFACE_STRIDE);
     }
 
     #[test]

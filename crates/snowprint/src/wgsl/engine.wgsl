@@ -35,6 +35,10 @@ struct snowprint_Surface {
     height: u32,            // texels along local z
     texel_x: f32,           // texel side along local x, metres
     texel_z: f32,           // texel side along local z, metres
+    albedo: vec4<f32>,      // the material's look (snow.wgsl): untouched albedo, dry roughness
+    disturbed: vec4<f32>,   // disturbed albedo, wet roughness
+    grain: vec4<f32>,       // grain, sparkle, wetness, water depth (metres, 0: none)
+    translucency: vec4<f32>, // translucency; yzw unused
 }
 
 @group(0) @binding(0) var<storage, read> snowprint_pool: array<u32>;

@@ -7,7 +7,7 @@
 use super::config::RenderConfig;
 use super::frame::FrameSurface;
 use super::gpu::{
-    STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, Shading, SurfaceUniform, UNIFORM_STRIDE,
+    STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, SURFACE_STRIDE, Shading, SurfaceUniform,
 };
 use super::graph::PASSES;
 use super::heightfield::HeightfieldPass;
@@ -16,7 +16,7 @@ use super::readback::{Timestamps, render_span};
 use super::targets::{KEEP, Targets};
 use super::tessellate::dice::DicePass;
 use super::tessellate::snow_shadow::TessSurface;
-use crate::gpu::resources::{Growable, bind_group, uniform_block};
+use crate::gpu::resources::{Growable, bind_group};
 use crate::view::GroundMaterial;
 
 pub(super) struct SnowPass {
@@ -64,7 +64,7 @@ impl SnowPass {
                 device,
                 "snow surfaces",
                 wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                UNIFORM_STRIDE * 8,
+                SURFACE_STRIDE * 8,
             ),
             layout,
             basic,
@@ -73,7 +73,7 @@ impl SnowPass {
         }
     }
 
-    /// Upload each surface's uniform (transform, grid, ground, search and look) and bind it with
+    /// Upload each surface's uniform (transform, grid, ground, search, look and its material's look) and bind it with
     /// its heightfield textures.
     pub(super) fn prepare(
         &mut self,
@@ -85,7 +85,7 @@ impl SnowPass {
     ) {
         let search = cfg.search_settings();
         let look = cfg.look;
-        let stride = UNIFORM_STRIDE as usize;
+        let stride = SURFACE_STRIDE as usize;
         let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
         for (s, surface) in surfaces.iter().enumerate() {
             let shading = Shading {
@@ -117,11 +117,7 @@ impl SnowPass {
                     "snow surface",
                     &self.layout,
                     &[
-                        uniform_block(
-                            &self.uniforms.buffer,
-                            s,
-                            std::mem::size_of::<SurfaceUniform>(),
-                        ),
+                        SurfaceUniform::block(&self.uniforms.buffer, s),
                         wgpu::BindingResource::TextureView(&tex.shape),
                         wgpu::BindingResource::TextureView(&tex.light),
                     ],

@@ -31,7 +31,8 @@
 //   let hf = snow_heightfield(s, snow_uv(s, hit.position.xz));
 //   let m = snow_deformable(s, hit, hf, face_normal, sky_tint, pixel);
 //   ... light m.albedo, m.roughness, m.normal (local frame), m.ao with your own lights, times
-//   hit.shadow ...
+//   hit.shadow; add the material's glints (m.sparkle, `snow_sparkle`) and, on water
+//   (m.mirror, hit.water), your sky mirrored through `snow_water_reflection` ...
 // or, for a surface nothing has pressed yet, the cheaper `snow_basic(s, local_position,
 // face_normal, sky_tint, pixel)`. Nothing here needs derivatives, so compute shaders may call it
 // too (a `discard` is a fragment shader's; a compute shader tests `hit.found` instead).
@@ -61,6 +62,11 @@ struct SnowSurface {
     height: u32,            // texels along z
     texel_x: f32,           // texel side along x, metres
     texel_z: f32,           // texel side along z, metres
+    // The surface's material look (`MaterialLook` in src/material.rs).
+    albedo: vec4<f32>,      // xyz: untouched albedo, w: dry roughness
+    disturbed: vec4<f32>,   // xyz: disturbed albedo at the bottom of prints, w: wet roughness
+    grain: vec4<f32>,       // x: grain, y: sparkle, z: wetness, w: water depth below the top (m, 0: none)
+    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), yzw unused
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
@@ -79,6 +85,7 @@ struct SnowHit {
     taps: u32,              // heightfield taps spent (debug view)
     side: u32,              // 1: met at the entry on a side face (a cut through the snow)
     shadow: f32,            // self-shadow of the heightfield towards the light, 1 = lit
+    water: u32,             // 1: met the flat water filling a print deeper than the water depth
 }
 
 // What the material gives to lighting.
@@ -91,6 +98,8 @@ struct SnowSample {
     ground: f32,            // weight of the flattened-ground stage (0 = snow)
     transition: f32,        // weight of the transition zone (the fake subsurface scattering)
     wrap: f32,              // diffuse wrap (light bleeding through snow), 0 for hard surfaces
+    sparkle: f32,           // strength of the grains' glints here (`snow_sparkle`), 0 = none
+    mirror: f32,            // weight of the sky's mirror reflection (1 on water)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -315,6 +324,14 @@ fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f3
     return lit;
 }
 
+// Height above the ground of the water table (`grain.w` below the top), or -1 without water.
+fn snow_water_level(s: SnowSurface) -> f32 {
+    if s.grain.w <= 0.0 {
+        return -1.0;
+    }
+    return s.snow_depth - s.grain.w;
+}
+
 // Trace the view ray entering the surface's box at local `o` with unit local direction `d`.
 fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_local: vec3<f32>) -> SnowHit {
     // The rasterized point can lie a hair outside the box: pull it in.
@@ -335,8 +352,18 @@ fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_lo
     hit.t = r.x;
     hit.found = u32(r.y);
     hit.position = o + d * r.x;
+    hit.water = 0u;
     if r.x == 0.0 && o.y < s.snow_depth - 1e-3 {
         hit.side = 1u;
+    }
+    // Water: a hit below the water table lies in a print deeper than it; the view ray met the
+    // flat water surface first, where it crossed the level (in the air over the print, since the
+    // search found no material before the hit).
+    let level = snow_water_level(s);
+    if hit.found == 1u && hit.side == 0u && hit.position.y < level && d.y < 0.0 {
+        hit.t = max((level - o.y) / d.y, 0.0);
+        hit.position = o + d * hit.t;
+        hit.water = 1u;
     }
     if hit.found == 1u && hit.side == 0u {
         hit.shadow = snow_light_visibility(s, snow_uv(s, hit.position.xz));
@@ -445,9 +472,74 @@ fn snow_ground_layer(s: SnowSurface, p: vec2<f32>, pixel: f32) -> SnowLayer {
     return snow_roof_tiles(p, pixel);
 }
 
-// Fresh snow: bright, faintly blue; packed snow at the bottom of prints: greyer and smoother.
+// The talk's fresh snow (`MaterialLook::snow`'s albedo), for the snow cover of meshes.
 const SNOW_FRESH: vec3<f32> = vec3<f32>(0.86, 0.89, 0.93);
-const SNOW_PACKED: vec3<f32> = vec3<f32>(0.66, 0.71, 0.78);
+
+// ---------------------------------------------------------------------------------------------
+// The material's look (`MaterialLook`): grain, wetness, glints and water.
+
+// Fine grain (sand, mud): a per-grain speckle of the albedo, cells of 2.5 mm fixed in the world,
+// faded to its mean once a cell is smaller than about half a pixel. Multiplies the albedo.
+fn snow_grain_speckle(s: SnowSurface, q: vec2<f32>, pixel: f32) -> f32 {
+    let fine = snow_hash2(vec2<i32>(floor(q * 400.0))) - 0.5;
+    let coarse = snow_noise(q * 60.0).x - 0.5;
+    let keep = 1.0 - smoothstep(0.003, 0.012, pixel);
+    let keep_coarse = 1.0 - smoothstep(0.01, 0.04, pixel);
+    return 1.0 + s.grain.x * (0.35 * keep * fine + 0.3 * keep_coarse * coarse);
+}
+
+// Glints of single grains: each cell of a lattice fixed in the world (`q`, 2.5 cm) holds at most
+// one grain, at a random spot with a random facet tilted from the surface normal `n`; it flashes
+// when that facet mirrors the light `l` into the eye `v` (all local, unit). So the glints are view
+// dependent but fixed per grain: a still camera sees the same grains flash every frame, a moving
+// one sees them come and go as a real snowfield does. Cells smaller than a pixel fade out (no
+// screen-space noise). Returns the glint's intensity, to be multiplied by the light.
+fn snow_sparkle(q: vec2<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, pixel: f32) -> f32 {
+    let cell_size = 0.025;
+    let p = q / cell_size;
+    let cell = vec2<i32>(floor(p));
+    let a = snow_hash2(cell);
+    if a > 0.4 {
+        return 0.0;
+    }
+    let spot = vec2<f32>(snow_hash2(cell + vec2<i32>(7919, 0)), snow_hash2(cell + vec2<i32>(0, 7919)));
+    let r = length(fract(p) - (0.2 + 0.6 * spot));
+    let dot_size = 1.0 - smoothstep(0.12, 0.3, r);
+    let tilt = vec3<f32>(
+        snow_hash2(cell + vec2<i32>(31, 17)) - 0.5,
+        snow_hash2(cell + vec2<i32>(53, 91)) - 0.5,
+        snow_hash2(cell + vec2<i32>(97, 13)) - 0.5,
+    );
+    let facet = normalize(n + 0.9 * tilt);
+    let h = normalize(l + v);
+    let mirror = smoothstep(0.95, 0.99, dot(facet, h));
+    let fade = 1.0 - smoothstep(cell_size, 3.0 * cell_size, pixel);
+    return 40.0 * mirror * dot_size * fade * max(dot(n, l), 0.0);
+}
+
+// The flat water filling a deep print: dark, smooth, a mirror of the sky (added in lighting from
+// `mirror`), tinted by the mud under it.
+fn snow_water(s: SnowSurface, hf: vec4<f32>) -> SnowSample {
+    var m: SnowSample;
+    m.albedo = s.disturbed.xyz * 0.5;
+    m.roughness = 0.06;
+    m.normal = vec3<f32>(0.0, 1.0, 0.0);
+    m.f0 = 0.02;
+    m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z);
+    m.ground = 0.0;
+    m.transition = 0.0;
+    m.wrap = 0.0;
+    m.sparkle = 0.0;
+    m.mirror = 1.0;
+    return m;
+}
+
+// The sky mirrored by water: Schlick's Fresnel of water (f0 0.02) times the sky in the reflected
+// direction `sky` (the caller's sky radiance there), for `cos_v` the cosine of the view angle.
+fn snow_water_reflection(sky: vec3<f32>, cos_v: f32) -> vec3<f32> {
+    let f = 0.02 + 0.98 * pow(1.0 - clamp(cos_v, 0.0, 1.0), 5.0);
+    return sky * f;
+}
 
 // Albedo in the transition zone tinted with the sky, to fake light scattered under the snow (the
 // talk's fake SSS). `sky` is the sky colour scaled to a luminance near 1.
@@ -490,21 +582,27 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>, pix
     m.ao = 1.0;
     m.ground = 0.0;
     m.f0 = 0.02;
-    m.wrap = 0.35;
+    m.wrap = 0.35 * s.translucency.x;
+    m.mirror = 0.0;
+    m.sparkle = 0.0;
     if face.y > 0.5 {
         let n = snow_combine(s, snow_macro_normal(q), snow_detail_normal(q, 1.0, pixel));
         m.normal = snow_ts_to_local(n);
-        m.albedo = SNOW_FRESH;
-        m.roughness = 0.62;
+        m.albedo = s.albedo.xyz;
+        if s.grain.x > 0.0 {
+            m.albedo *= snow_grain_speckle(s, q, pixel);
+        }
+        m.roughness = s.albedo.w;
         m.transition = 0.0;
+        m.sparkle = s.grain.y;
     } else {
         // The cut through the snow at an open edge: faint layers of successive snowfalls.
         let along = dot(p.xz, vec2<f32>(-face.z, face.x));
         let layers = snow_noise(vec2<f32>(along * 2.0, p.y * 40.0)).x;
         m.normal = face;
-        m.albedo = SNOW_FRESH * (0.85 + 0.1 * layers);
+        m.albedo = s.albedo.xyz * (0.85 + 0.1 * layers);
         m.roughness = 0.8;
-        m.transition = 0.45;
+        m.transition = 0.45 * s.translucency.x;
         m.ao = mix(0.6, 1.0, clamp(p.y / max(s.snow_depth, 1e-3), 0.0, 1.0));
     }
     m.albedo = snow_tint(s, m.albedo, m.transition, sky);
@@ -515,6 +613,9 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>, pix
 // blended by the heightmap at the relief hit. `hf` is `snow_heightfield` at the hit, `face` the
 // entry face's local normal, `pixel` the pixel's footprint in metres.
 fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>, sky: vec3<f32>, pixel: f32) -> SnowSample {
+    if hit.water == 1u {
+        return snow_water(s, hf);
+    }
     if hit.side == 1u {
         var cut = snow_basic(s, hit.position, face, sky, pixel);
         cut.ao = min(cut.ao, mix(1.0, hf.w, s.look.z));
@@ -528,7 +629,7 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     // Stage weights: how much ground shows, and the transition (walls and rims of prints).
     let ground = smoothstep(s.look.x, s.look.y, dep);
     let rim = smoothstep(0.01, 0.12, dep);
-    let transition = rim * (1.0 - ground) * (0.55 + 0.45 * (1.0 - smoothstep(0.3, 0.9, dep)));
+    let transition = rim * (1.0 - ground) * (0.55 + 0.45 * (1.0 - smoothstep(0.3, 0.9, dep))) * s.translucency.x;
 
     // Normals. The heightmap's normal is the base; on it, RNM puts the snow's macro wave (pressed
     // flat where the snow is packed) and its detail, or the ground's own normal where it shows.
@@ -552,16 +653,31 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
 
     // Diffuse and specular: a simple lerp between the stages, as in the talk. The ground is wet
     // where the snow was pressed onto it.
-    let snow_albedo = mix(SNOW_FRESH, SNOW_PACKED, smoothstep(0.05, 0.8, dep));
+    // The material's own albedo: untouched on top, disturbed at the bottom of prints; a wet
+    // material (mud) darkens and turns glossy quickly as it is pressed.
+    var snow_albedo = mix(s.albedo.xyz, s.disturbed.xyz, smoothstep(0.05, 0.8, dep));
+    var wet = dep;
+    var f0 = 0.02;
+    if s.grain.x > 0.0 {
+        snow_albedo *= snow_grain_speckle(s, q, pixel);
+    }
+    if s.grain.z > 0.0 {
+        let soaked = smoothstep(0.02, 0.3, dep) * s.grain.z;
+        wet = max(dep, soaked);
+        snow_albedo *= 1.0 - 0.35 * soaked;
+        f0 = mix(0.02, 0.03, soaked);
+    }
     let wet_ground = ground_layer.albedo * 0.8;
     var m: SnowSample;
     m.albedo = snow_tint(s, mix(snow_albedo, wet_ground, ground), transition, sky);
-    m.roughness = mix(mix(0.62, 0.5, dep), ground_layer.roughness * 0.55, ground);
-    m.f0 = mix(0.02, 0.05, ground);
+    m.roughness = mix(mix(s.albedo.w, s.disturbed.w, wet), ground_layer.roughness * 0.55, ground);
+    m.f0 = mix(f0, 0.05, ground);
+    m.sparkle = s.grain.y * (1.0 - smoothstep(0.05, 0.5, dep)) * (1.0 - ground);
+    m.mirror = 0.0;
     m.normal = snow_ts_to_local(n);
     m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z);
     m.ground = ground;
     m.transition = transition;
-    m.wrap = 0.35 * (1.0 - ground);
+    m.wrap = 0.35 * (1.0 - ground) * s.translucency.x;
     return m;
 }

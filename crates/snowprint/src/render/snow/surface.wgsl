@@ -136,11 +136,25 @@ fn sky_tint() -> vec3<f32> {
     return mix(vec3<f32>(1.0), frame.sss_tint.rgb, frame.sss_tint.w);
 }
 
-fn shade(m: SnowSample, local: vec3<f32>, shadow_in: f32) -> vec3<f32> {
+// Light a material sample at `local` (`pixel`: the pixel's footprint, metres): the frame's lights,
+// then the grains' glints towards the moon and the sky mirrored by water, where the material has
+// them (snow.wgsl's `snow_sparkle`, `snow_water_reflection`).
+fn shade(m: SnowSample, local: vec3<f32>, shadow_in: f32, pixel: f32) -> vec3<f32> {
     let world = (surface.local_to_world * vec4<f32>(local, 1.0)).xyz;
     let n = normalize((surface.local_to_world * vec4<f32>(m.normal, 0.0)).xyz);
     let shadow = moon_shadow(world, n) * shadow_in;
-    return light_surface(m.albedo, m.roughness, m.f0, n, world, m.ao, m.wrap, shadow);
+    var c = light_surface(m.albedo, m.roughness, m.f0, n, world, m.ao, m.wrap, shadow);
+    let v = normalize(frame.eye.xyz - world);
+    if m.sparkle > 0.0 {
+        let q = local.xz + surface.pattern.xy;
+        let glint = snow_sparkle(q, n, v, frame.moon_dir.xyz, pixel);
+        c += frame.moon_color.rgb * shadow * m.sparkle * glint;
+    }
+    if m.mirror > 0.0 {
+        let sky = sky_radiance(reflect(-v, n));
+        c += m.mirror * m.ao * snow_water_reflection(sky, dot(n, v));
+    }
+    return c;
 }
 
 struct SnowOut {
@@ -163,7 +177,7 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
     }
     let hf = snow_heightfield(surface, snow_uv(surface, hit.position.xz));
     let m = snow_deformable(surface, hit, hf, in.face, sky_tint(), pixel);
-    let c = deformable_view(shade(m, hit.position, hit.shadow), m, hf.x, f32(hit.taps) / 48.0);
+    let c = deformable_view(shade(m, hit.position, hit.shadow, pixel), m, hf.x, f32(hit.taps) / 48.0);
     var out: SnowOut;
     out.color = vec4<f32>(c, 1.0);
     let world = surface.local_to_world * vec4<f32>(hit.position, 1.0);
@@ -178,6 +192,9 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
 fn deformable_view(shaded: vec3<f32>, m: SnowSample, depression: f32, taps: f32) -> vec3<f32> {
     switch frame.options.x {
         case DEBUG_MATERIALS: {
+            if m.mirror > 0.5 {
+                return vec3<f32>(0.0, 0.9, 1.0);   // water
+            }
             return mix(vec3<f32>(1.0, 0.45, 0.1), vec3<f32>(0.35, 0.2, 0.1), m.ground) * (0.3 + 0.7 * m.ao) + vec3<f32>(0.0, 0.2, 0.9) * m.transition;
         }
         case DEBUG_DEPRESSION: {
@@ -201,8 +218,9 @@ fn deformable_view(shaded: vec3<f32>, m: SnowSample, depression: f32, taps: f32)
 // The basic snow material (the talk's first material): untouched snow, no heightmap, no search.
 @fragment
 fn fs_basic(in: SurfaceVarying) -> @location(0) vec4<f32> {
-    let m = snow_basic(surface, in.local, in.face, sky_tint(), length(fwidth(in.local)));
-    var c = shade(m, in.local, 1.0);
+    let pixel = length(fwidth(in.local));
+    let m = snow_basic(surface, in.local, in.face, sky_tint(), pixel);
+    var c = shade(m, in.local, 1.0, pixel);
     switch frame.options.x {
         case DEBUG_MATERIALS: {
             c = vec3<f32>(0.15, 0.8, 0.3) * (0.5 + 0.5 * m.normal.y);

@@ -5,7 +5,7 @@
 
 use super::VERTEX_BYTES;
 use super::dice::DicePass;
-use crate::gpu::resources::{bind_group, uniform_block};
+use crate::gpu::resources::bind_group;
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::SurfaceUniform;
 use crate::render::heightfield::HeightfieldPass;
@@ -105,7 +105,7 @@ impl TessSurface {
                     "tessellated snow surface",
                     &self.layout,
                     &[
-                        uniform_block(uniforms, s, std::mem::size_of::<SurfaceUniform>()),
+                        SurfaceUniform::block(uniforms, s),
                         tv(&tex.shape),
                         tv(&tex.light),
                         tv(&tex.bank),

@@ -136,8 +136,10 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
         hit.shadow = 1.0;
         hit.taps = 0u;
         hit.t = 0.0;
+        // No water in this tier yet: the diced surface has no water plane.
+        hit.water = 0u;
         m = snow_deformable(surface, hit, hf, vec3<f32>(0.0, 1.0, 0.0), sky_tint(), pixel);
     }
     // No search in this tier: no taps.
-    return vec4<f32>(deformable_view(shade(m, in.local, 1.0), m, hf.x, 0.0), 1.0);
+    return vec4<f32>(deformable_view(shade(m, in.local, 1.0, pixel), m, hf.x, 0.0), 1.0);
 }
