@@ -85,7 +85,7 @@ mod tests {
             age: 0.0,
         };
         let mut top: f32 = 0.0;
-        for _ in 0..60 {
+        for _ in 0..70 {
             p = integrate(&p, 1.0 / 60.0, 9.81, 1.0);
             top = top.max(p.position[1]);
         }
