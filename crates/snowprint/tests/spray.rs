@@ -3,7 +3,8 @@
 //! after), none on a still scene (a deformer resting in place after its first frame, with or
 //! without snow refilling), on the new snow top; they move as the reference step says; a frame's
 //! spawns past the ring's capacity are dropped and counted; and the update's heights are
-//! bit-identical with spray on or off.
+//! bit-identical with spray on or off; the renderer's `spray` pass draws them (a still is written
+//! to `target/tmp/spray/`).
 
 mod common;
 
@@ -249,4 +250,80 @@ fn bad_settings_are_refused_with_their_name() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("capacity"), "{e}");
+}
+
+/// A ball sliding fast across the yard, drawn by two renderers: one world with spray and one
+/// without, the same frames. The spray shows as grains over the print and nowhere else changes much;
+/// the still is written for a look.
+#[test]
+fn the_renderer_draws_the_spray_where_the_ball_slid() {
+    use snowprint::render::{Environment, PointLight, RenderConfig, RenderFrame, Renderer, Tier};
+    use snowprint::{Camera, GroundMaterial};
+    let desc = SurfaceDesc::new("yard", [0.0, 0.0, 0.0], [2.0, 2.0], DEPTH);
+    let mut worlds = [
+        world(Some(SprayConfig {
+            threshold: 0.02,
+            speed: 2.0,
+            ..SprayConfig::default()
+        })),
+        world(None),
+    ];
+    let ids: Vec<SurfaceId> = worlds
+        .iter_mut()
+        .map(|w| w.add_surface(desc.clone()).unwrap())
+        .collect();
+    for k in 0..10 {
+        let x = -0.7 + 0.1 * k as f32;
+        let d = [ball(&desc, x, 0.0, 0.12)];
+        for w in &mut worlds {
+            w.step(DT, &d).unwrap();
+        }
+    }
+    let (c, particles) = worlds[0].read_spray().unwrap().unwrap();
+    let alive = particles.iter().filter(|p| p.life > 0.0).count();
+    assert!(alive > 50, "{c:?}: {alive} alive");
+    let lights = [PointLight {
+        position: Vec3::new(0.5, 1.5, 1.0),
+        color: Vec3::new(3.0, 2.6, 2.0),
+        radius: 6.0,
+    }];
+    let mut images = Vec::new();
+    for (w, &id) in worlds.iter().zip(&ids) {
+        let mut config = RenderConfig::new(320, 180, Tier::Relief);
+        config.shadow_map_size = 512;
+        let mut r = Renderer::new(common::gpu(), config).unwrap();
+        let surfaces = [(id, GroundMaterial::Concrete)];
+        let frame = RenderFrame {
+            camera: Camera {
+                eye: Vec3::new(0.0, 0.9, 1.6),
+                target: Vec3::new(-0.1, 0.2, 0.0),
+                fov_y_degrees: 50.0,
+            },
+            time: 0.0,
+            surfaces: &surfaces,
+            instances: &[],
+            lights: &lights,
+            environment: Environment::moonlit_night(),
+            snowfall: false,
+        };
+        images.push(r.render(w, &frame).unwrap().rgba8);
+    }
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("spray");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, img) in [
+        ("with_spray.png", &images[0]),
+        ("without_spray.png", &images[1]),
+    ] {
+        image::save_buffer(dir.join(name), img, 320, 180, image::ColorType::Rgba8).unwrap();
+    }
+    let changed = images[0]
+        .chunks(4)
+        .zip(images[1].chunks(4))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    assert!(changed > 20, "the spray changed {changed} pixels");
+    assert!(
+        changed < 320 * 180 / 5,
+        "the spray changed {changed} pixels"
+    );
 }

@@ -41,6 +41,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("mesh", "render/opaque/mesh.wgsl", true),
     ("sky", "render/sky/sky.wgsl", true),
     ("snowfall", "render/snowfall/snowfall.wgsl", true),
+    ("spray", "render/spray/spray.wgsl", true),
     ("tonemap", "render/tonemap/tonemap.wgsl", true),
     ("classify", "render/classify/classify.wgsl", true),
     ("heightfield", "render/heightfield/heightfield.wgsl", true),
