@@ -48,8 +48,8 @@ pub fn integrate(p: &Particle, dt: f32, gravity: f32, drag: f32) -> Particle {
     }
     let mut out = *p;
     out.velocity = v;
-    for k in 0..3 {
-        out.position[k] += v[k] * dt;
+    for (x, dx) in out.position.iter_mut().zip(v) {
+        *x += dx * dt;
     }
     out.life = (p.life - dt).max(0.0);
     out.age = p.age + dt;

@@ -292,6 +292,7 @@ impl SprayGpu {
         device: &wgpu::Device,
         enc: &mut wgpu::CommandEncoder,
         inputs: &SpawnInputs<'_>,
+        queries: &mut crate::gpu::timestamps::StageQueries<'_>,
     ) {
         let sim_bg = bind_group(
             device,
@@ -305,7 +306,7 @@ impl SprayGpu {
         );
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("spray"),
-            timestamp_writes: None,
+            timestamp_writes: queries.compute("spray"),
         });
         pass.set_pipeline(&self.simulate);
         pass.set_bind_group(0, &sim_bg, &[]);

@@ -82,6 +82,8 @@ pub struct StageTimes {
     pub fused_ms: f64,
     /// The relaxation of slumping materials (see [`crate::Material`]).
     pub relax_ms: f64,
+    /// The kicked-up snow's pass (simulate, spawn, fold, place), with [`WorldConfig::spray`].
+    pub spray_ms: f64,
 }
 
 impl StageTimes {
@@ -93,6 +95,7 @@ impl StageTimes {
             + self.normals_ms
             + self.fused_ms
             + self.relax_ms
+            + self.spray_ms
     }
 }
 

@@ -162,7 +162,7 @@ impl SnowWorld {
                 self.record(encoder, &plan, &mut queries, (j, dt));
                 remember_captures(&mut self.scratch_cpu.captured, &plan);
             } else {
-                self.record_spray(encoder, &plan, j, dt);
+                self.record_spray(encoder, &plan, j, dt, &mut queries);
             }
             self.keep_carries(&plan.carries);
             self.keep_settles(&plan.settles);
@@ -443,7 +443,7 @@ impl SnowWorld {
             &self.meshes,
             queries,
         );
-        self.record_spray(enc, plan, layer.0, layer.1);
+        self.record_spray(enc, plan, layer.0, layer.1, queries);
         let accumulate_buffers = AccumulateBuffers {
             records: &self.records.buffer,
             capture: &self.capture.buffer,
@@ -514,6 +514,7 @@ fn stage_times(times: &[(&'static str, f64)]) -> StageTimes {
             "merge" => t.merge_ms += ms,
             "normals" => t.normals_ms += ms,
             "relax" => t.relax_ms += ms,
+            "spray" => t.spray_ms += ms,
             _ => t.fused_ms += ms,
         }
     }

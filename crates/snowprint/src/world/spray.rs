@@ -17,6 +17,7 @@ impl SnowWorld {
         plan: &FramePlan,
         layer: usize,
         dt: f32,
+        queries: &mut crate::gpu::timestamps::StageQueries<'_>,
     ) {
         let Some(spray) = self.spray.as_mut() else {
             return;
@@ -68,7 +69,7 @@ impl SnowWorld {
             max_width: acc.max_width,
             max_height: acc.max_height,
         };
-        spray.encode(device, enc, &inputs);
+        spray.encode(device, enc, &inputs, queries);
     }
 
     /// The kicked-up snow's ring, for an engine's own drawing: [`crate::SPRAY_RING_HEADER`] bytes
