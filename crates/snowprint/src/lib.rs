@@ -55,6 +55,7 @@ mod relax;
 pub mod render;
 pub mod scene;
 mod skin;
+mod spray;
 mod surface;
 mod view;
 pub mod wgsl;
@@ -79,6 +80,7 @@ pub use mesh::{
 pub use pool::{PoolFormat, Precision};
 pub use render::gpu::SurfaceUniform;
 pub use skin::{Playback, SkinnedMesh};
+pub use spray::{MAX_SPRAY_CAPACITY, Particle, SPRAY_RING_HEADER, SprayConfig, SprayCounters};
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
@@ -122,6 +124,10 @@ pub mod reference {
     /// The relaxation of materials with an angle of repose: one step, and the slope's threshold.
     pub mod relax {
         pub use crate::relax::cpu::*;
+    }
+    /// Kicked-up snow: which texels spawn, the ring's bookkeeping, a particle's step.
+    pub mod spray {
+        pub use crate::spray::cpu::*;
     }
     /// Skinning: a skeleton posed at an animation's time, joint matrices, skinned vertices.
     pub mod skin {

@@ -234,6 +234,8 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             fused_ms,
             // The bench's surfaces are the talk's snow, which never relaxes.
             relax_ms: _,
+            // Nor has spray.
+            spray_ms: _,
         } = t;
         cap.push(capture_ms * 1e3);
         blur.push(blur_ms * 1e3);

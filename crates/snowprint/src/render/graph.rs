@@ -15,6 +15,8 @@ pub enum Resource {
     FrameUniforms,
     /// Surfaces this frame with their transforms (uploaded by the CPU; outside the frame).
     SurfaceTable,
+    /// The world's kicked-up snow: its spray ring (from [`crate::SnowWorld`]; outside the frame).
+    SprayParticles,
     /// Per surface: material flag, indirect draw and dispatch arguments.
     SurfaceState,
     /// Per deformed surface: the filtered texture of (depression, normal, occlusion).
@@ -42,6 +44,7 @@ impl Resource {
                 | Resource::Instances
                 | Resource::FrameUniforms
                 | Resource::SurfaceTable
+                | Resource::SprayParticles
         )
     }
 }
@@ -93,13 +96,16 @@ pub mod pass {
     pub const SKY: usize = 8;
     /// Falling snow.
     pub const SNOWFALL: usize = 9;
+    /// Kicked-up snow (the world's spray; empty without it).
+    pub const SPRAY: usize = 10;
     /// Resolve and tonemap.
-    pub const TONEMAP: usize = 10;
+    pub const TONEMAP: usize = 11;
 }
 
 /// The passes of a frame, in the order they run. The tessellated tier's passes (`banks`, `dice`,
-/// `snow_shadow`) are encoded empty in the other tiers, so every tier reports the same list.
-pub const PASSES: [PassInfo; 11] = [
+/// `snow_shadow`) are encoded empty in the other tiers, and `spray` for a world without spray, so
+/// every tier reports the same list.
+pub const PASSES: [PassInfo; 12] = [
     PassInfo {
         name: "classify",
         kind: PassKind::Compute,
@@ -184,6 +190,12 @@ pub const PASSES: [PassInfo; 11] = [
         writes: &[R::SceneColor],
     },
     PassInfo {
+        name: "spray",
+        kind: PassKind::Render,
+        reads: &[R::SprayParticles, R::FrameUniforms, R::SceneDepth],
+        writes: &[R::SceneColor],
+    },
+    PassInfo {
         name: "tonemap",
         kind: PassKind::Render,
         reads: &[R::FrameUniforms, R::SceneColor, R::SceneDepth],
@@ -236,6 +248,7 @@ mod tests {
         assert_eq!(PASSES[pass::SNOW].name, "snow");
         assert_eq!(PASSES[pass::SKY].name, "sky");
         assert_eq!(PASSES[pass::SNOWFALL].name, "snowfall");
+        assert_eq!(PASSES[pass::SPRAY].name, "spray");
         assert_eq!(PASSES[pass::TONEMAP].name, "tonemap");
     }
 

@@ -12,6 +12,7 @@
 //! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth |
 //! | `sky` | depth | scene colour |
 //! | `snowfall` | depth | scene colour |
+//! | `spray` | the world's spray ring, depth | scene colour |
 //! | `tonemap` | scene colour, depth | the output |
 //!
 //! Each snow surface is drawn as the box of its snow slab. A surface whose heightmap is all zero
@@ -23,7 +24,7 @@
 //! choice is made on the GPU by `classify` and costs no readback; [`RenderOutput`] reports it.
 //!
 //! Each pass is a module with its WGSL beside it (`classify/`, `heightfield/`, `shadow`,
-//! `opaque/`, `snow/`, `tessellate/{banks,dice,snow_shadow}/`, `sky/`, `snowfall/`, `tonemap/`),
+//! `opaque/`, `snow/`, `tessellate/{banks,dice,snow_shadow}/`, `sky/`, `snowfall/`, `spray/`, `tonemap/`),
 //! owning its layouts, pipelines and buffers, with `new`, `prepare` (the frame's uploads and bind
 //! groups) and `encode`. What they share has small modules of its own: `frame/` (the frame
 //! uniform and `frame.wgsl`), `targets`, `cascades` (the shadow cascades' maths), `meshes`,
@@ -79,6 +80,7 @@ mod shadow;
 mod sky;
 mod snow;
 mod snowfall;
+mod spray;
 mod stats;
 mod targets;
 pub(crate) mod tessellate;
@@ -143,6 +145,7 @@ pub struct Renderer {
     snow: snow::SnowPass,
     sky: sky::SkyPass,
     snowfall: snowfall::SnowfallPass,
+    spray: spray::SprayPass,
     tonemap: tonemap::TonemapPass,
     /// Registered meshes and the frame's instances.
     meshes: meshes::MeshSet,
@@ -207,6 +210,7 @@ impl Renderer {
             snow: snow::SnowPass::new(&device, &frame.layout, filterable),
             sky: sky::SkyPass::new(&device, &frame.layout),
             snowfall: snowfall::SnowfallPass::new(&device, &frame.layout),
+            spray: spray::SprayPass::new(&device, &frame.layout),
             tonemap: tonemap::TonemapPass::new(&device, &frame.layout),
             meshes: meshes::MeshSet::new(&device),
             targets: Targets::new(&device, config.width, config.height, config.supersample),
@@ -581,8 +585,12 @@ impl Renderer {
 
         // The table sets the order: pass `slot` of PASSES is recorded `slot`-th.
         let flakes = uniform.options[3];
+        // The world's spray ring, read from the world directly (the extract predates it).
+        let spray = world
+            .spray_particles()
+            .zip(world.config().spray.map(|s| s.capacity));
         for slot in 0..PASSES.len() {
-            self.encode_pass(encoder, slot, target, flakes);
+            self.encode_pass(encoder, slot, target, flakes, spray);
         }
         Ok(self.last_surfaces.clone())
     }
@@ -594,6 +602,7 @@ impl Renderer {
         slot: usize,
         target: &wgpu::TextureView,
         flakes: u32,
+        spray: spray::SprayRing<'_>,
     ) {
         let ts = self.timestamps.as_ref();
         let state = &self.classify.state.buffer;
@@ -632,6 +641,7 @@ impl Renderer {
             pass::SNOWFALL => self
                 .snowfall
                 .encode(encoder, ts, slot, targets, frame, flakes),
+            pass::SPRAY => self.spray.encode(encoder, ts, slot, targets, frame, spray),
             pass::TONEMAP => self.tonemap.encode(encoder, ts, slot, target, frame),
             _ => unreachable!("pass {slot} of PASSES has no encoder"),
         }

@@ -23,6 +23,10 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("normals", "accumulate/normals.wgsl", true),
     ("fused", "accumulate/fused.wgsl", true),
     ("seal", "accumulate/seal.wgsl", true),
+    // Kicked-up snow: spawned from the update's data, simulated in a ring (`spray/`).
+    ("particle", "spray/particle.wgsl", false),
+    ("spray_spawn", "spray/spawn.wgsl", true),
+    ("spray_simulate", "spray/simulate.wgsl", true),
     // Materials that slump to their angle of repose.
     ("relax", "relax/relax.wgsl", true),
     // Skinned mesh deformers: the bind pose blended by the joints into the capture's vertices.
@@ -37,6 +41,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("mesh", "render/opaque/mesh.wgsl", true),
     ("sky", "render/sky/sky.wgsl", true),
     ("snowfall", "render/snowfall/snowfall.wgsl", true),
+    ("spray", "render/spray/spray.wgsl", true),
     ("tonemap", "render/tonemap/tonemap.wgsl", true),
     ("classify", "render/classify/classify.wgsl", true),
     ("heightfield", "render/heightfield/heightfield.wgsl", true),

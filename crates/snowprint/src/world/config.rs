@@ -32,6 +32,9 @@ pub struct WorldConfig {
     pub list_tiles_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
+    /// Kicked-up snow: particles spawned where an update deepens a print fast (`spray/`). `None`
+    /// (the default): no spray pass, the update exactly as without it.
+    pub spray: Option<crate::spray::SprayConfig>,
 }
 
 /// How the accumulation chain is dispatched.
@@ -59,6 +62,7 @@ impl Default for WorldConfig {
             passes: PassMode::Auto,
             list_tiles_from: 16384,
             format: PoolFormat::default(),
+            spray: None,
         }
     }
 }
@@ -78,6 +82,8 @@ pub struct StageTimes {
     pub fused_ms: f64,
     /// The relaxation of slumping materials (see [`crate::Material`]).
     pub relax_ms: f64,
+    /// The kicked-up snow's pass (simulate, spawn, fold, place), with [`WorldConfig::spray`].
+    pub spray_ms: f64,
 }
 
 impl StageTimes {
@@ -89,6 +95,7 @@ impl StageTimes {
             + self.normals_ms
             + self.fused_ms
             + self.relax_ms
+            + self.spray_ms
     }
 }
 

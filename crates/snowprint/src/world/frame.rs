@@ -155,10 +155,14 @@ impl SnowWorld {
             let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
             self.plan_into(&mut plan, updates);
             stats.add_layer(&plan.stats());
+            // The spray's particles move by the layer's longest step (a step passes one dt).
+            let dt = updates.iter().map(|u| u.elapsed).fold(0.0, f32::max);
             if !plan.is_empty() {
                 self.upload(&plan, (j > 0).then_some(&mut *encoder));
-                self.record(encoder, &plan, &mut queries);
+                self.record(encoder, &plan, &mut queries, (j, dt));
                 remember_captures(&mut self.scratch_cpu.captured, &plan);
+            } else {
+                self.record_spray(encoder, &plan, j, dt, &mut queries);
             }
             self.keep_carries(&plan.carries);
             self.keep_settles(&plan.settles);
@@ -411,12 +415,13 @@ impl SnowWorld {
     }
 
     /// Record the plan's capture and accumulation into `enc`, measuring their passes with
-    /// `queries`.
+    /// `queries`; with spray, its pass for `layer` (index, seconds) between the two.
     fn record(
         &mut self,
         enc: &mut wgpu::CommandEncoder,
         plan: &FramePlan,
         queries: &mut StageQueries<'_>,
+        layer: (usize, f32),
     ) {
         let atlas = self.atlas(plan.capture.atlas_side);
         let capture_buffers = CaptureBuffers {
@@ -438,6 +443,7 @@ impl SnowWorld {
             &self.meshes,
             queries,
         );
+        self.record_spray(enc, plan, layer.0, layer.1, queries);
         let accumulate_buffers = AccumulateBuffers {
             records: &self.records.buffer,
             capture: &self.capture.buffer,
@@ -508,6 +514,7 @@ fn stage_times(times: &[(&'static str, f64)]) -> StageTimes {
             "merge" => t.merge_ms += ms,
             "normals" => t.normals_ms += ms,
             "relax" => t.relax_ms += ms,
+            "spray" => t.spray_ms += ms,
             _ => t.fused_ms += ms,
         }
     }

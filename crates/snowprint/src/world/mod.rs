@@ -24,6 +24,7 @@ pub(crate) mod probe;
 mod readback;
 mod skinned;
 mod snapshot;
+mod spray;
 
 pub use crate::capture::{CaptureConfig, CaptureMode};
 pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
@@ -132,6 +133,8 @@ pub struct SnowWorld {
     deferred_frees: Vec<Slot>,
     /// Gameplay probes, their ring and cache, and the last update's footsteps.
     probes: probe::Probes,
+    /// Kicked-up snow, when [`WorldConfig::spray`] asks for it.
+    spray: Option<crate::spray::SprayGpu>,
 }
 
 /// Source of [`SnowWorld`] ids.
@@ -197,6 +200,12 @@ impl SnowWorld {
             config.passes = PassMode::Fused;
         }
         config.max_resolution = config.max_resolution.clamp(1, config.atlas_side);
+        if let Some(spray) = &config.spray {
+            spray.validate()?;
+        }
+        let spray = config
+            .spray
+            .map(|s| crate::spray::SprayGpu::new(&device, config.format.precision, s));
         let alloc = SlotAllocator::new(config.pool_bytes);
         let pool = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("heightmap pool"),
@@ -278,6 +287,7 @@ impl SnowWorld {
             frames: 0,
             in_flight: None,
             deferred_frees: Vec::new(),
+            spray,
         })
     }
 

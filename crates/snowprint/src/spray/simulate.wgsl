@@ -1,0 +1,60 @@
+// simulate.wgsl: every particle of the kicked-up snow's ring advances by the frame's dt: gravity,
+// then drag, then the move (semi-implicit Euler); a particle whose life runs out stays dead until
+// a spawn reuses its slot. One invocation per slot: the cost is the ring's capacity, whatever
+// spawned. Runs before `spawn`, so a particle spawned this frame sits where it was spawned.
+// `place` (after spawn.wgsl's `fold`) moves this frame's spawns from their surface's frame to the
+// world by the record's transform; it too costs one invocation a slot.
+// Reads and writes: ring (particles). Reads: params, spray_records. CPU reference:
+// spray::cpu::integrate.
+
+// import particle
+
+@group(0) @binding(0) var<uniform> params: SprayParams;
+@group(0) @binding(1) var<storage, read_write> ring: Ring;
+@group(0) @binding(2) var<storage, read> spray_records: array<SprayRecord>;
+
+struct Ring {
+    counters: array<u32, RING_HEADER>,
+    particles: array<Particle>,
+}
+
+fn slot_index(gid: vec3<u32>) -> u32 {
+    return gid.x + gid.y * 65535u * 64u;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn simulate(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = slot_index(gid);
+    if i >= params.capacity {
+        return;
+    }
+    var p = ring.particles[i];
+    if p.life <= 0.0 || p.age < 0.0 {
+        return;
+    }
+    let dt = params.dt;
+    var v = p.velocity - vec3<f32>(0.0, params.gravity * dt, 0.0);
+    v = v / (1.0 + params.drag * dt);
+    p.velocity = v;
+    p.position = p.position + v * dt;
+    p.life = max(p.life - dt, 0.0);
+    p.age = p.age + dt;
+    ring.particles[i] = p;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn place(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = slot_index(gid);
+    if i >= params.capacity {
+        return;
+    }
+    var p = ring.particles[i];
+    if p.age >= 0.0 {
+        return;
+    }
+    let m = spray_records[u32(-p.age) - 1u].local_to_world;
+    p.position = (m * vec4<f32>(p.position, 1.0)).xyz;
+    p.velocity = (m * vec4<f32>(p.velocity, 0.0)).xyz;
+    p.age = 0.0;
+    ring.particles[i] = p;
+}
