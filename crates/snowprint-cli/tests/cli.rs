@@ -286,7 +286,10 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
         // It finished before the signal: start again from the first set.
         assert!(run("1").wait().unwrap().success());
     }
-    assert!(interrupted, "twenty runs finished before SIGINT reached them");
+    assert!(
+        interrupted,
+        "twenty runs finished before SIGINT reached them"
+    );
     // The next run publishes its set and removes the dead run's staging.
     assert!(run("3").wait().unwrap().success());
     assert!(dump_frames(&dump, N).iter().all(|&f| f == 3));
