@@ -4,6 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The tests of this file one at a time: the SIGINT test must see a dump being written, a window
+/// of milliseconds that a 2-core machine busy with the other tests' software-Vulkan runs can hide.
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 fn snowprint() -> Command {
     Command::new(env!("CARGO_BIN_EXE_snowprint"))
 }
@@ -60,6 +69,7 @@ fn prints(map: &snowprint::Heightmap) -> Vec<usize> {
 
 #[test]
 fn walker_leaves_one_print_per_step() {
+    let _serial = serial();
     let out = scratch("walker");
     let status = snowprint()
         .args(["simulate", "--scene"])
@@ -89,6 +99,7 @@ fn walker_leaves_one_print_per_step() {
 
 #[test]
 fn bad_scene_is_one_sentence_and_leaves_no_output() {
+    let _serial = serial();
     let dir = scratch("bad");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("roof.toml");
@@ -135,6 +146,7 @@ fn bad_scene_is_one_sentence_and_leaves_no_output() {
 
 #[test]
 fn managed_run_reports_every_frame_within_the_budget() {
+    let _serial = serial();
     let out = scratch("managed");
     let report = out.join("report.json");
     let status = snowprint()
@@ -220,6 +232,7 @@ fn partial_folders(dump: &Path) -> Vec<String> {
 /// the next run removes what the interrupted run left.
 #[test]
 fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
+    let _serial = serial();
     use std::os::unix::process::ExitStatusExt as _;
     const N: usize = 400;
     let dir = scratch("sigint");
@@ -255,7 +268,7 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
             if child.try_wait().unwrap().is_some() {
                 break;
             }
-            std::thread::sleep(std::time::Duration::from_micros(200));
+            std::thread::yield_now();
         }
         if writing {
             let _ = Command::new("kill")
@@ -301,6 +314,7 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
 /// done are written, marked partial, report included.
 #[test]
 fn a_failing_frame_writes_the_frames_done_marked_partial() {
+    let _serial = serial();
     let dir = scratch("partial");
     let dump = dir.join("dump");
     let report = dir.join("report/r.json");
@@ -336,6 +350,7 @@ fn a_failing_frame_writes_the_frames_done_marked_partial() {
 /// without [budget] is not silently ignored.
 #[test]
 fn nested_report_folders_are_created_and_an_unused_camera_is_named() {
+    let _serial = serial();
     let dir = scratch("nested");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("cam.toml");
@@ -381,6 +396,7 @@ fn nested_report_folders_are_created_and_an_unused_camera_is_named() {
 /// Item 7: a scene file over the limit is refused before it is parsed.
 #[test]
 fn a_huge_scene_is_refused_before_parsing() {
+    let _serial = serial();
     let dir = scratch("huge");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("huge.toml");
@@ -413,6 +429,7 @@ fn a_huge_scene_is_refused_before_parsing() {
 /// Item 8: a managed run holds flat memory (nothing kept per frame), with or without a report.
 #[test]
 fn a_managed_run_holds_flat_memory() {
+    let _serial = serial();
     let dir = scratch("memory");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("m.toml");
@@ -448,6 +465,7 @@ fn a_managed_run_holds_flat_memory() {
 /// Item 10: with stderr not a terminal, progress is a plain line (no bar, no escapes).
 #[test]
 fn progress_is_a_plain_line_when_stderr_is_not_a_terminal() {
+    let _serial = serial();
     let dir = scratch("progress");
     let out = snowprint()
         .args(["simulate", "--scene"])
@@ -472,6 +490,7 @@ fn progress_is_a_plain_line_when_stderr_is_not_a_terminal() {
 /// Item 9: `demo --camera`'s help lists the cameras that exist.
 #[test]
 fn demo_help_lists_the_real_cameras() {
+    let _serial = serial();
     let out = snowprint()
         .args(["demo", "--help"])
         .output()
