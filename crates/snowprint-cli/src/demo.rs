@@ -81,8 +81,9 @@ pub struct Args {
     /// software adapter; deformers are swept between steps, so trails stay continuous).
     #[arg(long, allow_negative_numbers = true)]
     pub sim_hz: Option<u32>,
-    /// Which demo: `rooftops` (the library's demo world, rendered), `standin` (the renderer's
-    /// small stand-in world, rendered) or `city` (several hundred surfaces under the surface
+    /// Which demo: `rooftops` (the library's demo world, rendered), `skinned` (the rooftops with
+    /// one person pressing the snow with its own skinned glTF mesh, rendered), `standin` (the
+    /// renderer's small stand-in world, rendered) or `city` (several hundred surfaces under the surface
     /// manager's budget: heightmaps, a report, a pool plot and a map; not rendered).
     #[arg(long, default_value = "rooftops")]
     pub scene: String,

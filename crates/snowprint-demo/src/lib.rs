@@ -43,6 +43,7 @@
 pub mod anim;
 pub mod camera;
 pub mod city;
+pub mod export;
 pub mod people;
 pub mod plot;
 pub mod scene;

@@ -4,6 +4,7 @@
 //! lamps) and [`standin`] (a small, self-contained second world).
 
 pub mod rooftops;
+pub mod skinned;
 pub mod standin;
 
 use snowprint::render::{Environment, Instance, PointLight, Renderer};
@@ -46,8 +47,9 @@ pub fn build_scene(
     match name {
         "rooftops" => Ok(Box::new(rooftops::LibraryDemo::new(world, renderer)?)),
         "standin" => Ok(Box::new(standin::StandIn::new(world, renderer)?)),
+        "skinned" => Ok(Box::new(skinned::SkinnedDemo::new(world, renderer)?)),
         _ => Err(format!(
-            "unknown scene {name:?}; use rooftops, standin or city"
+            "unknown scene {name:?}; use rooftops, skinned, standin or city"
         )),
     }
 }

@@ -71,21 +71,25 @@ fn material_for(size: Vec3) -> MeshMaterial {
     }
 }
 
-impl LibraryDemo {
-    /// Build the world: surfaces and part meshes into `world`, meshes into `renderer`.
-    pub fn new(world: &mut SnowWorld, renderer: &mut Renderer) -> Result<Self, String> {
-        let demo = DemoWorld::build();
+/// What every scene on the rooftops shares: the demo world's surfaces in the `SnowWorld`, its props
+/// with materials, the ground and distant buildings around the block, and the street lamps.
+pub(super) struct Scenery {
+    pub(super) surfaces: Vec<(SurfaceId, GroundMaterial)>,
+    pub(super) statics: Vec<Instance>,
+    pub(super) lights: Vec<PointLight>,
+}
+
+impl Scenery {
+    pub(super) fn build(
+        demo: &DemoWorld,
+        world: &mut SnowWorld,
+        renderer: &mut Renderer,
+    ) -> Result<Self, String> {
         let werr = |e: snowprint::SnowError| e.to_string();
         let rerr = |e: snowprint::render::RenderError| e.to_string();
         let mut surfaces = Vec::new();
         for s in &demo.surfaces {
             surfaces.push((world.add_surface(s.desc.clone()).map_err(werr)?, s.ground));
-        }
-        let mut part_world = Vec::new();
-        let mut part_render = Vec::new();
-        for (i, m) in demo.part_meshes.iter().enumerate() {
-            part_world.push(world.add_mesh(&format!("body part {i}"), m).map_err(werr)?);
-            part_render.push(renderer.add_mesh(m).map_err(rerr)?);
         }
         let mut statics = Vec::new();
         for (i, prop) in demo.props.iter().enumerate() {
@@ -176,6 +180,27 @@ impl LibraryDemo {
             surfaces,
             statics,
             lights,
+        })
+    }
+}
+
+impl LibraryDemo {
+    /// Build the world: surfaces and part meshes into `world`, meshes into `renderer`.
+    pub fn new(world: &mut SnowWorld, renderer: &mut Renderer) -> Result<Self, String> {
+        let demo = DemoWorld::build();
+        let scenery = Scenery::build(&demo, world, renderer)?;
+        let werr = |e: snowprint::SnowError| e.to_string();
+        let rerr = |e: snowprint::render::RenderError| e.to_string();
+        let mut part_world = Vec::new();
+        let mut part_render = Vec::new();
+        for (i, m) in demo.part_meshes.iter().enumerate() {
+            part_world.push(world.add_mesh(&format!("body part {i}"), m).map_err(werr)?);
+            part_render.push(renderer.add_mesh(m).map_err(rerr)?);
+        }
+        Ok(Self {
+            surfaces: scenery.surfaces,
+            statics: scenery.statics,
+            lights: scenery.lights,
             part_world,
             part_render,
             // Probe keys of their own, far from any a game beside the demo would pick.
