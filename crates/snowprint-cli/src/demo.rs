@@ -91,6 +91,9 @@ pub struct Args {
     /// side (relief left, tessellated right) to `compare_tiers.png`.
     #[arg(long)]
     pub compare_tiers: bool,
+    /// Leave out the kicked-up snow (the world's spray particles, on by default).
+    #[arg(long)]
+    pub no_spray: bool,
 }
 
 /// Statistics of one pass over the frames.
@@ -144,7 +147,11 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
     let ctx = GpuContext::new(gpu).map_err(|e| e.to_string())?;
     let mut settings = Settings::new(&ctx, args)?;
 
-    let mut world = SnowWorld::new(&ctx, WorldConfig::default()).map_err(|e| e.to_string())?;
+    let config = WorldConfig {
+        spray: (!args.no_spray).then(snowprint::SprayConfig::default),
+        ..WorldConfig::default()
+    };
+    let mut world = SnowWorld::new(&ctx, config).map_err(|e| e.to_string())?;
     let mut renderer =
         Renderer::new(&ctx, settings.render_config(args)).map_err(|e| e.to_string())?;
     let mut scene = build_scene(&args.scene, &mut world, &mut renderer)?;
@@ -581,6 +588,7 @@ mod tests {
             sim_hz: Some(10),
             scene: "rooftops".into(),
             compare_tiers: false,
+            no_spray: false,
         }
     }
 

@@ -80,7 +80,9 @@ pub use mesh::{
 pub use pool::{PoolFormat, Precision};
 pub use render::gpu::SurfaceUniform;
 pub use skin::{Playback, SkinnedMesh};
-pub use spray::{MAX_SPRAY_CAPACITY, Particle, SPRAY_RING_HEADER, SprayConfig, SprayCounters};
+pub use spray::{
+    MAX_SPRAY_CAPACITY, Particle, SPRAY_RING_HEADER, SprayConfig, SprayCounters, SprayLook,
+};
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{

@@ -9,6 +9,7 @@
 //! mud keep their walls.
 
 use crate::error::{Result, SnowError};
+pub use crate::spray::SprayLook;
 
 /// How a surface's material moves after it is pressed, and how it looks.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -26,6 +27,10 @@ pub struct Material {
     /// Updates it keeps slumping after the last one that pressed it (a world's `step` lists every
     /// surface, so this is frames; under a manager, the surface's own updates).
     pub settle_updates: u32,
+    /// Its kicked-up grains, when the world has spray ([`crate::WorldConfig::spray`]). Absent from
+    /// older saves: the talk's snow.
+    #[serde(default)]
+    pub spray: SprayLook,
 }
 
 impl Default for Material {
@@ -42,12 +47,17 @@ impl Material {
             repose_degrees: None,
             relax_steps: 0,
             settle_updates: 0,
+            spray: SprayLook::snow(),
         }
     }
 
-    /// Packed snow: crisp edges, no slumping; the look of the talk's snow.
+    /// Packed snow: crisp edges, no slumping; the look of the talk's snow; its spray is a few
+    /// chunks.
     pub const fn packed_snow() -> Self {
-        Self::snow()
+        Self {
+            spray: SprayLook::packed_snow(),
+            ..Self::snow()
+        }
     }
 
     /// Fresh powder: walls steeper than 60 degrees crumble, slowly; it sparkles.
@@ -57,6 +67,7 @@ impl Material {
             repose_degrees: Some(60.0),
             relax_steps: 2,
             settle_updates: 30,
+            spray: SprayLook::powder(),
         }
     }
 
@@ -67,6 +78,7 @@ impl Material {
             repose_degrees: Some(34.0),
             relax_steps: 8,
             settle_updates: 120,
+            spray: SprayLook::sand(),
         }
     }
 
@@ -74,6 +86,7 @@ impl Material {
     pub const fn mud() -> Self {
         Self {
             look: MaterialLook::mud(),
+            spray: SprayLook::mud(),
             ..Self::snow()
         }
     }
@@ -117,6 +130,7 @@ impl Material {
             });
         }
         self.look.validate(name)?;
+        self.spray.validate(name)?;
         if self.relax_steps > 64 {
             return Err(SnowError::InvalidSurface {
                 name: name.to_owned(),

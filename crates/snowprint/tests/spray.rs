@@ -9,10 +9,10 @@
 mod common;
 
 use snowprint::glam::Vec3;
-use snowprint::reference::spray::{integrate, ring_fold, spawning_texels};
+use snowprint::reference::spray::{integrate, kept, ring_fold, spawning_texels};
 use snowprint::{
-    Deformer, Particle, PoolFormat, Pose, Precision, Shape, SnowWorld, SprayConfig, SurfaceDesc,
-    SurfaceId, WorldConfig,
+    Deformer, Material, Particle, PoolFormat, Pose, Precision, Shape, SnowWorld, SprayConfig,
+    SurfaceDesc, SurfaceId, WorldConfig,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -146,7 +146,7 @@ fn spawns_only_where_the_snow_was_pressed_deeper() {
         if let Some(old) = &last_particles {
             for (i, (o, n)) in old.iter().zip(&particles).enumerate() {
                 if o.life > 0.0 && (n.age > 0.0 || o.life <= DT) {
-                    let r = integrate(o, DT, config.gravity, config.drag);
+                    let r = integrate(o, DT, config.gravity);
                     for k in 0..3 {
                         assert!(
                             (r.position[k] - n.position[k]).abs() < 1e-5
@@ -163,6 +163,73 @@ fn spawns_only_where_the_snow_was_pressed_deeper() {
         last_particles = Some(particles);
         before = after;
     }
+}
+
+/// Snow, sand and mud yards pressed one a frame by the same ball: each frame's spawns are thinned
+/// by the material's amount exactly as the reference's hash of (slot, frame) says, and every grain
+/// kept carries its material's albedo, radius and drag, a life and a speed within its material's
+/// factors of the world's, over its own yard.
+#[test]
+fn each_material_throws_its_own_grains() {
+    let config = spray(4096);
+    let mut w = world(Some(config));
+    let materials = [
+        ("snow", Material::snow()),
+        ("sand", Material::sand()),
+        ("mud", Material::mud()),
+    ];
+    let mut yards = Vec::new();
+    for (k, (name, material)) in materials.iter().enumerate() {
+        let mut desc = yard_desc(0.0);
+        desc.name = (*name).to_owned();
+        desc.center = Vec3::new(2.0 + 3.0 * k as f32, 1.0, -3.0);
+        desc.material = *material;
+        w.add_surface(desc.clone()).unwrap();
+        yards.push(desc);
+    }
+    let mut head = 0;
+    let mut kept_by_material = Vec::new();
+    for (k, (desc, (name, material))) in yards.iter().zip(&materials).enumerate() {
+        w.step(DT, &[ball(desc, 0.0, 0.05, 0.12)]).unwrap();
+        let (counters, particles) = w.read_spray().unwrap().unwrap();
+        let spawned = counters.last_requested - counters.last_dropped;
+        assert!(spawned > 20, "{name}: {spawned} spawns");
+        let look = material.spray;
+        let expect = (0..spawned)
+            .filter(|i| kept((head + i) % config.capacity, k as u32 + 1, look.amount))
+            .count();
+        let fresh: Vec<&Particle> = particles
+            .iter()
+            .filter(|p| p.life > 0.0 && p.age == 0.0)
+            .collect();
+        assert_eq!(fresh.len(), expect, "{name}: grains kept of {spawned}");
+        let unorm = |c: f32| (c * 255.0).round() as u32;
+        let [r, g, b] = look.albedo;
+        let albedo = unorm(r) | unorm(g) << 8 | unorm(b) << 16 | 255 << 24;
+        for p in &fresh {
+            texel_of(desc, p);
+            assert_eq!(p.albedo, albedo, "{name}");
+            assert_eq!(p.radius, look.radius, "{name}");
+            assert_eq!(p.drag, config.drag * look.drag, "{name}");
+            let life = config.lifetime * look.lifetime;
+            assert!(
+                p.life <= life * 1.0001 && p.life >= 0.7 * life * 0.9999,
+                "{name}: life {} of {life}",
+                p.life
+            );
+            let speed = Vec3::from(p.velocity).length();
+            assert!(
+                speed <= 1.5 * config.speed * look.speed * 1.0001 && p.velocity[1] > 0.0,
+                "{name}: speed {speed}"
+            );
+        }
+        kept_by_material.push(fresh.len() as f32 / spawned as f32);
+        head = counters.head;
+    }
+    // Snow keeps every spawn; sand about 0.6 of them and mud about 0.3 (a hash, not a count).
+    assert_eq!(kept_by_material[0], 1.0);
+    assert!((kept_by_material[1] - 0.6).abs() < 0.2, "{kept_by_material:?}");
+    assert!((kept_by_material[2] - 0.3).abs() < 0.2, "{kept_by_material:?}");
 }
 
 #[test]

@@ -18,16 +18,22 @@
 //!
 //! The spawn reads the heights before the accumulation overwrites them and writes nothing the
 //! accumulation reads, so the update is bit-identical with spray on or off. CPU reference:
-//! [`cpu`]. One kind of particle for every material (per-material spray is not done).
+//! [`cpu`]. Each material throws its own grains ([`SprayLook`], `Material::spray`): `place`
+//! thins a surface's spawns by its amount, scales their speed, life and drag, and gives them its
+//! albedo and radius, which the renderer's `spray` pass draws.
 
 pub(crate) mod cpu;
+mod look;
+
+pub use look::SprayLook;
 
 use crate::error::{Result, SnowError};
 use crate::gpu::resources::{Growable, bind_group};
 use crate::pool::Precision;
 
-/// Largest ring, particles (32 bytes each: 128 MiB).
-pub const MAX_SPRAY_CAPACITY: u32 = 1 << 22;
+/// Largest ring, particles (48 bytes each: 96 MiB, under WebGPU's least storage binding of
+/// 128 MiB).
+pub const MAX_SPRAY_CAPACITY: u32 = 1 << 21;
 
 /// Settings of the kicked-up snow ([`crate::WorldConfig::spray`]).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -77,7 +83,7 @@ impl SprayConfig {
             return bad(
                 "capacity",
                 self.capacity.to_string(),
-                "1 to 4194304 particles",
+                "1 to 2097152 particles",
             );
         }
         if !(self.threshold.is_finite() && (0.0..1.0).contains(&self.threshold)) {
@@ -132,13 +138,29 @@ pub struct SprayParams {
     pub _pad1: [u32; 3],
 }
 
-/// Where an updated surface lies, as `SprayRecord` in particle.wgsl: one per
-/// [`crate::pool::SurfaceRecord`] of the update, same order.
+/// Where an updated surface lies and what its material throws, as `SprayRecord` in
+/// particle.wgsl: one per [`crate::pool::SurfaceRecord`] of the update, same order.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SprayRecord {
     /// Column-major surface-local to world transform.
     pub local_to_world: [f32; 16],
+    /// The material's [`SprayLook`] factors: amount, speed, lifetime, drag.
+    pub factors: [f32; 4],
+    /// The material's grain: albedo (linear RGB) and radius (metres).
+    pub grain: [f32; 4],
+}
+
+impl SprayRecord {
+    /// A surface's record: its placement and its material's spray.
+    pub fn new(local_to_world: [f32; 16], look: &SprayLook) -> Self {
+        let [r, g, b] = look.albedo;
+        Self {
+            local_to_world,
+            factors: [look.amount, look.speed, look.lifetime, look.drag],
+            grain: [r, g, b, look.radius],
+        }
+    }
 }
 
 /// One particle, as `Particle` in particle.wgsl (32 bytes, world space).
@@ -153,6 +175,14 @@ pub struct Particle {
     pub velocity: [f32; 3],
     /// Seconds since it was spawned.
     pub age: f32,
+    /// Albedo, RGBA8 unorm (alpha 255): its material's [`SprayLook::albedo`].
+    pub albedo: u32,
+    /// Radius as drawn, metres.
+    pub radius: f32,
+    /// Velocity lost per second, as a rate: the world's drag times its material's factor.
+    pub drag: f32,
+    /// Padding to 48 bytes.
+    pub _pad: u32,
 }
 
 /// The ring's counters as the GPU left them (u32 words, see particle.wgsl).
@@ -259,7 +289,7 @@ impl SprayGpu {
                 U::STORAGE | U::VERTEX | U::COPY_SRC,
             ),
             params: buffer("spray params", 48, U::UNIFORM | U::COPY_DST),
-            records: Growable::new(device, "spray records", U::STORAGE | U::COPY_DST, 64 * 16),
+            records: Growable::new(device, "spray records", U::STORAGE | U::COPY_DST, 96 * 16),
             config,
         }
     }
@@ -379,8 +409,8 @@ mod tests {
                 std::mem::size_of::<super::SprayParams>(),
                 12usize,
             ),
-            ("SprayRecord", std::mem::size_of::<super::SprayRecord>(), 1),
-            ("Particle", std::mem::size_of::<super::Particle>(), 4),
+            ("SprayRecord", std::mem::size_of::<super::SprayRecord>(), 3),
+            ("Particle", std::mem::size_of::<super::Particle>(), 8),
         ] {
             let (handle, ty) = module
                 .types
@@ -393,7 +423,8 @@ mod tests {
             assert_eq!(layouter[handle].size as usize, size, "{name}");
             assert_eq!(members.len(), fields, "{name}");
         }
-        // Particle: position at 0, life at 12, velocity at 16, age at 28.
+        // Particle: position at 0, life at 12, velocity at 16, age at 28, then albedo, radius,
+        // drag and padding.
         let (_, ty) = module
             .types
             .iter()
@@ -403,7 +434,7 @@ mod tests {
             panic!()
         };
         let offsets: Vec<u32> = members.iter().map(|m| m.offset).collect();
-        assert_eq!(offsets, [0, 12, 16, 28]);
+        assert_eq!(offsets, [0, 12, 16, 28, 32, 36, 40, 44]);
     }
 
     #[test]

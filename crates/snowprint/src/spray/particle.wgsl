@@ -20,9 +20,12 @@ struct SprayParams {
     _pad3: u32,
 }
 
-// Where a surface of the update lies in the world: one per `SurfaceRecord`, same order.
+// Where a surface of the update lies in the world and what its material throws: one per
+// `SurfaceRecord`, same order.
 struct SprayRecord {
     local_to_world: mat4x4<f32>,
+    factors: vec4<f32>, // the material's amount, speed, lifetime and drag factors
+    grain: vec4<f32>,   // the material's grain albedo (rgb) and radius (metres)
 }
 
 // One particle: alive while `life` > 0. World space.
@@ -31,6 +34,18 @@ struct Particle {
     life: f32,     // seconds left
     velocity: vec3<f32>,
     age: f32,      // seconds since it was spawned
+    albedo: u32,   // rgba8 unorm
+    radius: f32,   // metres, as drawn
+    drag: f32,     // velocity lost per second, as a rate
+    _pad: u32,
+}
+
+// A number in [0, 1] from two words (a PCG-style hash): the spawn's jitter and `place`'s thinning.
+fn spray_hash(a: u32, b: u32) -> f32 {
+    var v = a * 747796405u + b * 2891336453u + 12345u;
+    v = ((v >> ((v >> 28u) + 4u)) ^ v) * 277803737u;
+    v = (v >> 22u) ^ v;
+    return f32(v >> 8u) * (1.0 / 16777215.0);
 }
 
 // The ring buffer: RING_HEADER counter words, then the particles. Each pass declares it with its own

@@ -29,13 +29,6 @@ struct Ring {
     particles: array<Particle>,
 }
 
-fn spray_hash(a: u32, b: u32) -> f32 {
-    var v = a * 747796405u + b * 2891336453u + 12345u;
-    v = ((v >> ((v >> 28u) + 4u)) ^ v) * 277803737u;
-    v = (v >> 22u) ^ v;
-    return f32(v >> 8u) * (1.0 / 16777215.0);
-}
-
 @compute @workgroup_size(TILE, TILE, 1)
 fn spawn(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = records[gid.z];

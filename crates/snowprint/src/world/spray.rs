@@ -28,11 +28,16 @@ impl SnowWorld {
         let records: Vec<SprayRecord> = plan
             .surfaces
             .iter()
-            .map(|p| SprayRecord {
-                local_to_world: surfaces[p.index]
+            .map(|p| {
+                surfaces[p.index]
                     .as_ref()
-                    .map(|s| s.desc.local_to_world().to_cols_array())
-                    .unwrap_or_default(),
+                    .map(|s| {
+                        SprayRecord::new(
+                            s.desc.local_to_world().to_cols_array(),
+                            &s.desc.material.spray,
+                        )
+                    })
+                    .unwrap_or_default()
             })
             .collect();
         spray.records.ensure(

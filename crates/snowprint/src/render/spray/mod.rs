@@ -22,11 +22,14 @@ impl SprayPass {
             blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
             write_mask: wgpu::ColorWrites::ALL,
         })];
-        // One instance a particle: `Particle` of src/spray/mod.rs (position, life; velocity, age).
+        // One instance a particle: `Particle` of src/spray/mod.rs (position, life; velocity, age;
+        // albedo as RGBA8; radius and drag).
         let particle = [Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<crate::spray::Particle>() as u64,
             step_mode: wgpu::VertexStepMode::Instance,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4],
+            attributes: &wgpu::vertex_attr_array![
+                0 => Float32x4, 1 => Float32x4, 2 => Unorm8x4, 3 => Float32x2
+            ],
         })];
         let pipeline = pipeline::Raster {
             label: "spray",
