@@ -228,8 +228,14 @@ fn each_material_throws_its_own_grains() {
     }
     // Snow keeps every spawn; sand about 0.6 of them and mud about 0.3 (a hash, not a count).
     assert_eq!(kept_by_material[0], 1.0);
-    assert!((kept_by_material[1] - 0.6).abs() < 0.2, "{kept_by_material:?}");
-    assert!((kept_by_material[2] - 0.3).abs() < 0.2, "{kept_by_material:?}");
+    assert!(
+        (kept_by_material[1] - 0.6).abs() < 0.2,
+        "{kept_by_material:?}"
+    );
+    assert!(
+        (kept_by_material[2] - 0.3).abs() < 0.2,
+        "{kept_by_material:?}"
+    );
 }
 
 #[test]

@@ -162,15 +162,14 @@ impl App {
         if software {
             config.snowflakes = 3000;
         }
-        let mut world =
-            SnowWorld::new(
-                &gfx.ctx,
-                WorldConfig {
-                    spray: Some(snowprint::SprayConfig::default()),
-                    ..WorldConfig::default()
-                },
-            )
-            .map_err(|e| e.to_string())?;
+        let mut world = SnowWorld::new(
+            &gfx.ctx,
+            WorldConfig {
+                spray: Some(snowprint::SprayConfig::default()),
+                ..WorldConfig::default()
+            },
+        )
+        .map_err(|e| e.to_string())?;
         let mut renderer = Renderer::new(&gfx.ctx, config).map_err(|e| e.to_string())?;
         let yard = Yard::new(&mut world, &mut renderer)?;
         let half = Vec2::splat(SIDE * 0.5 - 0.6);

@@ -125,7 +125,11 @@ impl SprayLook {
                 "metres above 0, at most 0.5",
             );
         }
-        if !self.albedo.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c)) {
+        if !self
+            .albedo
+            .iter()
+            .all(|c| c.is_finite() && (0.0..=1.0).contains(c))
+        {
             return bad(
                 "material spray albedo",
                 format!("{:?}", self.albedo),
@@ -154,7 +158,13 @@ mod tests {
         let ok = SprayLook::snow();
         for (bad, what) in [
             (SprayLook { amount: 1.5, ..ok }, "amount"),
-            (SprayLook { drag: f32::NAN, ..ok }, "drag"),
+            (
+                SprayLook {
+                    drag: f32::NAN,
+                    ..ok
+                },
+                "drag",
+            ),
             (SprayLook { radius: 0.0, ..ok }, "radius"),
             (
                 SprayLook {
