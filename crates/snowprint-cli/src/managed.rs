@@ -7,7 +7,7 @@ use snowprint::manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, ZoneId,
 };
 use snowprint::scene::Scene;
-use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap};
+use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap, Shape};
 
 use crate::progress::Progress;
 use crate::simulate::{Done, Outputs};
@@ -134,11 +134,18 @@ pub fn simulate(
     let (mut snow, ids) = start(&ctx, scene, config, persist.load.as_deref())?;
     // Frames continue from the save's clock.
     let first = snow.planner().next_frame();
-    // The manager registers meshes as they are: an animated mesh presses in its bind pose here
-    // (skinning runs in the plain `simulate`, without [budget]).
-    let shapes = crate::simulate::scene_shapes(scene, |d, mesh| match snow.mesh_named(&d.name) {
-        Some(id) if persist.load.is_some() => Ok(id),
-        _ => snow.add_mesh(&d.name, mesh),
+    // An animated mesh is posed each frame before the tick (on the CPU, so that a surface the
+    // budget leaves waiting is pressed later with each frame's own pose); a save keeps a mesh's
+    // last posing, and its skeleton is given back here.
+    let shapes = crate::simulate::scene_shapes(scene, |d, mesh| {
+        match (snow.mesh_named(&d.name), &d.animation) {
+            (Some(id), Some(a)) if persist.load.is_some() => {
+                snow.set_skin(id, &a.skinned).map(|()| id)
+            }
+            (Some(id), None) if persist.load.is_some() => Ok(id),
+            (_, Some(a)) => snow.add_skinned_mesh(&d.name, &a.skinned),
+            (_, None) => snow.add_mesh(&d.name, mesh),
+        }
     })?;
     let mut progress = Progress::new(frames as u64, "simulate (managed)", "frames")?;
     let mut failure = None;
@@ -159,7 +166,19 @@ pub fn simulate(
             .camera
             .as_ref()
             .map(|c| CameraView::new(&c.at(t), ASPECT));
-        match snow.tick(dt, camera.as_ref(), &deformers) {
+        let animations: Vec<snowprint::MeshAnimation> = scene
+            .deformers
+            .iter()
+            .zip(&shapes)
+            .filter_map(|(d, shape)| match (&d.animation, shape) {
+                (Some(a), Shape::Mesh(id)) => Some(a.at(*id, t)),
+                _ => None,
+            })
+            .collect();
+        match snow
+            .animate_meshes(&animations)
+            .and_then(|()| snow.tick(dt, camera.as_ref(), &deformers))
+        {
             Ok(stats) => {
                 if let Some((_, stream)) = &mut report {
                     stream.push(&stats)?;

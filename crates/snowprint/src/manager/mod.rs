@@ -45,6 +45,7 @@ mod camera;
 mod config;
 mod frame;
 mod probe;
+mod skinned;
 mod stats;
 
 use glam::Vec3;
@@ -144,6 +145,8 @@ pub struct SnowManager {
     /// (for saves).
     retired: Vec<MeshId>,
     retired_mesh: std::collections::HashMap<u32, Mesh>,
+    /// Skeletons of the skinned meshes.
+    skins: skinned::ManagedSkins,
     /// Bytes paged out between ticks (zone unloads), reported by the next tick.
     paged_between: u64,
     stats: TickStats,
@@ -215,6 +218,7 @@ impl SnowManager {
             meshes: Vec::new(),
             retired: Vec::new(),
             retired_mesh: Default::default(),
+            skins: Default::default(),
             paged_between: 0,
             stats: TickStats::default(),
             id: NEXT_MANAGER.fetch_add(1, std::sync::atomic::Ordering::Relaxed),

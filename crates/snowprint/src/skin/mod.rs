@@ -202,6 +202,45 @@ impl SkinnedMesh {
             .join(", ")
     }
 
+    /// The mesh in its rest pose (the nodes' rest transforms), after checking that every vertex
+    /// has influences naming joints the skin has and that the posed mesh is usable as a deformer.
+    ///
+    /// # Errors
+    ///
+    /// [`crate::SnowError::InvalidMesh`] naming mesh `name` and what is wrong.
+    pub fn rest_mesh(&self, name: &str) -> crate::Result<Mesh> {
+        self.mesh.validate(name)?;
+        let invalid = |reason: String| crate::SnowError::InvalidMesh {
+            name: name.to_owned(),
+            reason,
+        };
+        if self.influences.len() != self.mesh.positions.len() {
+            return Err(invalid(format!(
+                "has {} influences for {} vertices; give every vertex its influences",
+                self.influences.len(),
+                self.mesh.positions.len()
+            )));
+        }
+        let joints = self.joints.len() as u32;
+        if let Some(bad) = self
+            .influences
+            .iter()
+            .find(|i| i.joints.iter().any(|&j| j >= joints))
+        {
+            return Err(invalid(format!(
+                "names joint {:?} but has {joints} joints",
+                bad.joints
+            )));
+        }
+        let rest = self.pose(None, 0.0, Playback::Clamp);
+        let rest_mesh = Mesh {
+            positions: skin_vertices(&self.mesh.positions, &self.influences, &rest),
+            indices: self.mesh.indices.clone(),
+        };
+        rest_mesh.validate(name)?;
+        Ok(rest_mesh)
+    }
+
     /// The joint matrices (`global * inverse bind`) of `animation` at time `t` (seconds since it
     /// started, run past its end by `playback`); `None` poses the rest transforms.
     pub fn pose(&self, animation: Option<usize>, t: f32, playback: Playback) -> Vec<Mat4> {

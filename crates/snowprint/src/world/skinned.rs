@@ -59,36 +59,8 @@ impl SnowWorld {
     ///
     /// [`SnowError::InvalidMesh`] when the mesh, or its rest pose, is not usable as a deformer.
     pub fn add_skinned_mesh(&mut self, name: &str, skinned: &SkinnedMesh) -> Result<MeshId> {
-        skinned.mesh.validate(name)?;
-        let invalid = |reason: String| SnowError::InvalidMesh {
-            name: name.to_owned(),
-            reason,
-        };
-        if skinned.influences.len() != skinned.mesh.positions.len() {
-            return Err(invalid(format!(
-                "has {} influences for {} vertices; give every vertex its influences",
-                skinned.influences.len(),
-                skinned.mesh.positions.len()
-            )));
-        }
-        let joints = skinned.joints.len() as u32;
-        if let Some(bad) = skinned
-            .influences
-            .iter()
-            .find(|i| i.joints.iter().any(|&j| j >= joints))
-        {
-            return Err(invalid(format!(
-                "names joint {:?} but has {joints} joints",
-                bad.joints
-            )));
-        }
+        let rest_mesh = skinned.rest_mesh(name)?;
         let rest = skinned.pose(None, 0.0, Playback::Clamp);
-        let posed = crate::skin::skin_vertices(&skinned.mesh.positions, &skinned.influences, &rest);
-        let rest_mesh = crate::mesh::Mesh {
-            positions: posed,
-            indices: skinned.mesh.indices.clone(),
-        };
-        rest_mesh.validate(name)?;
         use wgpu::BufferUsages as U;
         use wgpu::util::DeviceExt;
         let vertices = self
