@@ -3,8 +3,9 @@
 //! after), none on a still scene (a deformer resting in place after its first frame, with or
 //! without snow refilling), on the new snow top; they move as the reference step says; a frame's
 //! spawns past the ring's capacity are dropped and counted; and the update's heights are
-//! bit-identical with spray on or off; the renderer's `spray` pass draws them (a still is written
-//! to `target/tmp/spray/`).
+//! bit-identical with spray on or off; each material thins, scales and colours its own grains as
+//! the reference's `place` says; the renderer's `spray` pass draws them, sand's warmer and mud's
+//! darker than snow's (stills are written to `target/tmp/spray/`).
 
 mod common;
 
@@ -328,11 +329,13 @@ fn bad_settings_are_refused_with_their_name() {
 /// A ball sliding fast across the yard, drawn by two renderers: one world with spray and one
 /// without, the same frames. The spray shows as grains over the print and nowhere else changes much;
 /// the still is written for a look.
-#[test]
-fn the_renderer_draws_the_spray_where_the_ball_slid() {
+/// A ball slid across a yard of `material` in a world with spray and one without, both rendered
+/// (320x180, relief); the two images, written to `target/tmp/spray/NAME_{with,without}.png`.
+fn slid_yard(material: snowprint::Material, name: &str) -> [Vec<u8>; 2] {
     use snowprint::render::{Environment, PointLight, RenderConfig, RenderFrame, Renderer, Tier};
     use snowprint::{Camera, GroundMaterial};
-    let desc = SurfaceDesc::new("yard", [0.0, 0.0, 0.0], [2.0, 2.0], DEPTH);
+    let mut desc = SurfaceDesc::new("yard", [0.0, 0.0, 0.0], [2.0, 2.0], DEPTH);
+    desc.material = material;
     let mut worlds = [
         world(Some(SprayConfig {
             threshold: 0.02,
@@ -354,14 +357,16 @@ fn the_renderer_draws_the_spray_where_the_ball_slid() {
     }
     let (c, particles) = worlds[0].read_spray().unwrap().unwrap();
     let alive = particles.iter().filter(|p| p.life > 0.0).count();
-    assert!(alive > 50, "{c:?}: {alive} alive");
+    assert!(alive > 15, "{name}: {c:?}: {alive} alive");
     let lights = [PointLight {
         position: Vec3::new(0.5, 1.5, 1.0),
         color: Vec3::new(3.0, 2.6, 2.0),
         radius: 6.0,
     }];
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("spray");
+    std::fs::create_dir_all(&dir).unwrap();
     let mut images = Vec::new();
-    for (w, &id) in worlds.iter().zip(&ids) {
+    for ((w, &id), which) in worlds.iter().zip(&ids).zip(["with", "without"]) {
         let mut config = RenderConfig::new(320, 180, Tier::Relief);
         config.shadow_map_size = 512;
         let mut r = Renderer::new(common::gpu(), config).unwrap();
@@ -379,24 +384,66 @@ fn the_renderer_draws_the_spray_where_the_ball_slid() {
             environment: Environment::moonlit_night(),
             snowfall: false,
         };
-        images.push(r.render(w, &frame).unwrap().rgba8);
+        let img = r.render(w, &frame).unwrap().rgba8;
+        let file = dir.join(format!("{name}_{which}.png"));
+        image::save_buffer(file, &img, 320, 180, image::ColorType::Rgba8).unwrap();
+        images.push(img);
     }
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("spray");
-    std::fs::create_dir_all(&dir).unwrap();
-    for (name, img) in [
-        ("with_spray.png", &images[0]),
-        ("without_spray.png", &images[1]),
-    ] {
-        image::save_buffer(dir.join(name), img, 320, 180, image::ColorType::Rgba8).unwrap();
-    }
-    let changed = images[0]
+    [images.remove(0), images.remove(0)]
+}
+
+/// Pixels the spray changed (by more than 8 of 255 in a channel): their indices.
+fn changed(images: &[Vec<u8>; 2]) -> Vec<usize> {
+    images[0]
         .chunks(4)
         .zip(images[1].chunks(4))
-        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
-        .count();
+        .enumerate()
+        .filter(|(_, (a, b))| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
+        .map(|(i, _)| i)
+        .collect()
+}
+
+#[test]
+fn the_renderer_draws_the_spray_where_the_ball_slid() {
+    let images = slid_yard(Material::snow(), "snow");
+    let changed = changed(&images).len();
     assert!(changed > 20, "the spray changed {changed} pixels");
     assert!(
         changed < 320 * 180 / 5,
         "the spray changed {changed} pixels"
     );
+}
+
+/// Sand's grains are drawn warmer than snow's, mud's darker: the mean red less blue, and the mean
+/// brightness, of the pixels each spray changed.
+#[test]
+fn each_material_draws_its_own_grains() {
+    let look = |m: Material, name: &str| {
+        let images = slid_yard(m, name);
+        let px = changed(&images);
+        assert!(
+            px.len() > 10,
+            "{name}: the spray changed {} pixels",
+            px.len()
+        );
+        let (mut warm, mut bright) = (0.0, 0.0);
+        for &i in &px {
+            let p = &images[0][i * 4..i * 4 + 3];
+            warm += p[0] as f64 - p[2] as f64;
+            bright += (p[0] as f64 + p[1] as f64 + p[2] as f64) / 3.0;
+        }
+        let n = px.len() as f64;
+        println!(
+            "{name}: {} pixels, red - blue {:.1}, brightness {:.1}",
+            px.len(),
+            warm / n,
+            bright / n
+        );
+        (warm / n, bright / n)
+    };
+    let snow = look(Material::snow(), "snow");
+    let sand = look(Material::sand(), "sand");
+    let mud = look(Material::mud(), "mud");
+    assert!(sand.0 > snow.0 + 10.0, "sand {sand:?}, snow {snow:?}");
+    assert!(mud.1 < snow.1 - 20.0, "mud {mud:?}, snow {snow:?}");
 }

@@ -87,8 +87,8 @@ impl SprayLook {
             speed: 0.8,
             lifetime: 0.7,
             drag: 0.3,
-            radius: 0.02,
-            albedo: [0.2, 0.14, 0.09],
+            radius: 0.016,
+            albedo: [0.1, 0.07, 0.045],
         }
     }
 
