@@ -16,6 +16,7 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
+use super::hud::{Hud, Placement};
 use super::player::{Intent, Player};
 use super::script::Key;
 use super::window::{Gfx, Readback, Rgba};
@@ -103,6 +104,9 @@ struct Game {
     last: Instant,
     frame_ms: Vec<f64>,
     title_at: Instant,
+    /// The heads-up line (frame time, tier, view) and its pass.
+    hud: Hud,
+    hud_text: String,
     gif: Option<GifWriter>,
     snowfall: bool,
     /// The pelvis (x, z) at every frame, for the report.
@@ -199,6 +203,7 @@ impl App {
                 "render the same frame offscreen (this surface cannot be copied)"
             }
         );
+        let hud = Hud::new(&gfx.ctx.device, gfx.config.format);
         Ok(Game {
             window,
             gfx,
@@ -216,6 +221,8 @@ impl App {
             last: Instant::now(),
             frame_ms: Vec::new(),
             title_at: Instant::now(),
+            hud,
+            hud_text: String::new(),
             gif,
             snowfall: !args.no_snowfall,
             path: Vec::new(),
@@ -469,6 +476,15 @@ impl Game {
                 self.gfx.config.format,
             )
             .map_err(|e| e.to_string())?;
+        let size = (self.gfx.config.width, self.gfx.config.height);
+        self.hud.encode(
+            &self.gfx.ctx.queue,
+            &mut encoder,
+            &view,
+            size,
+            Placement::corner(size.1),
+            &self.hud_text,
+        );
         let copy = (read && self.gfx.copyable)
             .then(|| Readback::record(&device, &mut encoder, &texture.texture));
         self.gfx.ctx.queue.submit([encoder.finish()]);
@@ -483,7 +499,7 @@ impl Game {
         }
     }
 
-    /// The frame time and the state in the window's title, twice a second.
+    /// The frame time and the state in the window's title and its heads-up line, twice a second.
     fn title(&mut self) {
         if self.title_at.elapsed().as_secs_f32() < 0.5 {
             return;
@@ -492,6 +508,12 @@ impl Game {
         let recent = &self.frame_ms[self.frame_ms.len().saturating_sub(30)..];
         let ms = recent.iter().sum::<f64>() / recent.len().max(1) as f64;
         let c = self.renderer.config();
+        self.hud_text = format!(
+            "{ms:.1} ms {:.0} fps {} {}",
+            1000.0 / ms.max(1e-3),
+            c.tier,
+            format!("{:?}", c.debug_view).to_lowercase()
+        );
         self.window.set_title(&format!(
             "snowprint play: {ms:.1} ms/frame ({:.0} fps) | {} | {:?} | WASD walk, Shift run, C slide, F fall, Space throw, T tier, V view, drag orbit",
             1000.0 / ms.max(1e-3),

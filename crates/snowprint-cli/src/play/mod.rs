@@ -5,14 +5,16 @@
 //!
 //! Controls: W A S D walk (relative to the camera), Shift runs, C slides, F falls, Space throws a
 //! snowball, T switches the snow tier (relief, POM, tessellated), V the debug view, a left-button
-//! drag or the arrow keys orbit the camera, the wheel zooms, Esc quits. The frame time is in the
-//! window's title (the renderer draws no text).
+//! drag or the arrow keys orbit the camera, the wheel zooms, Esc quits. The frame time, tier and
+//! view are drawn in the top left corner (`hud/`, the window's own pass: the renderer draws no
+//! text) and written in the window's title.
 //!
 //! For tests and recordings, `--script` replays keys over time (`script.rs`), `--frames` and
 //! `--seconds` end the run, `--dt` fixes the step of each frame, `--screenshot` writes the last
 //! frame as PNG and `--gif` the run as an animation.
 
 mod game;
+mod hud;
 mod player;
 mod script;
 mod window;
