@@ -392,3 +392,69 @@ fn supersampling_and_resize() {
         );
     }
 }
+
+/// The shadow pass keeps what resting casters cast into the far cascade and draws only the moving
+/// ones over it: a renderer that lives through four frames (a block resting throughout, a ball
+/// rolling for three frames and then resting, so the kept depth is drawn, drawn again, and reused;
+/// both beyond the near cascade, so their shadows come from the far one)
+/// gives, frame by frame, the very pixels of a renderer made afresh for each frame, which keeps
+/// nothing.
+#[test]
+fn kept_shadows_of_resting_casters_are_those_drawn_afresh() {
+    let gpu = common::gpu();
+    let mut w = world();
+    let id = w
+        .add_surface(SurfaceDesc::new("yard", [0.0, 0.0, 0.0], [40.0, 40.0], 0.2))
+        .expect("surface");
+    w.step(
+        1.0 / 30.0,
+        &[Deformer::new(
+            Shape::Sphere { radius: 0.3 },
+            Pose::at([0.5, 0.25, 0.0]),
+        )],
+    )
+    .expect("step");
+    let mut config = RenderConfig::new(128, 72, Tier::Relief);
+    config.shadow_map_size = 512;
+    let meshes = [
+        Mesh::cuboid(Vec3::new(1.5, 3.0, 1.5)),
+        Mesh::uv_sphere(1.0, 8, 16),
+    ];
+    let renderer = || {
+        let mut r = Renderer::new(gpu, config.clone()).expect("renderer");
+        let ids: Vec<_> = meshes
+            .iter()
+            .map(|m| r.add_mesh(m).expect("mesh"))
+            .collect();
+        (r, ids[0], ids[1])
+    };
+    let (mut living, block, ball) = renderer();
+    let surfaces = [(id, GroundMaterial::Concrete)];
+    for f in 0..4 {
+        // Both far from the camera's focus, in the far cascade only.
+        let x = 6.0 + 1.5 * f.min(2) as f32;
+        let instances = [
+            Instance::new(
+                block,
+                Mat4::from_translation(Vec3::new(-10.0, 3.0, -12.0)),
+                [0.4; 3],
+            ),
+            Instance::new(
+                ball,
+                Mat4::from_translation(Vec3::new(x, 1.2, -10.0)),
+                [0.6, 0.1, 0.1],
+            ),
+        ];
+        let mut frame = frame(&surfaces, &instances);
+        frame.snowfall = false;
+        frame.camera = Camera {
+            eye: Vec3::new(0.0, 14.0, 18.0),
+            target: Vec3::new(0.0, 0.0, -6.0),
+            fov_y_degrees: 60.0,
+        };
+        let kept = living.render(&w, &frame).expect("render").rgba8;
+        let fresh = renderer().0.render(&w, &frame).expect("render").rgba8;
+        let differ = kept.iter().zip(&fresh).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "frame {f}: {differ} bytes differ");
+    }
+}
