@@ -1,10 +1,5 @@
 //! The meshes a frame draws: registered meshes on the GPU, and each frame's instances uploaded
-//! grouped by mesh (all of them for the opaque pass, then the shadow casters for the shadow pass:
-//! first those that rest, exactly as they were in the previous frame, then those that moved, so
-//! that the shadow pass can keep what the resting ones cast).
-
-use std::collections::HashSet;
-use std::hash::{Hash, Hasher};
+//! grouped by mesh (all of them for the opaque pass, then the shadow casters for the shadow pass).
 
 use glam::{Mat3, Vec3};
 
@@ -25,41 +20,13 @@ pub(super) struct GpuMesh {
 /// Draws of one mesh: its index and a range of instances.
 type Run = (u32, std::ops::Range<u32>);
 
-/// A shadow caster as the previous frame drew it: its mesh and transform, bit for bit.
-type CasterKey = (u32, [u32; 16]);
-
-fn caster_key(inst: &Instance) -> CasterKey {
-    (
-        inst.mesh.0,
-        inst.transform.to_cols_array().map(f32::to_bits),
-    )
-}
-
-/// Which of the frame's draws to record.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Draws {
-    /// Every instance (the opaque pass).
-    All,
-    /// Every shadow caster.
-    Casters,
-    /// Shadow casters exactly as they were in the previous frame.
-    Resting,
-    /// The other shadow casters.
-    Moving,
-}
-
 /// Registered meshes and the frame's instances.
 pub(super) struct MeshSet {
     pub meshes: Vec<GpuMesh>,
     instances: Growable,
-    /// This frame's draws: every instance, then the resting and the moving shadow casters.
+    /// This frame's draws: every instance, then the shadow casters.
     draws: Vec<Run>,
-    resting_draws: Vec<Run>,
-    moving_draws: Vec<Run>,
-    /// The resting casters, as one number: equal between frames when the same casters rest.
-    pub resting_key: u64,
-    /// The previous frame's casters.
-    previous: HashSet<CasterKey>,
+    shadow_draws: Vec<Run>,
 }
 
 impl MeshSet {
@@ -73,10 +40,7 @@ impl MeshSet {
                 144 * 64,
             ),
             draws: Vec::new(),
-            resting_draws: Vec::new(),
-            moving_draws: Vec::new(),
-            resting_key: 0,
-            previous: HashSet::new(),
+            shadow_draws: Vec::new(),
         }
     }
 
@@ -101,8 +65,8 @@ impl MeshSet {
         Ok(())
     }
 
-    /// Upload the frame's instances: all of them grouped by mesh, then the resting shadow casters
-    /// and the moving ones, each grouped by mesh.
+    /// Upload the frame's instances: all of them grouped by mesh, then the shadow casters grouped
+    /// by mesh.
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -132,17 +96,7 @@ impl MeshSet {
             .copied()
             .filter(|&i| frame[i].casts_shadow)
             .collect();
-        let (resting, moving): (Vec<usize>, Vec<usize>) = casters
-            .iter()
-            .partition(|&&i| self.previous.contains(&caster_key(&frame[i])));
-        let mut hasher = std::collections::hash_map::DefaultHasher::new();
-        for &i in &resting {
-            caster_key(&frame[i]).hash(&mut hasher);
-        }
-        self.resting_key = hasher.finish();
-        self.previous = casters.iter().map(|&i| caster_key(&frame[i])).collect();
-        instances.extend(resting.iter().map(|&i| raw(&frame[i])));
-        instances.extend(moving.iter().map(|&i| raw(&frame[i])));
+        instances.extend(casters.iter().map(|&i| raw(&frame[i])));
         let runs = |ids: &[usize], first: u32| {
             let mut out: Vec<Run> = Vec::new();
             for (k, &i) in ids.iter().enumerate() {
@@ -156,8 +110,7 @@ impl MeshSet {
             out
         };
         self.draws = runs(&order, 0);
-        self.resting_draws = runs(&resting, order.len() as u32);
-        self.moving_draws = runs(&moving, (order.len() + resting.len()) as u32);
+        self.shadow_draws = runs(&casters, order.len() as u32);
         if !instances.is_empty() {
             self.instances
                 .ensure(device, std::mem::size_of_val(instances.as_slice()) as u64);
@@ -165,25 +118,26 @@ impl MeshSet {
         }
     }
 
-    fn runs(&self, which: Draws) -> impl Iterator<Item = &Run> {
-        let (a, b): (&[Run], &[Run]) = match which {
-            Draws::All => (&self.draws, &[]),
-            Draws::Casters => (&self.resting_draws, &self.moving_draws),
-            Draws::Resting => (&self.resting_draws, &[]),
-            Draws::Moving => (&self.moving_draws, &[]),
-        };
-        a.iter().chain(b)
+    /// Whether the frame has instances (`shadow`: shadow casters) to draw.
+    pub(super) fn has_draws(&self, shadow: bool) -> bool {
+        !if shadow {
+            &self.shadow_draws
+        } else {
+            &self.draws
+        }
+        .is_empty()
     }
 
-    /// Whether the frame has instances of `which` to draw.
-    pub(super) fn has_draws(&self, which: Draws) -> bool {
-        self.runs(which).next().is_some()
-    }
-
-    /// Draw the frame's instances of `which` with the pass's pipeline and bind groups set.
-    pub(super) fn draw(&self, p: &mut wgpu::RenderPass<'_>, which: Draws) {
+    /// Draw the frame's instances (`shadow`: the shadow casters) with the pass's pipeline and
+    /// bind groups set.
+    pub(super) fn draw(&self, p: &mut wgpu::RenderPass<'_>, shadow: bool) {
         p.set_vertex_buffer(1, self.instances.buffer.slice(..));
-        for (mesh, range) in self.runs(which) {
+        let runs = if shadow {
+            &self.shadow_draws
+        } else {
+            &self.draws
+        };
+        for (mesh, range) in runs {
             let m = &self.meshes[*mesh as usize];
             p.set_vertex_buffer(0, m.vertices.slice(..));
             p.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);

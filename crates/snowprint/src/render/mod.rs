@@ -157,8 +157,6 @@ pub struct Renderer {
     default_geometry: SurfaceGeometry,
     /// The surfaces of the latest frame encoded, in slot order (for readbacks).
     last_surfaces: Vec<SurfaceId>,
-    /// The far shadow cascade's resting casters and matrix in the frame being encoded.
-    shadow_key: Option<shadow::RestingKey>,
     timestamps: Option<Timestamps>,
     stats: StatsReadback,
     latest: Option<FrameReport>,
@@ -227,7 +225,6 @@ impl Renderer {
             geometry_version: 0,
             default_geometry: SurfaceGeometry::default(),
             last_surfaces: Vec::new(),
-            shadow_key: None,
             latest: None,
             queue: gpu.queue.clone(),
             device,
@@ -365,7 +362,6 @@ impl Renderer {
         );
         self.copy_stats(&mut encoder, surfaces);
         self.queue.submit([encoder.finish()]);
-        self.shadow.submitted();
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Gpu(e));
         }
@@ -457,7 +453,6 @@ impl Renderer {
     /// report back (without waiting). Returns the report of the latest earlier frame whose GPU
     /// results have come back, if any.
     pub fn submitted(&mut self, pending: RenderPending) -> Option<FrameReport> {
-        self.shadow.submitted();
         if pending.report_copied && self.stats.is_idle() {
             self.stats.start_map();
         }
@@ -585,7 +580,6 @@ impl Renderer {
         self.tess_surface
             .prepare(device, &surfaces, uniforms, &self.heightfield, state);
         self.meshes.prepare(device, queue, frame.instances);
-        self.shadow_key = Some(shadow::RestingKey::new(&self.meshes, shadow.far));
         self.tonemap
             .prepare(device, &self.targets, format, self.config.supersample);
 
@@ -619,12 +613,9 @@ impl Renderer {
             pass::HEIGHTFIELD => self.heightfield.encode(encoder, ts, slot, state),
             pass::BANKS => self.banks.encode(encoder, ts, slot, state),
             pass::DICE => self.dice.encode(encoder, ts, slot),
-            pass::SHADOW => {
-                if let Some(far) = self.shadow_key {
-                    self.shadow
-                        .encode(encoder, ts, slot, shadow_frame, &self.meshes, far)
-                }
-            }
+            pass::SHADOW => self
+                .shadow
+                .encode(encoder, ts, slot, shadow_frame, &self.meshes),
             pass::SNOW_SHADOW => self.tess_surface.encode_shadow(
                 encoder,
                 ts,

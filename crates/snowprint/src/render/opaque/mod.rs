@@ -3,7 +3,7 @@
 //! the shadow pass's `vs_shadow`: both passes build on the module made by [`mesh_module`].
 
 use super::graph::PASSES;
-use super::meshes::{Draws, MeshSet};
+use super::meshes::MeshSet;
 use super::readback::{Timestamps, render_writes};
 use super::targets::Targets;
 use super::{gpu, pipeline};
@@ -62,10 +62,10 @@ impl OpaquePass {
             Some(clear_depth),
             render_writes(ts, slot),
         );
-        if meshes.has_draws(Draws::All) {
+        if meshes.has_draws(false) {
             p.set_pipeline(&self.pipeline);
             p.set_bind_group(0, frame, &[]);
-            meshes.draw(&mut p, Draws::All);
+            meshes.draw(&mut p, false);
         }
     }
 }
