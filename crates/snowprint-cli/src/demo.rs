@@ -311,6 +311,8 @@ impl Clip {
 struct Measured {
     sim_ms: f64,
     render_ms: Vec<f64>,
+    /// CPU time to build and submit each frame (no readback, no image encoding).
+    encode_ms: Vec<f64>,
     pass_ms: Vec<(&'static str, Vec<f64>)>,
     first_surfaces: Option<Vec<SurfaceShading>>,
     last_surfaces: Vec<SurfaceShading>,
@@ -358,6 +360,7 @@ impl Demo<'_> {
         let mut m = Measured {
             sim_ms: 0.0,
             render_ms: Vec::new(),
+            encode_ms: Vec::new(),
             pass_ms: Vec::new(),
             first_surfaces: None,
             last_surfaces: Vec::new(),
@@ -397,6 +400,7 @@ impl Demo<'_> {
                 .render(self.world, &frame)
                 .map_err(|e| e.to_string())?;
             m.render_ms.push(out.cpu_ms);
+            m.encode_ms.push(out.cpu_encode_ms);
             for p in &out.pass_times {
                 match m.pass_ms.iter_mut().find(|(n, _)| *n == p.name) {
                     Some((_, v)) => v.push(p.gpu_ms),
@@ -556,6 +560,7 @@ impl Demo<'_> {
             "cpu_ms": {
                 "simulation_total": m.sim_ms,
                 "render_median_per_frame": median(&mut m.render_ms.clone()),
+                "frame_build_median": median(&mut m.encode_ms.clone()),
                 "render_total": m.render_ms.iter().sum::<f64>(),
             },
             "surfaces": surfaces_json,

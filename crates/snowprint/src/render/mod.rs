@@ -336,6 +336,7 @@ impl Renderer {
         self.finish_stats(true)?;
         let output_view = self.targets.output_view.clone();
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let encode_start = Instant::now();
         let mut encoder = self.frame_encoder();
         let surfaces = self.encode(&mut encoder, world, frame, &output_view, OUTPUT_FORMAT)?;
         let (w, h) = self.targets.size;
@@ -362,6 +363,7 @@ impl Renderer {
         );
         self.copy_stats(&mut encoder, surfaces);
         self.queue.submit([encoder.finish()]);
+        let cpu_encode_ms = encode_start.elapsed().as_secs_f64() * 1e3;
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Gpu(e));
         }
@@ -395,6 +397,7 @@ impl Renderer {
             surfaces: report.surfaces,
             dice_overflow: report.dice_overflow,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
+            cpu_encode_ms,
         })
     }
 

@@ -81,4 +81,7 @@ pub struct RenderOutput {
     pub dice_overflow: u32,
     /// CPU time from the call to the pixels being back, milliseconds.
     pub cpu_ms: f64,
+    /// CPU time to build the frame and submit it (every pass's tables written and its commands
+    /// recorded), milliseconds: what a frame costs the CPU when nothing is read back.
+    pub cpu_encode_ms: f64,
 }
