@@ -13,8 +13,13 @@
 //!   when no snow falls on it, is redundant and not queued;
 //! - an entry whose swept shape holds a queued one replaces it (in its own frame).
 //!
-//! Both are exact as long as prints of one frame that are not in the other do not come within the
-//! blur's reach (one texel) of each other, as footprints of one walker do not.
+//! Moving an entry out of its frame changes what that frame captured together, and the update blurs
+//! each frame's capture as a whole: two prints within the blur's reach of each other (a texel) in
+//! one frame press deeper between them than either does alone. So an entry leaves its frame only
+//! when it is isolated there, no other entry of that frame within [`Isolation::reach`] of its
+//! sweep (dropping `d` from this tick needs it apart from this tick's other deformers; absorbing a
+//! queued entry needs it apart from the other entries of its frame). Within one frame both are
+//! always exact: the frame's capture is the union of its entries.
 //!
 //! Nothing is ever dropped. A surface updated in a frame takes its whole queue, however long.
 //! Only the queue of a surface that waits (for the budget or for memory) is bounded, by
@@ -53,6 +58,79 @@ pub enum Push {
     Redundant,
     /// Replaced a queued entry it holds.
     Absorbed,
+}
+
+/// The bounds of an entry's swept shape: a ball of radius `r` swept from `a` to `b`.
+pub type Sweep = (Vec3, Vec3, f32);
+
+/// What a push needs to know to move an entry out of its frame exactly (see the module docs).
+pub struct Isolation<'a> {
+    /// The sweeps of every deformer of this tick.
+    pub tick: &'a [Sweep],
+    /// Which of them is the one pushed.
+    pub index: usize,
+    /// The sweep of a queued entry.
+    pub sweep: &'a dyn Fn(&Deformer) -> Sweep,
+    /// Distance, metres, within which two prints of one frame interact through the blur.
+    pub reach: f32,
+}
+
+impl Isolation<'_> {
+    /// Whether the pushed deformer is apart from the tick's other deformers.
+    fn pushed_alone(&self) -> bool {
+        let me = self.tick[self.index];
+        self.tick
+            .iter()
+            .enumerate()
+            .all(|(k, &o)| k == self.index || !near(me, o, self.reach))
+    }
+
+    /// Whether the queued entry at `i` is apart from the other entries of its frame.
+    fn queued_alone(&self, queue: &VecDeque<Imprint>, i: usize) -> bool {
+        let me = (self.sweep)(&queue[i].deformer);
+        queue.iter().enumerate().all(|(k, e)| {
+            k == i || e.frame != queue[i].frame || !near(me, (self.sweep)(&e.deformer), self.reach)
+        })
+    }
+}
+
+/// Whether two sweeps come within `reach` of each other.
+fn near(x: Sweep, y: Sweep, reach: f32) -> bool {
+    segment_distance((x.0, x.1), (y.0, y.1)) <= x.2 + y.2 + reach
+}
+
+/// Distance between the segments `p.0..p.1` and `q.0..q.1` (closest points, clamped to both).
+fn segment_distance(p: (Vec3, Vec3), q: (Vec3, Vec3)) -> f32 {
+    let (d1, d2, r) = (p.1 - p.0, q.1 - q.0, p.0 - q.0);
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    let (s, t) = if a <= EPS * EPS && e <= EPS * EPS {
+        (0.0, 0.0)
+    } else if a <= EPS * EPS {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(r);
+        if e <= EPS * EPS {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > 0.0 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    (p.0 + d1 * s).distance(q.0 + d2 * t)
 }
 
 /// Start pose of an entry's sweep.
@@ -129,7 +207,8 @@ pub fn contains(outer: &Deformer, inner: &Deformer) -> bool {
 
 /// Push one frame's deformer into a surface's queue. `applied` is what the surface's last update
 /// captured; it is consulted only when `skip_applied` (no snowfall on the surface, so pressing the
-/// same shape again cannot change the heightmap). Nothing is dropped: see [`bound`] for how a
+/// same shape again cannot change the heightmap). An entry leaves its frame only when `isolation`
+/// says it is alone there (see the module docs). Nothing is dropped: see [`bound`] for how a
 /// waiting surface's queue is kept short.
 pub fn push(
     queue: &mut VecDeque<Imprint>,
@@ -137,16 +216,21 @@ pub fn push(
     skip_applied: bool,
     frame: u64,
     d: Deformer,
+    isolation: &Isolation<'_>,
 ) -> Push {
     let scan_from = queue.len().saturating_sub(SCAN);
+    // Whether `d` may leave this tick (be dropped as held by an entry of another frame).
+    let alone = isolation.pushed_alone();
+    let may_drop = |q: &Imprint| q.frame == frame || alone;
     // The common case first, by exact comparison: a deformer resting where a queued sweep of the
     // same shape ends or starts (a planted foot), or the same entry again.
     let resting = start(&d) == d.pose;
     if queue
         .range(scan_from..)
         .rev()
-        .any(|q| covers_exactly(&q.deformer, &d, resting))
+        .any(|q| may_drop(q) && covers_exactly(&q.deformer, &d, resting))
         || (skip_applied
+            && alone
             && applied
                 .iter()
                 .rev()
@@ -157,21 +241,21 @@ pub fn push(
     }
     // Newest first: a foot standing still matches its own last entry.
     for i in (scan_from..queue.len()).rev() {
-        let q = &queue[i].deformer;
-        if q.shape != d.shape {
+        let q = &queue[i];
+        if q.deformer.shape != d.shape {
             continue;
         }
-        if contains(q, &d) {
+        if may_drop(q) && contains(&q.deformer, &d) {
             return Push::Redundant;
         }
-        if contains(&d, q) {
+        if contains(&d, &q.deformer) && (q.frame == frame || isolation.queued_alone(queue, i)) {
             // It presses all the held entry did: the held one goes, `d` is queued in its frame.
             queue.remove(i);
             queue.push_back(Imprint { frame, deformer: d });
             return Push::Absorbed;
         }
     }
-    if skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) {
+    if skip_applied && alone && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) {
         return Push::Redundant;
     }
     queue.push_back(Imprint { frame, deformer: d });
@@ -291,6 +375,95 @@ mod tests {
 
     fn sphere(from: [f32; 3], to: [f32; 3]) -> Deformer {
         Deformer::moving(Shape::Sphere { radius: 0.1 }, Pose::at(from), Pose::at(to))
+    }
+
+    fn sweep(d: &Deformer) -> Sweep {
+        let r = d.shape.bounding_radius().unwrap_or(1e6);
+        (start(d).position, d.pose.position, r)
+    }
+
+    /// Push `d` as the only deformer of its tick.
+    fn push(
+        q: &mut VecDeque<Imprint>,
+        applied: &[Deformer],
+        skip: bool,
+        frame: u64,
+        d: Deformer,
+    ) -> Push {
+        push_among(q, applied, skip, frame, d, &[])
+    }
+
+    /// Push `d` in a tick whose other deformers are `others`.
+    fn push_among(
+        q: &mut VecDeque<Imprint>,
+        applied: &[Deformer],
+        skip: bool,
+        frame: u64,
+        d: Deformer,
+        others: &[Deformer],
+    ) -> Push {
+        let tick: Vec<Sweep> = std::iter::once(&d).chain(others).map(sweep).collect();
+        let isolation = Isolation {
+            tick: &tick,
+            index: 0,
+            sweep: &sweep,
+            reach: 0.08,
+        };
+        super::push(q, applied, skip, frame, d, &isolation)
+    }
+
+    /// A second deformer within the blur's reach in this tick keeps `d` in its frame, and one
+    /// within reach of a queued entry in that entry's frame keeps the entry there; apart, both
+    /// leave as before.
+    #[test]
+    fn an_entry_leaves_its_frame_only_when_alone_there() {
+        let planted = sphere([0.0, 0.1, 0.0], [0.0, 0.1, 0.0]);
+        let neighbour = sphere([0.25, 0.1, 0.0], [0.25, 0.1, 0.0]);
+        let far = sphere([3.0, 0.1, 0.0], [3.0, 0.1, 0.0]);
+        // A foot planted in tick 1 where tick 0's sweep ended: redundant alone or beside a far
+        // ball, kept beside a near one (0.25 m apart: 0.05 m between the balls, within 0.08 m).
+        let step_down = sphere([-0.2, 0.1, 0.0], [0.0, 0.1, 0.0]);
+        for (other, expect) in [(far, Push::Redundant), (neighbour, Push::Queued)] {
+            let mut q = VecDeque::new();
+            assert_eq!(push(&mut q, &[], false, 0, step_down), Push::Queued);
+            assert_eq!(push_among(&mut q, &[], false, 1, planted, &[other]), expect);
+        }
+        // A sweep in tick 1 that holds tick 0's entry absorbs it only if nothing of tick 0 lies
+        // within reach of it.
+        let sweep_on = sphere([0.0, 0.1, 0.0], [-0.2, 0.1, 0.0]);
+        for (other, expect) in [(far, Push::Absorbed), (neighbour, Push::Queued)] {
+            let mut q = VecDeque::new();
+            assert_eq!(
+                push_among(&mut q, &[], false, 0, planted, &[other]),
+                Push::Queued
+            );
+            assert_eq!(
+                push_among(&mut q, &[], false, 0, other, &[planted]),
+                Push::Queued
+            );
+            assert_eq!(push(&mut q, &[], false, 1, sweep_on), expect);
+        }
+    }
+
+    #[test]
+    fn segment_distances_computed_by_hand() {
+        let seg = |a: [f32; 3], b: [f32; 3]| (Vec3::from(a), Vec3::from(b));
+        // Parallel, 1 m apart; crossing at right angles 2 m apart in y; point to segment.
+        let d = segment_distance(
+            seg([0.0; 3], [1.0, 0.0, 0.0]),
+            seg([0.0, 0.0, 1.0], [1.0, 0.0, 1.0]),
+        );
+        assert!((d - 1.0).abs() < 1e-6, "{d}");
+        let d = segment_distance(
+            seg([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+            seg([0.0, 2.0, -1.0], [0.0, 2.0, 1.0]),
+        );
+        assert!((d - 2.0).abs() < 1e-6, "{d}");
+        let d = segment_distance(
+            seg([3.0, 4.0, 0.0], [3.0, 4.0, 0.0]),
+            seg([0.0; 3], [1.0, 0.0, 0.0]),
+        );
+        assert!((d - (4.0f32 * 4.0 + 2.0 * 2.0).sqrt()).abs() < 1e-6, "{d}");
     }
 
     #[test]

@@ -50,6 +50,17 @@ use crate::surface::SurfaceDesc;
 /// world's own culling (float rounding between the two can never hide a touch).
 pub(crate) const TOUCH_MARGIN: f32 = 1e-3;
 
+/// The swept bounds of a deformer: the ball that holds its shape (a mesh's registered bound, from
+/// `radii`; an unknown mesh's as large as any world) swept from its previous pose. The world draws
+/// a moving mesh at sub-steps along its motion, which this ball holds too.
+pub(super) fn sweep_with(radii: &[Option<f32>], d: &Deformer) -> (Vec3, Vec3, f32) {
+    let r = match d.shape {
+        Shape::Mesh(id) => radii.get(id.0 as usize).copied().flatten().unwrap_or(1e9),
+        shape => shape.bounding_radius().unwrap_or(0.0),
+    };
+    (d.previous.unwrap_or(d.pose).position, d.pose.position, r)
+}
+
 /// How the planner finds which surfaces a box overlaps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Lookup {
@@ -602,26 +613,20 @@ impl Planner {
 
     /// Swept bounds of a deformer: the sweep's two ends and a radius holding the shape.
     fn sweep_of(&self, d: &Deformer) -> Result<(Vec3, Vec3, f32)> {
-        match d.shape {
-            Shape::Mesh(id) => {
-                let r = self
-                    .mesh_radius
-                    .get(id.0 as usize)
-                    .copied()
-                    .flatten()
-                    .ok_or(SnowError::StaleHandle {
-                        what: "mesh",
-                        index: id.0,
-                    })?;
-                // The world draws a moving mesh at sub-steps along its motion: the ball of its
-                // bound swept from the previous pose holds them all.
-                Ok((d.previous.unwrap_or(d.pose).position, d.pose.position, r))
-            }
-            shape => {
-                let r = shape.bounding_radius().unwrap_or(0.0);
-                Ok((d.previous.unwrap_or(d.pose).position, d.pose.position, r))
-            }
+        if let Shape::Mesh(id) = d.shape
+            && self
+                .mesh_radius
+                .get(id.0 as usize)
+                .copied()
+                .flatten()
+                .is_none()
+        {
+            return Err(SnowError::StaleHandle {
+                what: "mesh",
+                index: id.0,
+            });
         }
+        Ok(sweep_with(&self.mesh_radius, d))
     }
 
     fn rank(&self, index: u32, now: u64, focus: Option<Vec3>) -> Rank {

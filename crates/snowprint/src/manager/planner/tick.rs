@@ -4,7 +4,7 @@ use glam::Vec3;
 
 use super::surface::plausible;
 use super::{LISTED, REMOVED, RESIDENT, SNOWFALL, WANTED};
-use super::{Plan, Planner, TOUCH_MARGIN};
+use super::{Plan, Planner, TOUCH_MARGIN, sweep_with};
 use crate::deformer::Shape;
 use crate::error::{Result, SnowError};
 use crate::manager::quadtree::Aabb;
@@ -115,9 +115,27 @@ impl Planner {
                 if d.player {
                     st.player = now;
                 }
-                let m = &mut self.surfaces[i as usize];
                 let skip_applied = !st.has(SNOWFALL);
-                queue::push(&mut m.queue, &m.applied, skip_applied, now, d.deformer);
+                let radii = &self.mesh_radius;
+                let m = &mut self.surfaces[i as usize];
+                let layout = m.desc.layout();
+                let texel =
+                    (m.desc.size.x / layout.width as f32).max(m.desc.size.y / layout.height as f32);
+                let isolation = queue::Isolation {
+                    tick: sweeps,
+                    index: k,
+                    sweep: &|d| sweep_with(radii, d),
+                    // The blur's one texel, and one more for where a print's edge falls.
+                    reach: 2.0 * texel,
+                };
+                queue::push(
+                    &mut m.queue,
+                    &m.applied,
+                    skip_applied,
+                    now,
+                    d.deformer,
+                    &isolation,
+                );
                 st.queue_len = m.queue.len() as u32;
                 if st.queue_len > 0 && !st.has(LISTED) {
                     st.set(LISTED, true);
