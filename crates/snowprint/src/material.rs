@@ -7,6 +7,12 @@
 //! neighbours until no step between neighbours is steeper than the repose angle, keeping the
 //! volume pressed out exactly. Dry sand slumps strongly, fresh powder a little; packed snow and
 //! mud keep their walls.
+//!
+//! What is pressed out either compacts under the foot or is pushed aside: [`Material::compressibility`]
+//! says how much of it compacts. The rest rises in rims beside the print, drawn from the
+//! heightmap's displaced channel by the renderer's banks (`render/tessellate/banks/`), so the rims
+//! hold `1 - compressibility` of the volume pressed out. Sand barely compacts and throws most of it
+//! aside; powder about half.
 
 use crate::error::{Result, SnowError};
 
@@ -26,6 +32,12 @@ pub struct Material {
     /// Updates it keeps slumping after the last one that pressed it (a world's `step` lists every
     /// surface, so this is frames; under a manager, the surface's own updates).
     pub settle_updates: u32,
+    /// Share of a print's volume that compacts (0 to 1); the rest, `1 - compressibility` of the
+    /// volume pressed out, is pushed aside into rims beside the print. `None`: the renderer's
+    /// `BankSettings::fraction` decides (the talk's snow: a quarter into banks by default). Absent
+    /// from older saves: `None`.
+    #[serde(default)]
+    pub compressibility: Option<f32>,
 }
 
 impl Default for Material {
@@ -42,6 +54,7 @@ impl Material {
             repose_degrees: None,
             relax_steps: 0,
             settle_updates: 0,
+            compressibility: None,
         }
     }
 
@@ -50,23 +63,27 @@ impl Material {
         Self::snow()
     }
 
-    /// Fresh powder: walls steeper than 60 degrees crumble, slowly; it sparkles.
+    /// Fresh powder: walls steeper than 60 degrees crumble, slowly; it sparkles; half of what a
+    /// print presses out compacts, half is pushed aside into loose rims.
     pub const fn powder() -> Self {
         Self {
             look: MaterialLook::powder(),
             repose_degrees: Some(60.0),
             relax_steps: 2,
             settle_updates: 30,
+            compressibility: Some(0.5),
         }
     }
 
-    /// Dry sand: slumps back into a print until its walls stand at 34 degrees.
+    /// Dry sand: slumps back into a print until its walls stand at 34 degrees; it hardly
+    /// compacts, so four fifths of what a print presses out rise in rims beside it.
     pub const fn sand() -> Self {
         Self {
             look: MaterialLook::sand(),
             repose_degrees: Some(34.0),
             relax_steps: 8,
             settle_updates: 120,
+            compressibility: Some(0.2),
         }
     }
 
@@ -95,6 +112,12 @@ impl Material {
         self.repose_degrees.is_some() && self.relax_steps > 0
     }
 
+    /// Share of the volume pressed out that rises in rims, when the material says
+    /// (`1 - compressibility`); `None`: the renderer's bank settings decide.
+    pub fn rim_fraction(&self) -> Option<f32> {
+        self.compressibility.map(|c| 1.0 - c)
+    }
+
     /// Relaxation steps an update takes: even, so that the last writes the pool.
     pub fn steps(&self) -> u32 {
         if self.slumps() {
@@ -114,6 +137,16 @@ impl Material {
                 what: "material repose_degrees",
                 value: a.to_string(),
                 expected: "degrees from 0 to 90",
+            });
+        }
+        if let Some(c) = self.compressibility
+            && !(c.is_finite() && (0.0..=1.0).contains(&c))
+        {
+            return Err(SnowError::InvalidSurface {
+                name: name.to_owned(),
+                what: "material compressibility",
+                value: c.to_string(),
+                expected: "a share of the pressed volume from 0 to 1",
             });
         }
         self.look.validate(name)?;

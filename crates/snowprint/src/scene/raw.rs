@@ -37,6 +37,16 @@ pub(super) struct RawMaterial {
     pub repose_degrees: Option<Num>,
     pub relax_steps: Option<Spanned<i64>>,
     pub settle_updates: Option<Spanned<i64>>,
+    pub compressibility: Option<Num>,
+    pub albedo: Option<Nums>,
+    pub disturbed_albedo: Option<Nums>,
+    pub roughness: Option<Num>,
+    pub wet_roughness: Option<Num>,
+    pub grain: Option<Num>,
+    pub sparkle: Option<Num>,
+    pub wetness: Option<Num>,
+    pub translucency: Option<Num>,
+    pub water_depth: Option<Num>,
 }
 
 /// `[budget]`: the surface manager's limits.
@@ -134,6 +144,16 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "repose_degrees",
             "relax_steps",
             "settle_updates",
+            "compressibility",
+            "albedo",
+            "disturbed_albedo",
+            "roughness",
+            "wet_roughness",
+            "grain",
+            "sparkle",
+            "wetness",
+            "translucency",
+            "water_depth",
         ],
     ),
     (

@@ -67,7 +67,7 @@ impl BanksPass {
                 layout.height,
                 surface.texel(),
                 desc.snow_depth,
-                surface.geometry.banks,
+                surface.banks(),
             );
             bytes[s * stride..s * stride + std::mem::size_of::<BankParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&bank));
