@@ -152,6 +152,96 @@ fn settled_sand_stands_at_its_angle_of_repose() {
     assert_eq!(fixed, again, "the CPU rule reaches a fixed point");
 }
 
+/// The dispatches of several steps in workgroup memory against the CPU's one step over the whole
+/// surface: two surfaces of several tiles (75 x 45 and 43 x 65 texels) pressed in four places,
+/// one at an odd column and one against an edge, relaxing 2 steps an update (one dispatch and a
+/// copy), 6 (two of three) and 10 (five of two and a copy), for five updates, at 8, 16 and 32 bits.
+#[test]
+fn many_steps_a_dispatch_match_the_cpu_over_several_tiles() {
+    let balls = [
+        ([-0.9, -0.2], 0.25),
+        ([0.62, 0.3], 0.2),
+        ([1.35, -0.7], 0.15),
+        ([-0.1, 0.55], 0.3),
+    ];
+    let press = |center: [f32; 3]| -> Vec<Deformer> {
+        balls
+            .iter()
+            .map(|&([x, z], r)| {
+                Deformer::new(
+                    Shape::Sphere { radius: r },
+                    Pose::at([center[0] + x, DEPTH - 0.6 * r + r, center[2] + z]),
+                )
+            })
+            .collect()
+    };
+    let sides = [
+        ([0.0, 0.0, 0.0], [3.0, 1.8]),
+        ([6.0, 0.0, 0.0], [1.72, 2.6]),
+    ];
+    for steps in [2, 6, 10] {
+        let material = Material {
+            relax_steps: steps,
+            ..Material::sand()
+        };
+        for precision in Precision::ALL {
+            let (mut snow, mut sandy) = (world(precision), world(precision));
+            let mut ids = Vec::new();
+            let mut deformers = Vec::new();
+            for (center, size) in sides {
+                let add = |w: &mut SnowWorld, m: Material| {
+                    let mut desc = SurfaceDesc::new("dune", center, size, DEPTH);
+                    desc.material = m;
+                    w.add_surface(desc).unwrap()
+                };
+                ids.push((add(&mut snow, Material::snow()), add(&mut sandy, material)));
+                deformers.extend(press(center));
+            }
+            snow.step(DT, &deformers).unwrap();
+            sandy.step(DT, &deformers).unwrap();
+            let max = precision.channel_max();
+            for &(s, d) in &ids {
+                let pressed = snow.read_channels(s).unwrap().0;
+                let layout = sandy.layout(d).unwrap();
+                let (w, h) = (layout.width, layout.height);
+                let t = relax::threshold(34.0, 0.04, DEPTH, max);
+                let mut expect = pressed.clone();
+                for _ in 0..steps {
+                    expect = relax::step(&expect, w, h, max, [t, t]);
+                }
+                let got = sandy.read_channels(d).unwrap().0;
+                assert_eq!(got, expect, "{steps} steps, {precision:?}, {w} x {h}");
+                assert_ne!(
+                    got, pressed,
+                    "{steps} steps, {precision:?}: the prints slumped"
+                );
+                assert_eq!(sum(&got), sum(&pressed));
+            }
+            // Four updates that only settle, both surfaces at once.
+            let mut expects: Vec<Vec<u32>> = ids
+                .iter()
+                .map(|&(_, d)| sandy.read_channels(d).unwrap().0)
+                .collect();
+            for update in 1..5 {
+                sandy.step(DT, &[]).unwrap();
+                for (&(_, d), expect) in ids.iter().zip(&mut expects) {
+                    let layout = sandy.layout(d).unwrap();
+                    let (w, h) = (layout.width, layout.height);
+                    let t = relax::threshold(34.0, 0.04, DEPTH, max);
+                    for _ in 0..steps {
+                        *expect = relax::step(expect, w, h, max, [t, t]);
+                    }
+                    let got = sandy.read_channels(d).unwrap().0;
+                    assert_eq!(
+                        &got, expect,
+                        "{steps} steps, {precision:?}, update {update}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn steepest_step(d: &[u32], w: usize, h: usize) -> u32 {
     let mut m = 0;
     for y in 0..h {

@@ -435,11 +435,13 @@ impl FramePlan {
                     threshold_x: threshold(r.texel_x),
                     threshold_z: threshold(r.texel_z),
                     rect: [rect.x0, rect.y0, rw, rh],
-                    _pad: [0; 2],
+                    dispatch_steps: 0,
+                    _pad: 0,
                 },
                 steps,
             );
         }
+        self.relax.schedule();
         let texels = c.texels.max(1) as u64 * 4;
         self.sizes = BufferSizes {
             records: (a.records.len() * std::mem::size_of::<SurfaceRecord>()) as u64,
