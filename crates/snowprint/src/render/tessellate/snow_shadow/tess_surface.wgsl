@@ -2,8 +2,11 @@
 // The vertex stage displaces each vertex of the top to the snow there: the base height, plus the
 // snow depth minus the depression (the heightfield pass's smoothed depression), plus the banks
 // (banks.wgsl), plus the macro "waves" of snow.wgsl's `snow_macro_height` (the same function whose
-// normal the relief tier shades with), pressed flat where the snow is packed. Skirt vertices at
-// the base stay there. The fragment stage shades the real surface with the deformable material
+// normal the relief tier shades with), pressed flat where the snow is packed. Where the material
+// has water (mud) and a print is deeper than its water depth, the top is the flat water surface at
+// the water table instead, so the water is real geometry (in the shadow map too) and the fragment
+// stage shades it as the relief tier's water: a mirror of the sky. Skirt vertices at the base stay
+// there. The fragment stage shades the real surface with the deformable material
 // (snow.wgsl) without any search: the heightmap's normal tilted by the banks' slope, RNM detail,
 // the heightmap's AO, and the moon's shadow from the shadow map, which holds this same displaced
 // geometry (vs_tess_shadow), so trails shadow themselves and characters' shadows bend into them.
@@ -53,7 +56,7 @@ fn bank_height(uv: vec2<f32>) -> f32 {
 
 // Snow top above the base at local xz, metres: depth minus depression, plus banks, plus the
 // macro waves (scaled by pattern.w, flattened where the snow is pressed).
-fn tess_snow_height(xz: vec2<f32>) -> f32 {
+fn tess_material_height(xz: vec2<f32>) -> f32 {
     var dep = 0.0;
     var bank = 0.0;
     if tess_touched() {
@@ -64,6 +67,22 @@ fn tess_snow_height(xz: vec2<f32>) -> f32 {
     let flatten = 1.0 - smoothstep(0.0, 0.5, dep);
     let waves = surface.pattern.w * (snow_macro_height(xz + surface.pattern.xy) - MACRO_MEAN) * flatten;
     return surface.snow_depth * (1.0 - dep) + bank + waves;
+}
+
+// Whether the material at local xz lies under the water table (snow.wgsl's `snow_water_level`):
+// a print deeper than the material's water depth, filled with water up to it.
+fn tess_under_water(xz: vec2<f32>) -> bool {
+    let level = snow_water_level(surface);
+    return level >= 0.0 && tess_touched() && tess_material_height(xz) < level;
+}
+
+// The top above the base at local xz: the material's, or the water's flat surface over it.
+fn tess_snow_height(xz: vec2<f32>) -> f32 {
+    let h = tess_material_height(xz);
+    if tess_under_water(xz) {
+        return snow_water_level(surface);
+    }
+    return h;
 }
 
 fn tess_local(v: TessVertex) -> vec3<f32> {
@@ -136,8 +155,8 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
         hit.shadow = 1.0;
         hit.taps = 0u;
         hit.t = 0.0;
-        // No water in this tier yet: the diced surface has no water plane.
-        hit.water = 0u;
+        // Water: the diced top is the flat water surface where the material lies under it.
+        hit.water = select(0u, 1u, tess_under_water(in.local.xz));
         m = snow_deformable(surface, hit, hf, vec3<f32>(0.0, 1.0, 0.0), sky_tint(), pixel);
     }
     // No search in this tier: no taps.
