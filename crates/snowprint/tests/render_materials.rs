@@ -275,7 +275,12 @@ fn material_terms_switched_off_fail_their_goldens() {
     for (what, name, material, tier) in [
         ("grain off", "material_sand", sand, Tier::Relief),
         ("water off", "material_mud", mud, Tier::Relief),
-        ("water off", "material_mud_tessellated", mud, Tier::Tessellated),
+        (
+            "water off",
+            "material_mud_tessellated",
+            mud,
+            Tier::Tessellated,
+        ),
         ("sparkle off", "material_powder", powder, Tier::Relief),
     ] {
         let out = render(&mut scene_in(material, tier));
