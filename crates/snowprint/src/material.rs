@@ -191,6 +191,11 @@ pub struct MaterialLook {
     /// Depth below the untouched top, metres, of the water table: prints deeper than this fill
     /// with a flat water surface up to it (mud); `None`: no water.
     pub water_depth: Option<f32>,
+    /// Depression (fraction of the depth pressed, 0 to 1) from which the ground under the
+    /// material shows, fully once pressed through; `None`: the renderer's `SnowLook` decides
+    /// (snow, which packs into a thin layer: from two thirds). Sand and mud show the material
+    /// itself at the bottom of a print until it is pressed almost to the ground.
+    pub ground_from: Option<f32>,
 }
 
 impl Default for MaterialLook {
@@ -212,6 +217,7 @@ impl MaterialLook {
             wetness: 0.0,
             translucency: 1.0,
             water_depth: None,
+            ground_from: None,
         }
     }
 
@@ -224,11 +230,13 @@ impl MaterialLook {
         }
     }
 
-    /// Dry sand: warm, fine grained, with a lighter, drier (rougher) layer kicked up in prints.
+    /// Dry sand: warm (saturated enough to stay sand under the bluish moon), fine grained, with a
+    /// slightly lighter, drier (rougher) layer kicked up in prints; the ground shows only where a
+    /// print is pressed almost through.
     pub const fn sand() -> Self {
         Self {
-            albedo: [0.50, 0.38, 0.24],
-            disturbed_albedo: [0.60, 0.47, 0.31],
+            albedo: [0.52, 0.36, 0.17],
+            disturbed_albedo: [0.56, 0.39, 0.19],
             roughness: 0.88,
             wet_roughness: 0.95,
             grain: 0.8,
@@ -236,10 +244,12 @@ impl MaterialLook {
             wetness: 0.0,
             translucency: 0.0,
             water_depth: None,
+            ground_from: Some(0.92),
         }
     }
 
-    /// Wet mud: dark brown, darker and glossy where pressed, water in prints deeper than 6 cm.
+    /// Wet mud: dark brown, darker and glossy where pressed, water in prints deeper than 6 cm;
+    /// the ground shows only where a print is pressed almost through.
     pub const fn mud() -> Self {
         Self {
             albedo: [0.11, 0.08, 0.055],
@@ -251,6 +261,7 @@ impl MaterialLook {
             wetness: 0.9,
             translucency: 0.0,
             water_depth: Some(0.06),
+            ground_from: Some(0.92),
         }
     }
 
@@ -282,6 +293,16 @@ impl MaterialLook {
         unit("material sparkle", self.sparkle)?;
         unit("material wetness", self.wetness)?;
         unit("material translucency", self.translucency)?;
+        if let Some(g) = self.ground_from
+            && !(g.is_finite() && g > 0.0 && g < 1.0)
+        {
+            return Err(SnowError::InvalidSurface {
+                name: name.to_owned(),
+                what: "material ground_from",
+                value: g.to_string(),
+                expected: "a fraction of the depth above 0 and below 1",
+            });
+        }
         if let Some(d) = self.water_depth
             && !(d.is_finite() && d > 0.0)
         {

@@ -315,6 +315,31 @@ fn scene_files_define_their_own_materials() {
     let e = err(scene(wet, "dry_sand"));
     assert!(e.contains("wet_sand") && e.contains("\"sand\""), "{e}");
     assert!(!e.contains('\n'), "one line: {e}");
+    // Compressibility and the look's keys.
+    let custom = "[[material]]\nname = \"beach\"\nlike = \"sand\"\ncompressibility = 0.6\nalbedo = [0.3, 0.2, 0.1]\nwetness = 0.5\nground_from = 0.8\nwater_depth = 0.05\n";
+    let m = parse(scene(custom, "beach")).unwrap().surfaces[0].material;
+    assert_eq!(m.compressibility, Some(0.6));
+    assert_eq!(m.rim_fraction(), Some(1.0 - 0.6));
+    assert_eq!(m.look.albedo, [0.3, 0.2, 0.1]);
+    assert_eq!(
+        (m.look.wetness, m.look.ground_from, m.look.water_depth),
+        (0.5, Some(0.8), Some(0.05))
+    );
+    assert_eq!(
+        m.look.grain,
+        Material::sand().look.grain,
+        "the rest from sand"
+    );
+    for (bad, line, says) in [
+        ("compressibility = 1.5", "dune.toml:4:", "from 0 to 1"),
+        ("albedo = [0.3, 0.2]", "dune.toml:4:", "three numbers"),
+        ("albedo = [0.3, 2.0, 0.1]", "dune.toml:4:", "from 0 to 1"),
+        ("ground_from = 1.0", "dune.toml:4:", "below 1"),
+        ("water_depth = -0.1", "dune.toml:4:", "above 0"),
+    ] {
+        let e = err(scene(&format!("[[material]]\nname = \"x\"\n{bad}\n"), "x"));
+        assert!(e.starts_with(line) && e.contains(says), "{bad}: {e}");
+    }
 }
 
 /// The looks are data: every preset's look is valid, snow's is the talk's constants (what

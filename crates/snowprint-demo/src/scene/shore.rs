@@ -35,8 +35,8 @@ fn strips() -> [(&'static str, Material, f32, f32, f32, f32); 4] {
 pub fn wet_sand() -> Material {
     Material {
         look: MaterialLook {
-            albedo: [0.30, 0.23, 0.15],
-            disturbed_albedo: [0.26, 0.2, 0.13],
+            albedo: [0.32, 0.22, 0.11],
+            disturbed_albedo: [0.27, 0.19, 0.09],
             roughness: 0.6,
             wet_roughness: 0.35,
             grain: 0.5,

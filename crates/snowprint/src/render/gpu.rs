@@ -202,7 +202,9 @@ impl SurfaceUniform {
                 m.wet_roughness,
             ],
             grain: [m.grain, m.sparkle, m.wetness, m.water_depth.unwrap_or(0.0)],
-            translucency: [m.translucency, 0.0, 0.0, 0.0],
+            // y: where the material's own ground blend starts (0: the renderer's look), z: where
+            // it ends (pressed through).
+            translucency: [m.translucency, m.ground_from.unwrap_or(0.0), 1.0, 0.0],
         }
     }
 

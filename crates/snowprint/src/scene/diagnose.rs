@@ -178,6 +178,7 @@ fn expectation(key: &str) -> Option<(&'static str, &'static str)> {
         "wetness" => ("a number from 0 to 1", "wetness = 0.6"),
         "translucency" => ("a number from 0 to 1", "translucency = 0.0"),
         "water_depth" => ("a number of metres", "water_depth = 0.06"),
+        "ground_from" => ("a number from 0 to 1", "ground_from = 0.92"),
         "shape" => ("a string", "shape = \"sphere\""),
         "radius" => ("a number of metres", "radius = 0.06"),
         "half_height" => ("a number of metres", "half_height = 0.08"),

@@ -47,6 +47,7 @@ pub(super) struct RawMaterial {
     pub wetness: Option<Num>,
     pub translucency: Option<Num>,
     pub water_depth: Option<Num>,
+    pub ground_from: Option<Num>,
 }
 
 /// `[budget]`: the surface manager's limits.
@@ -154,6 +155,7 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "wetness",
             "translucency",
             "water_depth",
+            "ground_from",
         ],
     ),
     (

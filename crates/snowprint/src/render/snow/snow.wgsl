@@ -66,7 +66,7 @@ struct SnowSurface {
     albedo: vec4<f32>,      // xyz: untouched albedo, w: dry roughness
     disturbed: vec4<f32>,   // xyz: disturbed albedo at the bottom of prints, w: wet roughness
     grain: vec4<f32>,       // x: grain, y: sparkle, z: wetness, w: water depth below the top (m, 0: none)
-    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), yzw unused
+    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), y: depression where the material's ground starts to show (0: look.x's), z: where it shows fully, w unused
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
@@ -365,7 +365,13 @@ fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_lo
         hit.position = o + d * hit.t;
         hit.water = 1u;
     }
-    if hit.found == 1u && hit.side == 0u {
+    if hit.water == 1u {
+        // The moon over the water surface: the floor's visibility, scaled by the walls above it.
+        let uv = snow_uv(s, hit.position.xz);
+        let floor_lit = snow_light_visibility(s, uv);
+        hit.shadow = mix(1.0, floor_lit, snow_water_enclosed(s, snow_depression(s, uv)));
+        hit.taps += 1u;
+    } else if hit.found == 1u && hit.side == 0u {
         hit.shadow = snow_light_visibility(s, snow_uv(s, hit.position.xz));
         hit.taps += 1u;
         if tier == SNOW_TIER_POM {
@@ -517,15 +523,31 @@ fn snow_sparkle(q: vec2<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, pixel: f
     return 40.0 * mirror * dot_size * fade * max(dot(n, l), 0.0);
 }
 
-// The flat water filling a deep print: dark, smooth, a mirror of the sky (added in lighting from
-// `mirror`), tinted by the mud under it.
+// Share of a print's walls (its floor `dep` deep, a fraction of the depth) that stand above the
+// water table: the water surface is that much less enclosed than the floor under it, so its
+// occlusion and the moon's shadow over it are the floor's scaled by it.
+fn snow_water_enclosed(s: SnowSurface, dep: f32) -> f32 {
+    return clamp(s.grain.w / max(dep * s.snow_depth, 1e-4), 0.0, 1.0);
+}
+
+// The flat water filling a deep print: smooth, a mirror of the sky (added in lighting from
+// `mirror`), over the soaked floor of the print seen through it, darker where the water is deeper
+// (`hf.x`: the floor's depression). Lit as the water surface, not as the floor: its occlusion is
+// the floor's, scaled by the walls that stand above the water.
 fn snow_water(s: SnowSurface, hf: vec4<f32>) -> SnowSample {
     var m: SnowSample;
-    m.albedo = s.disturbed.xyz * 0.5;
+    let column = max(hf.x * s.snow_depth - s.grain.w, 0.0);
+    let floor_albedo = s.disturbed.xyz * (1.0 - 0.35 * s.grain.z);
+    m.albedo = floor_albedo * mix(0.45, 1.0, exp(-column / 0.1));
     m.roughness = 0.06;
-    m.normal = vec3<f32>(0.0, 1.0, 0.0);
+    // The meniscus: near its edge (up to 2 cm of water over the floor) the water curves up the print's wall
+    // (`hf.yz`, the heightmap's slope there), so its rim mirrors the brighter sky low over the
+    // horizon: the line that tells a surface of water from a hole.
+    let hn = vec3<f32>(hf.y, hf.z, sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)));
+    let rim = 1.0 - smoothstep(0.0, 0.02, column);
+    m.normal = snow_ts_to_local(normalize(mix(vec3<f32>(0.0, 0.0, 1.0), hn, 0.6 * rim)));
     m.f0 = 0.02;
-    m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z);
+    m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z * snow_water_enclosed(s, hf.x));
     m.ground = 0.0;
     m.transition = 0.0;
     m.wrap = 0.0;
@@ -627,7 +649,15 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     // filtered `hf.x` is smoother but rounds off the bottoms of narrow prints).
     let dep = clamp(max(hf.x, 1.0 - p.y / s.snow_depth), 0.0, 1.0);
     // Stage weights: how much ground shows, and the transition (walls and rims of prints).
-    let ground = smoothstep(s.look.x, s.look.y, dep);
+    // Where the ground shows: the renderer's look, or the material's own (sand and mud show
+    // themselves at the bottom of prints until pressed almost through).
+    var ground_from = s.look.x;
+    var ground_full = s.look.y;
+    if s.translucency.y > 0.0 {
+        ground_from = s.translucency.y;
+        ground_full = s.translucency.z;
+    }
+    let ground = smoothstep(ground_from, ground_full, dep);
     let rim = smoothstep(0.01, 0.12, dep);
     let transition = rim * (1.0 - ground) * (0.55 + 0.45 * (1.0 - smoothstep(0.3, 0.9, dep))) * s.translucency.x;
 

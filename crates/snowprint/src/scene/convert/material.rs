@@ -119,6 +119,16 @@ fn look(src: &Source<'_>, m: &RawMaterial, who: &str, look: &mut MaterialLook) -
             *field = share(src, v, who, key)?;
         }
     }
+    if let Some(v) = &m.ground_from {
+        look.ground_from = Some(number(
+            src,
+            v,
+            who,
+            "ground_from",
+            |x| x > 0.0 && x < 1.0,
+            "ground_from must be a fraction of the depth above 0 and below 1",
+        )?);
+    }
     if let Some(v) = &m.water_depth {
         look.water_depth = Some(number(
             src,
