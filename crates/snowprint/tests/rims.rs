@@ -1,8 +1,8 @@
 //! Compressibility: of the volume a print presses out, `1 - compressibility` rises in rims beside
-//! it (the banks of the tessellated tier, from the displaced channel). A ball pressed into sand,
-//! powder and snow: the volume pressed out against the spherical cap computed by hand, the rims'
-//! volume against the material's share of it on the GPU, and the rims' field against the CPU
-//! reference of the banks.
+//! it (the banks, from the displaced channel). A ball pressed into sand, powder and snow: the
+//! volume pressed out against the spherical cap computed by hand, the rims' volume against the
+//! material's share of it on the GPU, and the rims' field against the CPU reference of the banks;
+//! the relief tier draws the rims too, around the print and nowhere else.
 
 mod common;
 
@@ -36,9 +36,20 @@ struct Rims {
     middle: f32,
 }
 
-/// A 2 m square yard of `material` with the ball pressed into its middle once, drawn in the
-/// tessellated tier with the renderer's default banks.
-fn pressed(material: Material) -> Rims {
+const WIDTH: u32 = 128;
+const HEIGHT: u32 = 72;
+
+fn camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.5, 2.5, 2.5),
+        target: Vec3::ZERO,
+        fov_y_degrees: 50.0,
+    }
+}
+
+/// A 2 m square yard of `material` with the ball pressed into its middle once, and a renderer of
+/// `tier`.
+fn yard(material: Material, tier: Tier) -> (SnowWorld, snowprint::SurfaceId, Renderer) {
     let mut world = SnowWorld::new(
         common::gpu(),
         WorldConfig {
@@ -55,19 +66,19 @@ fn pressed(material: Material) -> Rims {
         Pose::at([0.0, DEPTH - PRESSED + RADIUS, 0.0]),
     );
     world.step(1.0 / 60.0, &[ball]).expect("press");
-    let mut config = RenderConfig::new(128, 72, Tier::Tessellated);
+    let mut config = RenderConfig::new(WIDTH, HEIGHT, tier);
     config.shadow_map_size = 256;
-    let mut renderer = Renderer::new(common::gpu(), config).expect("renderer");
+    let renderer = Renderer::new(common::gpu(), config).expect("renderer");
+    (world, yard, renderer)
+}
+
+fn render(world: &SnowWorld, yard: snowprint::SurfaceId, renderer: &mut Renderer) -> Vec<u8> {
     let surfaces = [(yard, GroundMaterial::Concrete)];
     renderer
         .render(
-            &world,
+            world,
             &RenderFrame {
-                camera: Camera {
-                    eye: Vec3::new(0.5, 2.5, 2.5),
-                    target: Vec3::ZERO,
-                    fov_y_degrees: 50.0,
-                },
+                camera: camera(),
                 time: 0.0,
                 surfaces: &surfaces,
                 instances: &[],
@@ -76,7 +87,15 @@ fn pressed(material: Material) -> Rims {
                 snowfall: false,
             },
         )
-        .expect("render");
+        .expect("render")
+        .rgba8
+}
+
+/// The ball pressed into `material`, drawn in the tessellated tier with the renderer's default
+/// banks, measured.
+fn pressed(material: Material) -> Rims {
+    let (world, yard, mut renderer) = yard(material, Tier::Tessellated);
+    render(&world, yard, &mut renderer);
     let fields = renderer.read_surface_fields(yard).expect("fields");
     let heightmap = world.read_heightmap(yard).expect("heightmap");
     let texel = Vec2::new(2.0 / fields.width as f32, 2.0 / fields.height as f32);
@@ -170,4 +189,78 @@ fn rims_hold_what_the_material_does_not_compact() {
             r.middle
         );
     }
+}
+
+/// The pixel where a point of the yard's top lands on screen.
+fn pixel(p: Vec3) -> (u32, u32) {
+    let c = camera();
+    let clip = c.projection(WIDTH as f32 / HEIGHT as f32, 0.05, 100.0) * c.view() * p.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    (
+        ((ndc.x * 0.5 + 0.5) * WIDTH as f32) as u32,
+        ((0.5 - ndc.y * 0.5) * HEIGHT as f32) as u32,
+    )
+}
+
+/// The relief tier draws sand's rims: the same yard without them (sand stating no
+/// compressibility, so the relief tier has no banks) differs on pixels of the ring around the
+/// print and on none of the yard farther than the banks reach (the print's 18 cm, the banks' 30
+/// cm and the blur).
+#[test]
+fn the_relief_tier_raises_the_rims_beside_the_print() {
+    let plain = Material {
+        compressibility: None,
+        ..Material::sand()
+    };
+    let mut shots = Vec::new();
+    for material in [Material::sand(), plain] {
+        let (world, yard, mut renderer) = yard(material, Tier::Relief);
+        shots.push(render(&world, yard, &mut renderer));
+    }
+    // How far a pixel moved, the largest of its channels' differences.
+    let moved = |(x, y): (u32, u32)| {
+        let i = ((y * WIDTH + x) * 4) as usize;
+        (0..3)
+            .map(|c| shots[0][i + c].abs_diff(shots[1][i + c]))
+            .max()
+            .unwrap_or(0)
+    };
+    let (mut ring, mut far) = (Vec::new(), Vec::new());
+    let mut seen = std::collections::HashSet::new();
+    for k in 0..720 {
+        let a = k as f32 * std::f32::consts::TAU / 720.0;
+        for (r, near) in [(0.22, true), (0.3, true), (0.8, false), (0.9, false)] {
+            let p = pixel(Vec3::new(r * a.cos(), DEPTH, r * a.sin()));
+            if seen.insert((p, near)) {
+                if near {
+                    ring.push(moved(p))
+                } else {
+                    far.push(moved(p))
+                }
+            }
+        }
+    }
+    let changed = |v: &[u8], by: u8| v.iter().filter(|&&d| d > by).count();
+    let far_most = far.iter().copied().max().unwrap_or(0);
+    eprintln!(
+        "rims change {} of {} ring pixels by more than 8 levels; beyond: {} of {} changed, by {far_most} levels at most",
+        changed(&ring, 8),
+        ring.len(),
+        changed(&far, 0),
+        far.len()
+    );
+    assert!(
+        ring.len() > 50 && changed(&ring, 8) * 2 > ring.len(),
+        "{} of {} ring pixels changed",
+        changed(&ring, 8),
+        ring.len()
+    );
+    // Beyond the banks only the search's taps move (the slab is taller by the room for rims, so
+    // the flat top is found a rounding away): a few pixels by a level or two.
+    assert!(
+        far_most <= 3 && changed(&far, 0) * 20 <= far.len(),
+        "pixels beyond the banks' reach changed: {} of {}, by up to {far_most}",
+        changed(&far, 0),
+        far.len()
+    );
 }

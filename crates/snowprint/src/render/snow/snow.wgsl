@@ -66,7 +66,7 @@ struct SnowSurface {
     albedo: vec4<f32>,      // xyz: untouched albedo, w: dry roughness
     disturbed: vec4<f32>,   // xyz: disturbed albedo at the bottom of prints, w: wet roughness
     grain: vec4<f32>,       // x: grain, y: sparkle, z: wetness, w: water depth below the top (m, 0: none)
-    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), y: depression where the material's ground starts to show (0: look.x's), z: where it shows fully, w unused
+    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), y: depression where the material's ground starts to show (0: look.x's), z: where it shows fully, w: room for rims above the snow top (m, 0: none)
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
@@ -187,6 +187,13 @@ fn snow_uv(s: SnowSurface, xz: vec2<f32>) -> vec2<f32> {
     return (xz + s.half_size) / (2.0 * s.half_size);
 }
 
+// Top of the slab the view ray is traced through: the snow top, raised by the room for rims
+// (`translucency.w`, metres) where the material throws them (their banks are in
+// `snow_depression`).
+fn snow_top(s: SnowSurface) -> f32 {
+    return s.snow_depth + s.translucency.w;
+}
+
 // Snow height above the ground at a local (x, z), metres.
 fn snow_height(s: SnowSurface, xz: vec2<f32>) -> f32 {
     return s.snow_depth * (1.0 - snow_depression(s, snow_uv(s, xz)));
@@ -197,7 +204,7 @@ fn snow_inside(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t: f32) -> bool {
     return p.y <= snow_height(s, p.xz) + SNOW_EPSILON;
 }
 
-// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, 0 <= y <= depth:
+// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, 0 <= y <= snow_top(s):
 // (t, 1 when it reaches the ground first). Must match `slab_exit` in cpu.rs.
 fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     var t = 3.0e38;
@@ -206,7 +213,7 @@ fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
         t = o.y / -d.y;
         ground = 1.0;
     } else if d.y > 0.0 {
-        t = (s.snow_depth - o.y) / d.y;
+        t = (snow_top(s) - o.y) / d.y;
     }
     if d.x != 0.0 {
         let tx = (select(-s.half_size.x, s.half_size.x, d.x > 0.0) - o.x) / d.x;
@@ -310,7 +317,7 @@ fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f3
         return 1.0;
     }
     let start = p + vec3<f32>(0.0, 0.5 * s.texel, 0.0);
-    let t_top = (s.snow_depth - start.y) / l.y;
+    let t_top = (snow_top(s) - start.y) / l.y;
     if t_top <= 0.0 {
         return 1.0;
     }
@@ -335,7 +342,7 @@ fn snow_water_level(s: SnowSurface) -> f32 {
 // Trace the view ray entering the surface's box at local `o` with unit local direction `d`.
 fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_local: vec3<f32>) -> SnowHit {
     // The rasterized point can lie a hair outside the box: pull it in.
-    let o = clamp(o_in, vec3<f32>(-s.half_size.x, 0.0, -s.half_size.y), vec3<f32>(s.half_size.x, s.snow_depth, s.half_size.y));
+    let o = clamp(o_in, vec3<f32>(-s.half_size.x, 0.0, -s.half_size.y), vec3<f32>(s.half_size.x, snow_top(s), s.half_size.y));
     var hit: SnowHit;
     hit.shadow = 1.0;
     hit.side = 0u;

@@ -10,14 +10,13 @@
 // (snow.wgsl) without any search: the heightmap's normal tilted by the banks' slope, RNM detail,
 // the heightmap's AO, and the moon's shadow from the shadow map, which holds this same displaced
 // geometry (vs_tess_shadow), so trails shadow themselves and characters' shadows bend into them.
-// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-2 of group 1 and
-// its heightfield contract are reused.
+// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-3 of group 1 (the
+// bank texture and `bank_height` included) and its heightfield contract are reused.
 // Reads: frame uniforms, shadow map, the surface's heightfield, light and bank textures, the
 // surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade.
 
 // import surface
 
-@group(1) @binding(3) var bank_texture: texture_2d<f32>;
 @group(1) @binding(4) var<storage, read> surface_state: array<u32>;
 
 // Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
@@ -36,22 +35,6 @@ struct TessVarying {
 
 fn tess_touched() -> bool {
     return surface_state[surface.index * STATE_WORDS + STATE_TOUCHED] != 0u;
-}
-
-fn bank_texel(c: vec2<i32>) -> f32 {
-    let size = vec2<i32>(surface.grid);
-    return textureLoad(bank_texture, clamp(c, vec2<i32>(0), size - 1), 0).x;
-}
-
-// Bank height (metres) at uv, bilinear by hand (also usable in the vertex stage).
-fn bank_height(uv: vec2<f32>) -> f32 {
-    let p = uv * surface.grid - 0.5;
-    let i = floor(p);
-    let f = p - i;
-    let c = vec2<i32>(i);
-    let a = mix(bank_texel(c), bank_texel(c + vec2<i32>(1, 0)), f.x);
-    let b = mix(bank_texel(c + vec2<i32>(0, 1)), bank_texel(c + vec2<i32>(1, 1)), f.x);
-    return mix(a, b, f.y);
 }
 
 // Snow top above the base at local xz, metres: depth minus depression, plus banks, plus the
@@ -113,17 +96,6 @@ fn vs_tess_shadow(v: TessVertex) -> @builtin(position) vec4<f32> {
         m = frame.shadow_near;
     }
     return m * (surface.local_to_world * vec4<f32>(tess_local(v), 1.0));
-}
-
-// Slope of the banks at uv (metres per metre along local x and z), central differences.
-fn bank_gradient(uv: vec2<f32>) -> vec2<f32> {
-    let du = vec2<f32>(1.0 / surface.grid.x, 0.0);
-    let dv = vec2<f32>(0.0, 1.0 / surface.grid.y);
-    let step = 2.0 * surface.half_size / surface.grid;
-    return vec2<f32>(
-        (bank_height(uv + du) - bank_height(uv - du)) / (2.0 * step.x),
-        (bank_height(uv + dv) - bank_height(uv - dv)) / (2.0 * step.y),
-    );
 }
 
 @fragment
