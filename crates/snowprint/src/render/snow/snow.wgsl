@@ -9,7 +9,9 @@
 // functions that read one surface's heightmap:
 //
 //   // Fraction of the snow depth pressed down at `uv` (0 = untouched, 1 = ground), filtered.
-//   // Called by the relief search, several times per pixel: make it one texture tap.
+//   // Called by the relief search, several times per pixel: make it one texture tap. Where the
+//   // material has rims (`s.translucency.w` > 0, the room the slab rises by), subtract their
+//   // height over the depth to draw them (surface.wgsl does, from the banks pass).
 //   fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32
 //   // (depression, normal.x, normal.z, ambient occlusion) at `uv`, normal in the surface's local
 //   // frame, as smooth as you can afford (the renderer uses a 4-tap bicubic B-spline). Called
@@ -23,7 +25,7 @@
 // smallest x / z, as the heightmap pool stores them). The snowprint renderer fills all three from
 // textures that `heightfield.wgsl` derives from the pool each frame.
 //
-// Then, per pixel of the box drawn for a surface (top face at y = snow_depth, sides down to y = 0,
+// Then, per pixel of the box drawn for a surface (top face at y = snow_top(s), the snow depth raised by any room for rims, sides down to y = 0,
 // in the surface's local frame; `tier` SNOW_TIER_RELIEF or SNOW_TIER_POM, `light_local` the unit
 // direction towards the light in the local frame, `pixel` the pixel's footprint in metres):
 //   let hit = snow_trace(s, local_position, local_view_direction, tier, light_local);
