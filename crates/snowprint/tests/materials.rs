@@ -242,6 +242,59 @@ fn many_steps_a_dispatch_match_the_cpu_over_several_tiles() {
     }
 }
 
+/// A pit slumping across a tile's edge while the tiles around settle and are skipped: a deep pit
+/// 5 texels from the edge of the first tile (tiles start at the rectangle's first column, here the
+/// surface's, since a ball also presses its left edge) spreads into the flat tile beside it; the
+/// GPU matches the CPU's whole-surface steps after every one of 40 updates.
+#[test]
+fn slumping_crosses_into_a_still_tile_as_on_the_cpu() {
+    let sand = Material::sand();
+    let mut snow = world(Precision::Bits16);
+    let mut sandy = world(Precision::Bits16);
+    let add = |w: &mut SnowWorld, m: Material| {
+        let mut desc = SurfaceDesc::new("strip", [0.0, 0.0, 0.0], [3.0, 1.0], DEPTH);
+        desc.material = m;
+        w.add_surface(desc).unwrap()
+    };
+    let (s, d) = (add(&mut snow, Material::snow()), add(&mut sandy, sand));
+    // Texel x covers [-1.5 + 0.04 x, ...): the pit's centre at texel 22, its rim near 27; the
+    // tile boundary at 32.
+    let balls = [
+        Deformer::new(
+            Shape::Sphere { radius: 0.25 },
+            Pose::at([-0.4, DEPTH - 0.19 + 0.25, 0.0]),
+        ),
+        Deformer::new(
+            Shape::Sphere { radius: 0.1 },
+            Pose::at([-1.5, DEPTH - 0.05 + 0.1, 0.3]),
+        ),
+    ];
+    snow.step(DT, &balls).unwrap();
+    sandy.step(DT, &balls).unwrap();
+    let layout = sandy.layout(d).unwrap();
+    let (w, h) = (layout.width, layout.height);
+    let t = relax::threshold(34.0, 0.04, DEPTH, 65_535);
+    let mut expect = snow.read_channels(s).unwrap().0;
+    for update in 0..40 {
+        if update > 0 {
+            sandy.step(DT, &[]).unwrap();
+        }
+        for _ in 0..sand.steps() {
+            expect = relax::step(&expect, w, h, 65_535, [t, t]);
+        }
+        assert_eq!(sandy.read_channels(d).unwrap().0, expect, "update {update}");
+    }
+    let reach = (0..w as usize)
+        .filter(|&x| (0..h as usize).any(|y| expect[y * w as usize + x] > 0))
+        .max()
+        .unwrap_or(0);
+    eprintln!("the slump reaches column {reach}");
+    assert!(
+        reach > 33,
+        "the slump reached past the tile's edge: column {reach}"
+    );
+}
+
 fn steepest_step(d: &[u32], w: usize, h: usize) -> u32 {
     let mut m = 0;
     for y in 0..h {

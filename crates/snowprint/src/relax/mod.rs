@@ -10,7 +10,9 @@
 //!
 //! Why: one dispatch a step read five texels from the pool a texel a step, and on the talk's frame
 //! each step's dispatch and barrier cost more than its texels. A tile's steps in workgroup memory
-//! read the pool once, and a tile where a step moves nothing stops stepping.
+//! read the pool once, a tile where a step moves nothing stops stepping, and a tile that stood
+//! still with its neighbours in the dispatch from the pool is skipped by the one back to it (tile
+//! flags, `RelaxBuffers::tiles`): a settled surface costs one dispatch, not two.
 
 pub(crate) mod cpu;
 
@@ -38,8 +40,8 @@ pub struct RelaxRecord {
     pub rect: [u32; 4],
     /// Steps each relaxing dispatch takes ([`RelaxPlan::schedule`]).
     pub dispatch_steps: u32,
-    /// Padding to 48 bytes.
-    pub _pad: u32,
+    /// First word of the surface's tile flags ([`RelaxPlan::tile_words`]).
+    pub tiles: u32,
 }
 
 /// Where a surface of a slumping material may still move, kept by the world between updates.
@@ -116,6 +118,9 @@ pub struct RelaxPlan {
     pub steps: u32,
     /// u32 words of scratch (every listed surface's texels).
     pub scratch_words: u32,
+    /// u32 words of tile flags: a word for each `RELAX_TILE`-square tile of every listed
+    /// surface's rectangle (whether the tile stood still in the last dispatch from the pool).
+    pub tile_words: u32,
     /// Largest width and height of the listed surfaces (the dispatch grid).
     pub max_width: u32,
     /// See `max_width`.
@@ -150,11 +155,16 @@ impl RelaxPlan {
         self.records.clear();
     }
 
-    /// List a surface that relaxes `steps` steps this update over its record's rectangle.
-    pub fn push(&mut self, mut record: RelaxRecord, steps: u32) {
-        let [_, _, w, h] = record.rect;
+    /// List a surface that relaxes `steps` steps this update over its record's rectangle, in a
+    /// pool of `unit`-texel units.
+    pub fn push(&mut self, mut record: RelaxRecord, steps: u32, unit: u32) {
+        let [x0, _, w, h] = record.rect;
         record.scratch = self.scratch_words;
         self.scratch_words += w * h;
+        // Tiles start on a unit, as `tile_grid` in relax.wgsl counts them.
+        let tile = crate::wgsl::consts::RELAX_TILE;
+        record.tiles = self.tile_words;
+        self.tile_words += (x0 % unit.max(1) + w).div_ceil(tile) * h.div_ceil(tile);
         // The grid covers the rectangle's texels, and at 8 bits one unit more.
         self.max_width = self.max_width.max(w + 1);
         self.max_height = self.max_height.max(h);
@@ -229,6 +239,7 @@ pub(crate) struct RelaxGpu {
     pub(crate) pipes: RelaxPipelines,
     pub(crate) records: crate::gpu::resources::Growable,
     pub(crate) scratch: crate::gpu::resources::Growable,
+    pub(crate) tiles: crate::gpu::resources::Growable,
 }
 
 impl RelaxGpu {
@@ -239,6 +250,7 @@ impl RelaxGpu {
             pipes: RelaxPipelines::new(device, precision),
             records: Growable::new(device, "relax records", U::STORAGE | U::COPY_DST, 32 * 16),
             scratch: Growable::new(device, "relax scratch", U::STORAGE, 4 * 4096),
+            tiles: Growable::new(device, "relax tiles", U::STORAGE, 4 * 256),
         }
     }
 }
@@ -251,6 +263,8 @@ pub struct RelaxBuffers<'a> {
     pub pool: &'a wgpu::Buffer,
     /// At least `plan.scratch_words` u32.
     pub scratch: &'a wgpu::Buffer,
+    /// At least `plan.tile_words` u32 (written before they are read: no clearing).
+    pub tiles: &'a wgpu::Buffer,
 }
 
 /// Record the plan's steps: one compute pass, [`RelaxPlan::dispatches`] dispatches alternating
@@ -274,6 +288,7 @@ pub fn encode(
             b.records.as_entire_binding(),
             b.pool.as_entire_binding(),
             b.scratch.as_entire_binding(),
+            b.tiles.as_entire_binding(),
         ],
     );
     let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -13,6 +13,11 @@
 // RELAX_HALO) over a window that shrinks by a texel a step (a step moves material one texel, so
 // the tile's texels are exact after them), and writes its tile. A step that changes nothing in
 // its window ends the workgroup's steps early: the next ones would change nothing either.
+// Tiles that stand still are skipped: `relax_from_pool` flags each tile whose first step moved
+// nothing (`relax_tiles`, one word a tile, 1: still). Its span is then a fixed point and the
+// scratch holds the pool's values for it, so `relax_to_pool` skips a tile whose own and eight
+// neighbours' flags are all still (its span is as it was, the pool already holds it, and it
+// writes nothing another tile reads), and `relax_copy` a tile that is still itself.
 // Dispatches alternate: `relax_from_pool` reads the pool and writes the rectangle's depressions
 // into `scratch` (one u32 a texel), `relax_to_pool` reads `scratch` and writes the pool;
 // `relax_copy` (no step) writes `scratch` back to the pool after an odd number of dispatches.
@@ -36,12 +41,13 @@ struct RelaxRecord {
     rect_width: u32,
     rect_height: u32,
     dispatch_steps: u32, // steps each dispatch of `relax_from_pool` and `relax_to_pool` takes
-    _pad1: u32,
+    tiles: u32,       // first word of the record's tile flags in `relax_tiles`
 }
 
 @group(0) @binding(0) var<storage, read> relax_records: array<RelaxRecord>;
 @group(0) @binding(1) var<storage, read_write> pool: array<u32>;
 @group(0) @binding(2) var<storage, read_write> scratch: array<u32>;
+@group(0) @binding(3) var<storage, read_write> relax_tiles: array<u32>;
 
 const RELAX_SPAN: u32 = RELAX_TILE + 2u * RELAX_HALO;
 const RELAX_CELLS: u32 = RELAX_SPAN * RELAX_SPAN;
@@ -51,6 +57,31 @@ const RELAX_THREADS: u32 = 256u;
 var<workgroup> tops: array<u32, 2u * RELAX_CELLS>;
 var<workgroup> moved: atomic<u32>;
 var<workgroup> moved_any: u32;
+var<workgroup> skip_tile: u32;
+
+// The record's tiles along x and z (the dispatch's workgroups that cover its rectangle).
+fn tile_grid(r: RelaxRecord) -> vec2<u32> {
+    let first = r.x0 / unit_texels(PRECISION) * unit_texels(PRECISION);
+    return vec2<u32>((r.x0 - first + r.rect_width + RELAX_TILE - 1u) / RELAX_TILE, (r.rect_height + RELAX_TILE - 1u) / RELAX_TILE);
+}
+
+// Whether tile `t` of the record (and, with `around`, its eight neighbours within the grid) stood
+// still in the last `relax_from_pool`.
+fn tiles_still(r: RelaxRecord, t: vec2<u32>, around: bool) -> bool {
+    let grid = vec2<i32>(tile_grid(r));
+    let reach = select(0, 1, around);
+    for (var dy = -reach; dy <= reach; dy++) {
+        for (var dx = -reach; dx <= reach; dx++) {
+            let n = vec2<i32>(t) + vec2<i32>(dx, dy);
+            if all(n >= vec2<i32>(0)) && all(n < grid) {
+                if relax_tiles[r.tiles + u32(n.y * grid.x + n.x)] == 0u {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
 
 // Flow of material from a texel with top `a` to a neighbour with top `b`: (out, in) units.
 fn flow(a: u32, b: u32, threshold: u32) -> vec2<u32> {
@@ -141,11 +172,21 @@ fn settled(r: RelaxRecord, origin: vec2<i32>, at: u32, p: vec2<i32>) -> vec2<u32
 }
 
 // Load the span, take `steps` steps, write the tile: to the pool (`to_pool`) or to `scratch`.
-fn relax_tile(wg: vec3<u32>, lid: u32, from_scratch: bool, to_pool: bool, steps: u32) {
+// Reading `scratch`, skip the tile when the flags say it stands still (`around`: it and its
+// neighbours, before steps; else itself, for the copy).
+fn relax_tile(wg: vec3<u32>, lid: u32, from_scratch: bool, to_pool: bool, steps: u32, around: bool) {
     let r = relax_records[wg.z];
     let origin = tile_origin(r, wg);
     if origin.x >= i32(r.x0 + r.rect_width) || origin.y >= i32(r.y0 + r.rect_height) {
         return;
+    }
+    if from_scratch {
+        if lid == 0u {
+            skip_tile = select(0u, 1u, tiles_still(r, wg.xy, around));
+        }
+        if workgroupUniformLoad(&skip_tile) == 1u {
+            return;
+        }
     }
     for (var c = lid; c < RELAX_CELLS; c += RELAX_THREADS) {
         let p = cell_texel(origin, c);
@@ -160,6 +201,7 @@ fn relax_tile(wg: vec3<u32>, lid: u32, from_scratch: bool, to_pool: bool, steps:
         tops[c] = t;
     }
     var at = 0u;
+    var still = false;
     for (var k = 0u; k < steps; k++) {
         if lid == 0u {
             atomicStore(&moved, 0u);
@@ -172,8 +214,13 @@ fn relax_tile(wg: vec3<u32>, lid: u32, from_scratch: bool, to_pool: bool, steps:
             moved_any = atomicLoad(&moved);
         }
         if workgroupUniformLoad(&moved_any) == 0u {
+            still = k == 0u;
             break;
         }
+    }
+    if !from_scratch && lid == 0u {
+        let grid = tile_grid(r);
+        relax_tiles[r.tiles + wg.y * grid.x + wg.x] = select(0u, 1u, still);
     }
     workgroupBarrier();
     if to_pool {
@@ -204,15 +251,15 @@ fn relax_tile(wg: vec3<u32>, lid: u32, from_scratch: bool, to_pool: bool, steps:
 
 @compute @workgroup_size(16, 16, 1)
 fn relax_from_pool(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    relax_tile(wg, lid, false, false, relax_records[wg.z].dispatch_steps);
+    relax_tile(wg, lid, false, false, relax_records[wg.z].dispatch_steps, true);
 }
 
 @compute @workgroup_size(16, 16, 1)
 fn relax_to_pool(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    relax_tile(wg, lid, true, true, relax_records[wg.z].dispatch_steps);
+    relax_tile(wg, lid, true, true, relax_records[wg.z].dispatch_steps, true);
 }
 
 @compute @workgroup_size(16, 16, 1)
 fn relax_copy(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    relax_tile(wg, lid, true, true, 0u);
+    relax_tile(wg, lid, true, true, 0u, false);
 }
