@@ -54,7 +54,8 @@ pub struct Args {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Camera: flythrough, overview, closeup, run, fall, angel, slide or fight (the stand-in
-    /// scene has flythrough, closeup, overview, street, angel, fall and slide).
+    /// scene has flythrough, closeup, overview, street, angel, fall and slide; the shore
+    /// flythrough, overview, closeup and mud).
     #[arg(long, default_value = "flythrough")]
     pub camera: String,
     /// Snow tier: relief (the talk's relief mapping), pom (parallax occlusion mapping) or
@@ -83,8 +84,9 @@ pub struct Args {
     pub sim_hz: Option<u32>,
     /// Which demo: `rooftops` (the library's demo world, rendered), `skinned` (the rooftops with
     /// one person pressing the snow with its own skinned glTF mesh, rendered), `standin` (the
-    /// renderer's small stand-in world, rendered) or `city` (several hundred surfaces under the surface
-    /// manager's budget: heightmaps, a report, a pool plot and a map; not rendered).
+    /// renderer's small stand-in world, rendered), `shore` (wet and dry sand, a muddy track and a
+    /// snowy bank, people walking across, rendered) or `city` (several hundred surfaces under the
+    /// surface manager's budget: heightmaps, a report, a pool plot and a map; not rendered).
     #[arg(long, default_value = "rooftops")]
     pub scene: String,
     /// Also render the last frame in the relief and the tessellated tiers and write them side by

@@ -512,3 +512,44 @@ fn demo_help_lists_the_real_cameras() {
     assert!(!rooftops.contains("street"), "{camera}");
     assert!(standin.contains("street"), "{camera}");
 }
+
+/// `snowprint demo --scene shore` renders the shore: its four strips of sand, mud and snow are in
+/// the report, each printed by the people who crossed it by the frame.
+#[test]
+fn the_shore_demo_renders_its_four_strips() {
+    let _serial = serial();
+    let dir = scratch("shore");
+    let out = snowprint()
+        .args([
+            "demo", "--scene", "shore", "--camera", "overview", "--frames", "1",
+        ])
+        .args([
+            "--size", "96x54", "--sim-hz", "10", "--from", "7", "--to", "7",
+        ])
+        .args(["--no-snowfall", "--out"])
+        .arg(&dir)
+        .output()
+        .expect("run snowprint");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    assert!(
+        report["scene"].as_str().unwrap_or("").starts_with("shore"),
+        "{}",
+        report["scene"]
+    );
+    let surfaces = report["surfaces"].as_array().expect("surfaces");
+    let names: Vec<&str> = surfaces.iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(names, ["wet_sand", "dry_sand", "mud_track", "snow_bank"]);
+    for s in surfaces {
+        assert!(
+            s["deepest_print_last_frame"].as_f64().unwrap_or(0.0) > 0.2,
+            "{s}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -3,7 +3,8 @@
 //! sand (8 relaxation steps an update), against the same frames in snow (no relaxation), from the
 //! world's per-pass GPU timestamps: medians over the measured frames.
 //!
-//! `cargo bench -p snowprint --bench relax` (prints a table; needs timestamp queries).
+//! `cargo bench -p snowprint --bench relax` (prints a table; needs timestamp queries);
+//! `-- --quick` measures fewer frames, and 64 surfaces instead of 1024 (for software Vulkan).
 //! Results: `docs/PERFORMANCE.md`, "Relaxation".
 
 use snowprint::{
@@ -11,8 +12,9 @@ use snowprint::{
     SurfaceDesc, WorldConfig,
 };
 
-const WARMUP: u32 = 20;
-const FRAMES: u32 = 100;
+/// Frames run before measuring, and measured: full and `--quick`.
+const FULL: (u32, u32) = (20, 100);
+const QUICK: (u32, u32) = (5, 20);
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -20,7 +22,13 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// Median (relax, whole update) GPU milliseconds of `surfaces` 512^2 surfaces of `material`.
-fn run(gpu: &GpuContext, surfaces: u32, spheres: u32, material: Material) -> (f64, f64) {
+fn run(
+    gpu: &GpuContext,
+    (warmup, frames): (u32, u32),
+    surfaces: u32,
+    spheres: u32,
+    material: Material,
+) -> (f64, f64) {
     let format = PoolFormat::default();
     let side = 512.0 * 0.04;
     let mut world = SnowWorld::new(
@@ -48,8 +56,8 @@ fn run(gpu: &GpuContext, surfaces: u32, spheres: u32, material: Material) -> (f6
     }
     let mut times: Vec<(u64, StageTimes)> = Vec::new();
     let mut first_measured = 0;
-    for f in 0..WARMUP + FRAMES {
-        if f == WARMUP {
+    for f in 0..warmup + frames {
+        if f == warmup {
             first_measured = f as u64 + 1;
         }
         let t = f as f32 / 60.0;
@@ -86,17 +94,19 @@ fn main() {
         eprintln!("relax: this adapter has no timestamp queries; nothing to measure");
         return;
     }
+    let quick = std::env::args().any(|a| a == "--quick");
+    let (counts, many) = if quick { (QUICK, 64) } else { (FULL, 1024) };
     println!("relax on {}", gpu.info.name);
     println!(
         "{:<28} {:>12} {:>14} {:>14}",
         "frame", "relax_us", "update_us", "snow_update_us"
     );
     for (name, surfaces, spheres) in [
-        ("talk (2 x 512^2, 10 each)", 2, 10),
-        ("1024 x 512^2 (1 each)", 1024, 1),
+        ("talk (2 x 512^2, 10 each)".to_owned(), 2, 10),
+        (format!("{many} x 512^2 (1 each)"), many, 1),
     ] {
-        let (relax, total) = run(&gpu, surfaces, spheres, Material::sand());
-        let (_, snow) = run(&gpu, surfaces, spheres, Material::snow());
+        let (relax, total) = run(&gpu, counts, surfaces, spheres, Material::sand());
+        let (_, snow) = run(&gpu, counts, surfaces, spheres, Material::snow());
         println!(
             "{name:<28} {:>12.1} {:>14.1} {:>14.1}",
             relax * 1e3,

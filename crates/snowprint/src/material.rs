@@ -7,6 +7,12 @@
 //! neighbours until no step between neighbours is steeper than the repose angle, keeping the
 //! volume pressed out exactly. Dry sand slumps strongly, fresh powder a little; packed snow and
 //! mud keep their walls.
+//!
+//! What is pressed out either compacts under the foot or is pushed aside: [`Material::compressibility`]
+//! says how much of it compacts. The rest rises in rims beside the print, drawn from the
+//! heightmap's displaced channel by the renderer's banks (`render/tessellate/banks/`), so the rims
+//! hold `1 - compressibility` of the volume pressed out. Sand barely compacts and throws most of it
+//! aside; powder about half.
 
 use crate::error::{Result, SnowError};
 pub use crate::spray::SprayLook;
@@ -31,6 +37,12 @@ pub struct Material {
     /// older saves: the talk's snow.
     #[serde(default)]
     pub spray: SprayLook,
+    /// Share of a print's volume that compacts (0 to 1); the rest, `1 - compressibility` of the
+    /// volume pressed out, is pushed aside into rims beside the print. `None`: the renderer's
+    /// `BankSettings::fraction` decides (the talk's snow: a quarter into banks by default). Absent
+    /// from older saves: `None`.
+    #[serde(default)]
+    pub compressibility: Option<f32>,
 }
 
 impl Default for Material {
@@ -48,6 +60,7 @@ impl Material {
             relax_steps: 0,
             settle_updates: 0,
             spray: SprayLook::snow(),
+            compressibility: None,
         }
     }
 
@@ -60,7 +73,8 @@ impl Material {
         }
     }
 
-    /// Fresh powder: walls steeper than 60 degrees crumble, slowly; it sparkles.
+    /// Fresh powder: walls steeper than 60 degrees crumble, slowly; it sparkles; half of what a
+    /// print presses out compacts, half is pushed aside into loose rims.
     pub const fn powder() -> Self {
         Self {
             look: MaterialLook::powder(),
@@ -68,10 +82,12 @@ impl Material {
             relax_steps: 2,
             settle_updates: 30,
             spray: SprayLook::powder(),
+            compressibility: Some(0.5),
         }
     }
 
-    /// Dry sand: slumps back into a print until its walls stand at 34 degrees.
+    /// Dry sand: slumps back into a print until its walls stand at 34 degrees; it hardly
+    /// compacts, so four fifths of what a print presses out rise in rims beside it.
     pub const fn sand() -> Self {
         Self {
             look: MaterialLook::sand(),
@@ -79,6 +95,7 @@ impl Material {
             relax_steps: 8,
             settle_updates: 120,
             spray: SprayLook::sand(),
+            compressibility: Some(0.2),
         }
     }
 
@@ -108,6 +125,12 @@ impl Material {
         self.repose_degrees.is_some() && self.relax_steps > 0
     }
 
+    /// Share of the volume pressed out that rises in rims, when the material says
+    /// (`1 - compressibility`); `None`: the renderer's bank settings decide.
+    pub fn rim_fraction(&self) -> Option<f32> {
+        self.compressibility.map(|c| 1.0 - c)
+    }
+
     /// Relaxation steps an update takes: even, so that the last writes the pool.
     pub fn steps(&self) -> u32 {
         if self.slumps() {
@@ -127,6 +150,16 @@ impl Material {
                 what: "material repose_degrees",
                 value: a.to_string(),
                 expected: "degrees from 0 to 90",
+            });
+        }
+        if let Some(c) = self.compressibility
+            && !(c.is_finite() && (0.0..=1.0).contains(&c))
+        {
+            return Err(SnowError::InvalidSurface {
+                name: name.to_owned(),
+                what: "material compressibility",
+                value: c.to_string(),
+                expected: "a share of the pressed volume from 0 to 1",
             });
         }
         self.look.validate(name)?;
@@ -172,6 +205,11 @@ pub struct MaterialLook {
     /// Depth below the untouched top, metres, of the water table: prints deeper than this fill
     /// with a flat water surface up to it (mud); `None`: no water.
     pub water_depth: Option<f32>,
+    /// Depression (fraction of the depth pressed, 0 to 1) from which the ground under the
+    /// material shows, fully once pressed through; `None`: the renderer's `SnowLook` decides
+    /// (snow, which packs into a thin layer: from two thirds). Sand and mud show the material
+    /// itself at the bottom of a print until it is pressed almost to the ground.
+    pub ground_from: Option<f32>,
 }
 
 impl Default for MaterialLook {
@@ -193,6 +231,7 @@ impl MaterialLook {
             wetness: 0.0,
             translucency: 1.0,
             water_depth: None,
+            ground_from: None,
         }
     }
 
@@ -205,11 +244,13 @@ impl MaterialLook {
         }
     }
 
-    /// Dry sand: warm, fine grained, with a lighter, drier (rougher) layer kicked up in prints.
+    /// Dry sand: warm (saturated enough to stay sand under the bluish moon), fine grained, with a
+    /// slightly lighter, drier (rougher) layer kicked up in prints; the ground shows only where a
+    /// print is pressed almost through.
     pub const fn sand() -> Self {
         Self {
-            albedo: [0.50, 0.38, 0.24],
-            disturbed_albedo: [0.60, 0.47, 0.31],
+            albedo: [0.52, 0.36, 0.17],
+            disturbed_albedo: [0.56, 0.39, 0.19],
             roughness: 0.88,
             wet_roughness: 0.95,
             grain: 0.8,
@@ -217,10 +258,12 @@ impl MaterialLook {
             wetness: 0.0,
             translucency: 0.0,
             water_depth: None,
+            ground_from: Some(0.92),
         }
     }
 
-    /// Wet mud: dark brown, darker and glossy where pressed, water in prints deeper than 6 cm.
+    /// Wet mud: dark brown, darker and glossy where pressed, water in prints deeper than 6 cm;
+    /// the ground shows only where a print is pressed almost through.
     pub const fn mud() -> Self {
         Self {
             albedo: [0.11, 0.08, 0.055],
@@ -232,6 +275,7 @@ impl MaterialLook {
             wetness: 0.9,
             translucency: 0.0,
             water_depth: Some(0.06),
+            ground_from: Some(0.92),
         }
     }
 
@@ -263,6 +307,16 @@ impl MaterialLook {
         unit("material sparkle", self.sparkle)?;
         unit("material wetness", self.wetness)?;
         unit("material translucency", self.translucency)?;
+        if let Some(g) = self.ground_from
+            && !(g.is_finite() && g > 0.0 && g < 1.0)
+        {
+            return Err(SnowError::InvalidSurface {
+                name: name.to_owned(),
+                what: "material ground_from",
+                value: g.to_string(),
+                expected: "a fraction of the depth above 0 and below 1",
+            });
+        }
         if let Some(d) = self.water_depth
             && !(d.is_finite() && d > 0.0)
         {

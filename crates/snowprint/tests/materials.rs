@@ -152,6 +152,149 @@ fn settled_sand_stands_at_its_angle_of_repose() {
     assert_eq!(fixed, again, "the CPU rule reaches a fixed point");
 }
 
+/// The dispatches of several steps in workgroup memory against the CPU's one step over the whole
+/// surface: two surfaces of several tiles (75 x 45 and 43 x 65 texels) pressed in four places,
+/// one at an odd column and one against an edge, relaxing 2 steps an update (one dispatch and a
+/// copy), 6 (two of three) and 10 (five of two and a copy), for five updates, at 8, 16 and 32 bits.
+#[test]
+fn many_steps_a_dispatch_match_the_cpu_over_several_tiles() {
+    let balls = [
+        ([-0.9, -0.2], 0.25),
+        ([0.62, 0.3], 0.2),
+        ([1.35, -0.7], 0.15),
+        ([-0.1, 0.55], 0.3),
+    ];
+    let press = |center: [f32; 3]| -> Vec<Deformer> {
+        balls
+            .iter()
+            .map(|&([x, z], r)| {
+                Deformer::new(
+                    Shape::Sphere { radius: r },
+                    Pose::at([center[0] + x, DEPTH - 0.6 * r + r, center[2] + z]),
+                )
+            })
+            .collect()
+    };
+    let sides = [
+        ([0.0, 0.0, 0.0], [3.0, 1.8]),
+        ([6.0, 0.0, 0.0], [1.72, 2.6]),
+    ];
+    for steps in [2, 6, 10] {
+        let material = Material {
+            relax_steps: steps,
+            ..Material::sand()
+        };
+        for precision in Precision::ALL {
+            let (mut snow, mut sandy) = (world(precision), world(precision));
+            let mut ids = Vec::new();
+            let mut deformers = Vec::new();
+            for (center, size) in sides {
+                let add = |w: &mut SnowWorld, m: Material| {
+                    let mut desc = SurfaceDesc::new("dune", center, size, DEPTH);
+                    desc.material = m;
+                    w.add_surface(desc).unwrap()
+                };
+                ids.push((add(&mut snow, Material::snow()), add(&mut sandy, material)));
+                deformers.extend(press(center));
+            }
+            snow.step(DT, &deformers).unwrap();
+            sandy.step(DT, &deformers).unwrap();
+            let max = precision.channel_max();
+            for &(s, d) in &ids {
+                let pressed = snow.read_channels(s).unwrap().0;
+                let layout = sandy.layout(d).unwrap();
+                let (w, h) = (layout.width, layout.height);
+                let t = relax::threshold(34.0, 0.04, DEPTH, max);
+                let mut expect = pressed.clone();
+                for _ in 0..steps {
+                    expect = relax::step(&expect, w, h, max, [t, t]);
+                }
+                let got = sandy.read_channels(d).unwrap().0;
+                assert_eq!(got, expect, "{steps} steps, {precision:?}, {w} x {h}");
+                assert_ne!(
+                    got, pressed,
+                    "{steps} steps, {precision:?}: the prints slumped"
+                );
+                assert_eq!(sum(&got), sum(&pressed));
+            }
+            // Four updates that only settle, both surfaces at once.
+            let mut expects: Vec<Vec<u32>> = ids
+                .iter()
+                .map(|&(_, d)| sandy.read_channels(d).unwrap().0)
+                .collect();
+            for update in 1..5 {
+                sandy.step(DT, &[]).unwrap();
+                for (&(_, d), expect) in ids.iter().zip(&mut expects) {
+                    let layout = sandy.layout(d).unwrap();
+                    let (w, h) = (layout.width, layout.height);
+                    let t = relax::threshold(34.0, 0.04, DEPTH, max);
+                    for _ in 0..steps {
+                        *expect = relax::step(expect, w, h, max, [t, t]);
+                    }
+                    let got = sandy.read_channels(d).unwrap().0;
+                    assert_eq!(
+                        &got, expect,
+                        "{steps} steps, {precision:?}, update {update}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A pit slumping across a tile's edge while the tiles around settle and are skipped: a deep pit
+/// 5 texels from the edge of the first tile (tiles start at the rectangle's first column, here the
+/// surface's, since a ball also presses its left edge) spreads into the flat tile beside it; the
+/// GPU matches the CPU's whole-surface steps after every one of 40 updates.
+#[test]
+fn slumping_crosses_into_a_still_tile_as_on_the_cpu() {
+    let sand = Material::sand();
+    let mut snow = world(Precision::Bits16);
+    let mut sandy = world(Precision::Bits16);
+    let add = |w: &mut SnowWorld, m: Material| {
+        let mut desc = SurfaceDesc::new("strip", [0.0, 0.0, 0.0], [3.0, 1.0], DEPTH);
+        desc.material = m;
+        w.add_surface(desc).unwrap()
+    };
+    let (s, d) = (add(&mut snow, Material::snow()), add(&mut sandy, sand));
+    // Texel x covers [-1.5 + 0.04 x, ...): the pit's centre at texel 22, its rim near 27; the
+    // tile boundary at 32.
+    let balls = [
+        Deformer::new(
+            Shape::Sphere { radius: 0.25 },
+            Pose::at([-0.4, DEPTH - 0.19 + 0.25, 0.0]),
+        ),
+        Deformer::new(
+            Shape::Sphere { radius: 0.1 },
+            Pose::at([-1.5, DEPTH - 0.05 + 0.1, 0.3]),
+        ),
+    ];
+    snow.step(DT, &balls).unwrap();
+    sandy.step(DT, &balls).unwrap();
+    let layout = sandy.layout(d).unwrap();
+    let (w, h) = (layout.width, layout.height);
+    let t = relax::threshold(34.0, 0.04, DEPTH, 65_535);
+    let mut expect = snow.read_channels(s).unwrap().0;
+    for update in 0..40 {
+        if update > 0 {
+            sandy.step(DT, &[]).unwrap();
+        }
+        for _ in 0..sand.steps() {
+            expect = relax::step(&expect, w, h, 65_535, [t, t]);
+        }
+        assert_eq!(sandy.read_channels(d).unwrap().0, expect, "update {update}");
+    }
+    let reach = (0..w as usize)
+        .filter(|&x| (0..h as usize).any(|y| expect[y * w as usize + x] > 0))
+        .max()
+        .unwrap_or(0);
+    eprintln!("the slump reaches column {reach}");
+    assert!(
+        reach > 33,
+        "the slump reached past the tile's edge: column {reach}"
+    );
+}
+
 fn steepest_step(d: &[u32], w: usize, h: usize) -> u32 {
     let mut m = 0;
     for y in 0..h {
@@ -225,6 +368,31 @@ fn scene_files_define_their_own_materials() {
     let e = err(scene(wet, "dry_sand"));
     assert!(e.contains("wet_sand") && e.contains("\"sand\""), "{e}");
     assert!(!e.contains('\n'), "one line: {e}");
+    // Compressibility and the look's keys.
+    let custom = "[[material]]\nname = \"beach\"\nlike = \"sand\"\ncompressibility = 0.6\nalbedo = [0.3, 0.2, 0.1]\nwetness = 0.5\nground_from = 0.8\nwater_depth = 0.05\n";
+    let m = parse(scene(custom, "beach")).unwrap().surfaces[0].material;
+    assert_eq!(m.compressibility, Some(0.6));
+    assert_eq!(m.rim_fraction(), Some(1.0 - 0.6));
+    assert_eq!(m.look.albedo, [0.3, 0.2, 0.1]);
+    assert_eq!(
+        (m.look.wetness, m.look.ground_from, m.look.water_depth),
+        (0.5, Some(0.8), Some(0.05))
+    );
+    assert_eq!(
+        m.look.grain,
+        Material::sand().look.grain,
+        "the rest from sand"
+    );
+    for (bad, line, says) in [
+        ("compressibility = 1.5", "dune.toml:4:", "from 0 to 1"),
+        ("albedo = [0.3, 0.2]", "dune.toml:4:", "three numbers"),
+        ("albedo = [0.3, 2.0, 0.1]", "dune.toml:4:", "from 0 to 1"),
+        ("ground_from = 1.0", "dune.toml:4:", "below 1"),
+        ("water_depth = -0.1", "dune.toml:4:", "above 0"),
+    ] {
+        let e = err(scene(&format!("[[material]]\nname = \"x\"\n{bad}\n"), "x"));
+        assert!(e.starts_with(line) && e.contains(says), "{bad}: {e}");
+    }
 }
 
 /// The looks are data: every preset's look is valid, snow's is the talk's constants (what

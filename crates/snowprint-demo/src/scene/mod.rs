@@ -1,9 +1,11 @@
 //! What the rendered demo draws: a [`DemoScene`] is a world the command `snowprint demo` can
-//! simulate and render, and [`build_scene`] picks one by name. Two worlds implement it:
+//! simulate and render, and [`build_scene`] picks one by name. Three worlds implement it:
 //! [`rooftops`] (the demo world of this crate, [`crate::DemoWorld`], with materials and street
-//! lamps) and [`standin`] (a small, self-contained second world).
+//! lamps), [`standin`] (a small, self-contained second world) and [`shore`] (sand, mud and snow
+//! side by side, walked across by the stand-in's people).
 
 pub mod rooftops;
+pub mod shore;
 pub mod skinned;
 pub mod standin;
 
@@ -36,9 +38,9 @@ pub trait DemoScene {
     fn camera(&self, name: &str, t: f32) -> Option<Camera>;
 }
 
-/// The demo world by name: `rooftops`, this crate's demo world ([`crate::DemoWorld`]), or
-/// `standin`, the small world the command carried before that one existed. This is the one place
-/// where a world plugs into the renderer's demo.
+/// The demo world by name: `rooftops`, this crate's demo world ([`crate::DemoWorld`]),
+/// `standin`, the small world the command carried before that one existed, or `shore`, the
+/// materials' beach. This is the one place where a world plugs into the renderer's demo.
 pub fn build_scene(
     name: &str,
     world: &mut SnowWorld,
@@ -48,8 +50,9 @@ pub fn build_scene(
         "rooftops" => Ok(Box::new(rooftops::LibraryDemo::new(world, renderer)?)),
         "standin" => Ok(Box::new(standin::StandIn::new(world, renderer)?)),
         "skinned" => Ok(Box::new(skinned::SkinnedDemo::new(world, renderer)?)),
+        "shore" => Ok(Box::new(shore::Shore::new(world, renderer)?)),
         _ => Err(format!(
-            "unknown scene {name:?}; use rooftops, skinned, standin or city"
+            "unknown scene {name:?}; use rooftops, skinned, standin, shore or city"
         )),
     }
 }

@@ -3,8 +3,16 @@
 //!
 //! The world's frame plan lists the surfaces that relax this update ([`RelaxPlan`]); the pass runs
 //! after the fused (or merge) pass and before the normals, so that kept normals see the slumped
-//! top. Each step is one dispatch over every listed surface (`z` is the record), alternating
-//! between the pool and a scratch buffer, an even number of steps in all.
+//! top. A dispatch takes up to [`RELAX_HALO`](crate::wgsl::consts::RELAX_HALO) steps over every
+//! listed surface (`z` is the record) in workgroup memory, each workgroup a tile and a halo as
+//! wide as its steps; dispatches alternate between the pool and a scratch buffer, and a copy ends
+//! an odd number of them in the pool ([`RelaxPlan::schedule`]).
+//!
+//! Why: one dispatch a step read five texels from the pool a texel a step, and on the talk's frame
+//! each step's dispatch and barrier cost more than its texels. A tile's steps in workgroup memory
+//! read the pool once, a tile where a step moves nothing stops stepping, and a tile that stood
+//! still with its neighbours in the dispatch from the pool is skipped by the one back to it (tile
+//! flags, `RelaxBuffers::tiles`): a settled surface costs one dispatch, not two.
 
 pub(crate) mod cpu;
 
@@ -30,8 +38,10 @@ pub struct RelaxRecord {
     pub threshold_z: u32,
     /// The rectangle that relaxes ([`Rect`]): first column, first row, columns, rows.
     pub rect: [u32; 4],
-    /// Padding to 48 bytes.
-    pub _pad: [u32; 2],
+    /// Steps each relaxing dispatch takes ([`RelaxPlan::schedule`]).
+    pub dispatch_steps: u32,
+    /// First word of the surface's tile flags ([`RelaxPlan::tile_words`]).
+    pub tiles: u32,
 }
 
 /// Where a surface of a slumping material may still move, kept by the world between updates.
@@ -108,10 +118,31 @@ pub struct RelaxPlan {
     pub steps: u32,
     /// u32 words of scratch (every listed surface's texels).
     pub scratch_words: u32,
+    /// u32 words of tile flags: a word for each `RELAX_TILE`-square tile of every listed
+    /// surface's rectangle (whether the tile stood still in the last dispatch from the pool).
+    pub tile_words: u32,
     /// Largest width and height of the listed surfaces (the dispatch grid).
     pub max_width: u32,
     /// See `max_width`.
     pub max_height: u32,
+    /// Relaxing dispatches ([`RelaxPlan::schedule`]), each of `dispatch_steps` steps.
+    pub dispatches: u32,
+    /// See `dispatches`.
+    pub dispatch_steps: u32,
+}
+
+/// How `steps` relaxation steps split into dispatches: `(dispatches, steps each)`, the fewest
+/// dispatches of at most `halo` steps that take exactly `steps` in all (equal shares, so that one
+/// number a record says how many).
+pub fn split_steps(steps: u32, halo: u32) -> (u32, u32) {
+    if steps == 0 {
+        return (0, 0);
+    }
+    let fewest = steps.div_ceil(halo.max(1));
+    let n = (fewest..=steps)
+        .find(|n| steps.is_multiple_of(*n))
+        .unwrap_or(steps);
+    (n, steps / n)
 }
 
 impl RelaxPlan {
@@ -124,16 +155,32 @@ impl RelaxPlan {
         self.records.clear();
     }
 
-    /// List a surface that relaxes `steps` steps this update over its record's rectangle.
-    pub fn push(&mut self, mut record: RelaxRecord, steps: u32) {
-        let [_, _, w, h] = record.rect;
+    /// List a surface that relaxes `steps` steps this update over its record's rectangle, in a
+    /// pool of `unit`-texel units.
+    pub fn push(&mut self, mut record: RelaxRecord, steps: u32, unit: u32) {
+        let [x0, _, w, h] = record.rect;
         record.scratch = self.scratch_words;
         self.scratch_words += w * h;
+        // Tiles start on a unit, as `tile_grid` in relax.wgsl counts them.
+        let tile = crate::wgsl::consts::RELAX_TILE;
+        record.tiles = self.tile_words;
+        self.tile_words += (x0 % unit.max(1) + w).div_ceil(tile) * h.div_ceil(tile);
         // The grid covers the rectangle's texels, and at 8 bits one unit more.
         self.max_width = self.max_width.max(w + 1);
         self.max_height = self.max_height.max(h);
         self.steps = self.steps.max(steps);
         self.records.push(record);
+    }
+
+    /// Split the plan's steps into dispatches ([`split_steps`]) and tell every record (call once
+    /// every surface is listed).
+    pub fn schedule(&mut self) {
+        let (n, k) = split_steps(self.steps, crate::wgsl::consts::RELAX_HALO);
+        self.dispatches = n;
+        self.dispatch_steps = k;
+        for r in &mut self.records {
+            r.dispatch_steps = k;
+        }
     }
 
     /// Whether nothing relaxes.
@@ -142,10 +189,11 @@ impl RelaxPlan {
     }
 }
 
-/// The two entry points and their layout.
+/// The three entry points and their layout.
 pub struct RelaxPipelines {
     from_pool: wgpu::ComputePipeline,
     to_pool: wgpu::ComputePipeline,
+    copy: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -180,6 +228,7 @@ impl RelaxPipelines {
         Self {
             from_pool: make("relax_from_pool"),
             to_pool: make("relax_to_pool"),
+            copy: make("relax_copy"),
             layout,
         }
     }
@@ -190,6 +239,7 @@ pub(crate) struct RelaxGpu {
     pub(crate) pipes: RelaxPipelines,
     pub(crate) records: crate::gpu::resources::Growable,
     pub(crate) scratch: crate::gpu::resources::Growable,
+    pub(crate) tiles: crate::gpu::resources::Growable,
 }
 
 impl RelaxGpu {
@@ -200,6 +250,7 @@ impl RelaxGpu {
             pipes: RelaxPipelines::new(device, precision),
             records: Growable::new(device, "relax records", U::STORAGE | U::COPY_DST, 32 * 16),
             scratch: Growable::new(device, "relax scratch", U::STORAGE, 4 * 4096),
+            tiles: Growable::new(device, "relax tiles", U::STORAGE, 4 * 256),
         }
     }
 }
@@ -212,9 +263,12 @@ pub struct RelaxBuffers<'a> {
     pub pool: &'a wgpu::Buffer,
     /// At least `plan.scratch_words` u32.
     pub scratch: &'a wgpu::Buffer,
+    /// At least `plan.tile_words` u32 (written before they are read: no clearing).
+    pub tiles: &'a wgpu::Buffer,
 }
 
-/// Record the plan's steps: one compute pass, one dispatch a step.
+/// Record the plan's steps: one compute pass, [`RelaxPlan::dispatches`] dispatches alternating
+/// from the pool to the scratch and back, and a copy back to the pool after an odd number.
 pub fn encode(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
@@ -234,6 +288,7 @@ pub fn encode(
             b.records.as_entire_binding(),
             b.pool.as_entire_binding(),
             b.scratch.as_entire_binding(),
+            b.tiles.as_entire_binding(),
         ],
     );
     let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -241,15 +296,14 @@ pub fn encode(
         timestamp_writes: queries.compute("relax"),
     });
     pass.set_bind_group(0, &bg, &[]);
-    let wg = crate::wgsl::consts::WORKGROUP;
+    let tile = crate::wgsl::consts::RELAX_TILE;
+    // A tile's columns start on a unit (two texels at 8 bits): the grid covers one more column.
     let (gx, gy, gz) = (
-        plan.max_width.div_ceil(wg),
-        plan.max_height.div_ceil(wg),
+        plan.max_width.div_ceil(tile),
+        plan.max_height.div_ceil(tile),
         plan.records.len() as u32,
     );
-    for k in 0..plan.steps {
-        // Units of two texels at 8 bits only matter when writing the pool; a grid over texels
-        // covers them.
+    for k in 0..plan.dispatches {
         pass.set_pipeline(if k % 2 == 0 {
             &pipes.from_pool
         } else {
@@ -257,10 +311,39 @@ pub fn encode(
         });
         pass.dispatch_workgroups(gx, gy, gz);
     }
+    if plan.dispatches % 2 == 1 {
+        pass.set_pipeline(&pipes.copy);
+        pass.dispatch_workgroups(gx, gy, gz);
+    }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::split_steps;
+
+    /// Steps split into the fewest dispatches of at most the halo, equal shares, all taken.
+    #[test]
+    fn steps_split_into_equal_dispatches() {
+        assert_eq!(split_steps(0, 4), (0, 0));
+        assert_eq!(split_steps(2, 4), (1, 2));
+        assert_eq!(split_steps(8, 4), (2, 4));
+        assert_eq!(split_steps(6, 4), (2, 3));
+        assert_eq!(split_steps(10, 4), (5, 2));
+        assert_eq!(split_steps(64, 4), (16, 4));
+        for steps in (2..=64).step_by(2) {
+            let (n, k) = split_steps(steps, 4);
+            assert_eq!(
+                n,
+                (1..=steps)
+                    .find(|n| steps % n == 0 && steps / n <= 4)
+                    .unwrap()
+            );
+            assert_eq!(n * k, steps);
+            // Even steps always split into twos at worst.
+            assert!((2..=4).contains(&k), "{steps}: {k} a dispatch");
+        }
+    }
+
     /// `RelaxRecord` here and in relax.wgsl: same fields in order, 4 bytes each, 48 bytes.
     #[test]
     fn record_layout_matches_wgsl() {

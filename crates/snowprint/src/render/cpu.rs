@@ -52,7 +52,9 @@ impl SlabRay {
 }
 
 /// Where a ray leaves the snow slab `|x| <= half.x, |z| <= half.y, 0 <= y <= depth`:
-/// `(t, reaches_ground)`. Must match `snow_slab_exit` in `snow.wgsl`.
+/// `(t, reaches_ground)`. Must match `snow_slab_exit` in `snow.wgsl`, whose slab top is
+/// `snow_top`: the snow depth, plus the room for rims of a material that throws them (pass that
+/// sum as `depth`).
 pub fn slab_exit(ray: &SlabRay, half: Vec2, depth: f32) -> (f32, bool) {
     let (o, d) = (ray.origin, ray.dir);
     let mut t = f32::MAX;

@@ -128,6 +128,14 @@ pub struct SurfaceUniform {
     pub translucency: [f32; 4],
 }
 
+/// Room for rims above the snow top that the relief and POM tiers raise their slab by, metres:
+/// the material's share of the pushed volume times the snow depth (a rim a whole depth high needs
+/// the whole depth pushed out beside a print a bank's width wide; higher rims are cut flat); 0
+/// for a material without rims (the talk's snow: the slab as before).
+pub(crate) fn rim_room(material: &crate::Material, snow_depth: f32) -> f32 {
+    material.rim_fraction().map_or(0.0, |f| f * snow_depth)
+}
+
 impl SurfaceUniform {
     /// Surface `id` of a frame's view ([`crate::SnowWorld::frame_view`]): its transforms, size,
     /// snow depth and texel sides, where its heights lie in the pool and at what precision, and the
@@ -202,7 +210,14 @@ impl SurfaceUniform {
                 m.wet_roughness,
             ],
             grain: [m.grain, m.sparkle, m.wetness, m.water_depth.unwrap_or(0.0)],
-            translucency: [m.translucency, 0.0, 0.0, 0.0],
+            // y: where the material's own ground blend starts (0: the renderer's look), z: where
+            // it ends (pressed through); w: room for rims above the snow top (metres, 0: none).
+            translucency: [
+                m.translucency,
+                m.ground_from.unwrap_or(0.0),
+                1.0,
+                rim_room(&desc.material, desc.snow_depth),
+            ],
         }
     }
 

@@ -102,9 +102,10 @@ pub mod pass {
     pub const TONEMAP: usize = 11;
 }
 
-/// The passes of a frame, in the order they run. The tessellated tier's passes (`banks`, `dice`,
-/// `snow_shadow`) are encoded empty in the other tiers, and `spray` for a world without spray, so
-/// every tier reports the same list.
+/// The passes of a frame, in the order they run. The tessellated tier's passes (`dice`,
+/// `snow_shadow`) are encoded empty in the other tiers, `banks` too but for surfaces whose
+/// material throws rims, and `spray` for a world without spray, so every tier reports the same
+/// list.
 pub const PASSES: [PassInfo; 12] = [
     PassInfo {
         name: "classify",

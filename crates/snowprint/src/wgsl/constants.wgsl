@@ -57,5 +57,9 @@ const LIGHT_TAPS: u32 = 16u;
 const AO_DIRECTIONS: u32 = 8u;
 // Least receptivity of a texel to banks (at the bottom of trails), so that no pushed snow is lost.
 const RECEPTIVITY_FLOOR: f32 = 0.001;
+// Side of the square of texels a workgroup of the relaxation (relax/relax.wgsl) writes.
+const RELAX_TILE: u32 = 32u;
+// Most relaxation steps one dispatch takes: the halo of texels a workgroup reads around its tile.
+const RELAX_HALO: u32 = 4u;
 // Vertices a workgroup of the skinning pass (skin/skin.wgsl) skins.
 const SKIN_WORKGROUP: u32 = 64u;

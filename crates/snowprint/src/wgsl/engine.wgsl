@@ -38,7 +38,7 @@ struct snowprint_Surface {
     albedo: vec4<f32>,      // the material's look (snow.wgsl): untouched albedo, dry roughness
     disturbed: vec4<f32>,   // disturbed albedo, wet roughness
     grain: vec4<f32>,       // grain, sparkle, wetness, water depth (metres, 0: none)
-    translucency: vec4<f32>, // translucency; yzw unused
+    translucency: vec4<f32>, // translucency; y, z: the material's ground blend (0: the renderer's); w: room for rims above the top (m)
 }
 
 @group(0) @binding(0) var<storage, read> snowprint_pool: array<u32>;

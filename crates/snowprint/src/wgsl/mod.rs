@@ -133,6 +133,8 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
         Override::FilterableIfSupported,
     ),
     ("surface", "heightfield_light", Override::Stages(FRAGMENT)),
+    // Bank heights, read with textureLoad (bilinear by hand, as in the tessellated tier).
+    ("surface", "bank_texture", Override::NotFiltering),
     // The tessellated tier shares the snow pass's bindings with both stages.
     ("tess_surface", "surface", Override::Stages(VERTEX_FRAGMENT)),
     (

@@ -406,6 +406,7 @@ impl SnowWorld {
                 bytemuck::cast_slice(&plan.relax.records),
             );
             self.relax.scratch.ensure(device, sizes.relax_scratch);
+            self.relax.tiles.ensure(device, sizes.relax_tiles);
         }
         self.scratch.ensure(device, sizes.scratch);
         self.capture.ensure(device, sizes.capture);
@@ -465,6 +466,7 @@ impl SnowWorld {
             records: &self.relax.records.buffer,
             pool: &self.pool,
             scratch: &self.relax.scratch.buffer,
+            tiles: &self.relax.tiles.buffer,
         };
         relax::encode(
             &self.device,

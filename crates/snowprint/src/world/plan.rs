@@ -119,6 +119,8 @@ pub struct BufferSizes {
     pub relax_records: u64,
     /// Relaxation scratch (a u32 a texel of every relaxing surface).
     pub relax_scratch: u64,
+    /// Relaxation tile flags (a u32 a tile of every relaxing surface's rectangle).
+    pub relax_tiles: u64,
 }
 
 /// One surface's work while the plan is built.
@@ -435,11 +437,14 @@ impl FramePlan {
                     threshold_x: threshold(r.texel_x),
                     threshold_z: threshold(r.texel_z),
                     rect: [rect.x0, rect.y0, rw, rh],
-                    _pad: [0; 2],
+                    dispatch_steps: 0,
+                    tiles: 0,
                 },
                 steps,
+                settings.format.precision.unit_texels(),
             );
         }
+        self.relax.schedule();
         let texels = c.texels.max(1) as u64 * 4;
         self.sizes = BufferSizes {
             records: (a.records.len() * std::mem::size_of::<SurfaceRecord>()) as u64,
@@ -454,6 +459,7 @@ impl FramePlan {
             tile_list: (TILE_LIST_HEADER + 2 * c.tile_flags as u64) * 4,
             relax_records: std::mem::size_of_val(self.relax.records.as_slice()) as u64,
             relax_scratch: self.relax.scratch_words as u64 * 4,
+            relax_tiles: self.relax.tile_words as u64 * 4,
         };
     }
 }

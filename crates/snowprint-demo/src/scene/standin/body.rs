@@ -8,42 +8,42 @@ use snowprint::{Pose, Shape};
 use super::{PI, TAU};
 
 /// Limb dimensions, metres.
-pub(super) const THIGH: f32 = 0.45;
-pub(super) const SHIN: f32 = 0.44;
-pub(super) const UPPER_ARM: f32 = 0.30;
-pub(super) const FOREARM: f32 = 0.28;
-pub(super) const TORSO: f32 = 0.50;
-pub(super) const FOOT: f32 = 0.27;
+pub(in crate::scene) const THIGH: f32 = 0.45;
+pub(in crate::scene) const SHIN: f32 = 0.44;
+pub(in crate::scene) const UPPER_ARM: f32 = 0.30;
+pub(in crate::scene) const FOREARM: f32 = 0.28;
+pub(in crate::scene) const TORSO: f32 = 0.50;
+pub(in crate::scene) const FOOT: f32 = 0.27;
 
 /// The drawn parts of a person.
 #[derive(Clone, Copy)]
-pub(super) struct BodyMeshes {
-    pub(super) torso: RenderMeshId,
-    pub(super) head: RenderMeshId,
-    pub(super) upper_arm: RenderMeshId,
-    pub(super) forearm: RenderMeshId,
-    pub(super) thigh: RenderMeshId,
-    pub(super) shin: RenderMeshId,
-    pub(super) boot: RenderMeshId,
+pub(in crate::scene) struct BodyMeshes {
+    pub(in crate::scene) torso: RenderMeshId,
+    pub(in crate::scene) head: RenderMeshId,
+    pub(in crate::scene) upper_arm: RenderMeshId,
+    pub(in crate::scene) forearm: RenderMeshId,
+    pub(in crate::scene) thigh: RenderMeshId,
+    pub(in crate::scene) shin: RenderMeshId,
+    pub(in crate::scene) boot: RenderMeshId,
 }
 
 /// A posed person: joints in world space and the frame of each foot.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Skeleton {
-    pub(super) pelvis: Vec3,
-    pub(super) neck: Vec3,
-    pub(super) head: Vec3,
-    pub(super) shoulders: [Vec3; 2],
-    pub(super) elbows: [Vec3; 2],
-    pub(super) hands: [Vec3; 2],
-    pub(super) hips: [Vec3; 2],
-    pub(super) knees: [Vec3; 2],
-    pub(super) ankles: [Vec3; 2],
+pub(in crate::scene) struct Skeleton {
+    pub(in crate::scene) pelvis: Vec3,
+    pub(in crate::scene) neck: Vec3,
+    pub(in crate::scene) head: Vec3,
+    pub(in crate::scene) shoulders: [Vec3; 2],
+    pub(in crate::scene) elbows: [Vec3; 2],
+    pub(in crate::scene) hands: [Vec3; 2],
+    pub(in crate::scene) hips: [Vec3; 2],
+    pub(in crate::scene) knees: [Vec3; 2],
+    pub(in crate::scene) ankles: [Vec3; 2],
     /// Heel point on the sole and the unit forward and up of each foot.
-    pub(super) feet: [(Vec3, Vec3, Vec3); 2],
+    pub(in crate::scene) feet: [(Vec3, Vec3, Vec3); 2],
 }
 
-pub(super) fn segment_pose(a: Vec3, b: Vec3) -> Pose {
+pub(in crate::scene) fn segment_pose(a: Vec3, b: Vec3) -> Pose {
     let d = b - a;
     Pose {
         position: (a + b) * 0.5,
@@ -51,18 +51,18 @@ pub(super) fn segment_pose(a: Vec3, b: Vec3) -> Pose {
     }
 }
 
-pub(super) fn pose_matrix(p: &Pose) -> Mat4 {
+pub(in crate::scene) fn pose_matrix(p: &Pose) -> Mat4 {
     Mat4::from_rotation_translation(p.rotation, p.position)
 }
 
-pub(super) fn foot_rotation(fwd: Vec3, up: Vec3) -> Quat {
+pub(in crate::scene) fn foot_rotation(fwd: Vec3, up: Vec3) -> Quat {
     let side = fwd.cross(up).normalize();
     Quat::from_mat3(&glam::Mat3::from_cols(fwd, up, side))
 }
 
 /// The parts of a skeleton as capsules (a: start, b: end, radius) and the feet.
 impl Skeleton {
-    pub(super) fn capsules(&self) -> Vec<(Vec3, Vec3, f32)> {
+    pub(in crate::scene) fn capsules(&self) -> Vec<(Vec3, Vec3, f32)> {
         let mut v = vec![(self.pelvis, self.neck, 0.16)];
         for i in 0..2 {
             v.push((self.shoulders[i], self.elbows[i], 0.05));
@@ -75,7 +75,7 @@ impl Skeleton {
 
     /// Deformer shapes of the feet, a boot sole in three flat blocks: the heel, the ball and the
     /// arch between (1.5 cm higher, so prints show heel and toe), and a rounded toe.
-    pub(super) fn foot_shapes(&self) -> Vec<(Shape, Pose)> {
+    pub(in crate::scene) fn foot_shapes(&self) -> Vec<(Shape, Pose)> {
         let mut v = Vec::new();
         for &(heel, fwd, up) in &self.feet {
             let rotation = foot_rotation(fwd, up);
@@ -103,7 +103,7 @@ impl Skeleton {
     }
 
     /// Everything that presses the snow, with its pose.
-    pub(super) fn shapes(&self) -> Vec<(Shape, Pose)> {
+    pub(in crate::scene) fn shapes(&self) -> Vec<(Shape, Pose)> {
         let mut v: Vec<(Shape, Pose)> = self
             .capsules()
             .into_iter()
@@ -128,7 +128,7 @@ impl Skeleton {
         v
     }
 
-    pub(super) fn instances(
+    pub(in crate::scene) fn instances(
         &self,
         m: &BodyMeshes,
         coat: [f32; 3],
@@ -162,7 +162,7 @@ impl Skeleton {
     }
 
     /// The same skeleton turned rigidly about `pivot` by `q`, then moved by `shift`.
-    pub(super) fn transformed(&self, pivot: Vec3, q: Quat, shift: Vec3) -> Skeleton {
+    pub(in crate::scene) fn transformed(&self, pivot: Vec3, q: Quat, shift: Vec3) -> Skeleton {
         let p = |x: Vec3| pivot + q * (x - pivot) + shift;
         let mut s = *self;
         s.pelvis = p(s.pelvis);
@@ -183,7 +183,7 @@ impl Skeleton {
 }
 
 /// Knee of a two-bone leg from hip to ankle, bending towards `forward`.
-pub(super) fn knee(hip: Vec3, ankle: Vec3, forward: Vec3) -> Vec3 {
+pub(in crate::scene) fn knee(hip: Vec3, ankle: Vec3, forward: Vec3) -> Vec3 {
     let d = ankle - hip;
     let len = d.length().clamp(0.05, THIGH + SHIN - 1e-3);
     let dir = d.normalize_or(-Vec3::Y);
@@ -196,20 +196,20 @@ pub(super) fn knee(hip: Vec3, ankle: Vec3, forward: Vec3) -> Vec3 {
 
 /// A gait: walking or running along a straight path.
 #[derive(Clone, Copy)]
-pub(super) struct Gait {
-    pub(super) start: Vec3,
-    pub(super) dir: Vec3,
-    pub(super) speed: f32,
-    pub(super) period: f32,
-    pub(super) stance: f32,
-    pub(super) lift: f32,
-    pub(super) t0: f32,
-    pub(super) t1: f32,
+pub(in crate::scene) struct Gait {
+    pub(in crate::scene) start: Vec3,
+    pub(in crate::scene) dir: Vec3,
+    pub(in crate::scene) speed: f32,
+    pub(in crate::scene) period: f32,
+    pub(in crate::scene) stance: f32,
+    pub(in crate::scene) lift: f32,
+    pub(in crate::scene) t0: f32,
+    pub(in crate::scene) t1: f32,
 }
 
 impl Gait {
     /// Heel point, forward and up of foot `i` at time `t` (clamped to the walk).
-    pub(super) fn foot(&self, i: usize, t: f32) -> (Vec3, Vec3, Vec3) {
+    pub(in crate::scene) fn foot(&self, i: usize, t: f32) -> (Vec3, Vec3, Vec3) {
         let t = t.clamp(self.t0, self.t1) - self.t0;
         let side = self.dir.cross(Vec3::Y).normalize();
         let lateral = side * if i == 0 { -0.11 } else { 0.11 };
@@ -258,7 +258,7 @@ impl Gait {
         (heel, fwd, up)
     }
 
-    pub(super) fn skeleton(&self, t: f32) -> Skeleton {
+    pub(in crate::scene) fn skeleton(&self, t: f32) -> Skeleton {
         let tt = t.clamp(self.t0, self.t1) - self.t0;
         let side = self.dir.cross(Vec3::Y).normalize();
         let bob = 0.025 * (2.0 * TAU * tt / self.period).cos();
@@ -298,7 +298,12 @@ impl Gait {
 }
 
 /// A standing skeleton facing `dir` with its feet at `ground`, arms a little out.
-pub(super) fn standing(ground: Vec3, dir: Vec3, arms_out: f32, legs_out: f32) -> Skeleton {
+pub(in crate::scene) fn standing(
+    ground: Vec3,
+    dir: Vec3,
+    arms_out: f32,
+    legs_out: f32,
+) -> Skeleton {
     let side = dir.cross(Vec3::Y).normalize();
     let pelvis = ground + Vec3::Y * 0.93;
     let neck = pelvis + Vec3::Y * TORSO;
@@ -333,7 +338,7 @@ pub(super) fn standing(ground: Vec3, dir: Vec3, arms_out: f32, legs_out: f32) ->
 
 /// What one person does over time.
 #[derive(Clone, Copy)]
-pub(super) enum Act {
+pub(in crate::scene) enum Act {
     Walk(Gait),
     /// Lying on the back, sliding feet-first from `from` to `to` between t0 and t1.
     Slide {
@@ -359,7 +364,12 @@ pub(super) enum Act {
 
 /// A lying skeleton: a standing one, turned onto its back about the heels, head towards
 /// `head_dir`, face up.
-pub(super) fn lying(ground: Vec3, head_dir: Vec3, arms_out: f32, legs_out: f32) -> Skeleton {
+pub(in crate::scene) fn lying(
+    ground: Vec3,
+    head_dir: Vec3,
+    arms_out: f32,
+    legs_out: f32,
+) -> Skeleton {
     // Standing facing away from the head direction, then turned backwards by 90 degrees: its up
     // goes to `head_dir`, its front to +Y.
     let facing = -head_dir;
@@ -370,7 +380,7 @@ pub(super) fn lying(ground: Vec3, head_dir: Vec3, arms_out: f32, legs_out: f32) 
 }
 
 impl Act {
-    pub(super) fn skeleton(&self, t: f32) -> Skeleton {
+    pub(in crate::scene) fn skeleton(&self, t: f32) -> Skeleton {
         match *self {
             Act::Walk(g) => g.skeleton(t),
             Act::Slide { from, to, t0, t1 } => {
@@ -401,17 +411,17 @@ impl Act {
     }
 }
 
-pub(super) struct Person {
-    pub(super) act: Act,
-    pub(super) coat: [f32; 3],
-    pub(super) trousers: [f32; 3],
+pub(in crate::scene) struct Person {
+    pub(in crate::scene) act: Act,
+    pub(in crate::scene) coat: [f32; 3],
+    pub(in crate::scene) trousers: [f32; 3],
     /// Leaves the scene at this time (the stand-in has no getting-up animation: the fallen person
     /// vanishes so that the imprint of the body can be seen).
-    pub(super) leaves: Option<f32>,
+    pub(in crate::scene) leaves: Option<f32>,
 }
 
 impl Person {
-    pub(super) fn present(&self, t: f32) -> bool {
+    pub(in crate::scene) fn present(&self, t: f32) -> bool {
         self.leaves.is_none_or(|l| t < l)
     }
 }

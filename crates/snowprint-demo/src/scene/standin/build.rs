@@ -13,7 +13,7 @@ fn rerr(e: snowprint::render::RenderError) -> String {
 }
 
 /// A closed cylinder along +Y from y = 0 to `height`.
-pub(super) fn cylinder(radius: f32, height: f32, segments: u32) -> Mesh {
+pub(in crate::scene) fn cylinder(radius: f32, height: f32, segments: u32) -> Mesh {
     let mut positions = vec![Vec3::ZERO, Vec3::new(0.0, height, 0.0)];
     for s in 0..segments {
         let a = TAU * s as f32 / segments as f32;
@@ -143,7 +143,7 @@ fn set_meshes(renderer: &mut Renderer) -> Result<SetMeshes, String> {
     })
 }
 
-fn body_meshes(renderer: &mut Renderer) -> Result<BodyMeshes, String> {
+pub(in crate::scene) fn body_meshes(renderer: &mut Renderer) -> Result<BodyMeshes, String> {
     let capsule = |r: f32, len: f32| Mesh::capsule(r, len * 0.5, 8, 12);
     let body = BodyMeshes {
         torso: renderer.add_mesh(&capsule(0.16, TORSO)).map_err(rerr)?,

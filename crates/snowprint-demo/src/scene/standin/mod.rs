@@ -12,8 +12,8 @@ use snowprint::{Camera, Deformer, GroundMaterial, SnowWorld, SurfaceId};
 
 use super::DemoScene;
 
-mod body;
-mod build;
+pub(super) mod body;
+pub(super) mod build;
 
 use body::{BodyMeshes, Person};
 

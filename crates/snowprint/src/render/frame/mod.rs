@@ -38,6 +38,22 @@ impl FrameSurface<'_> {
             desc.size.y / layout.height as f32,
         )
     }
+
+    /// Whether its material throws rims (states a compressibility): the relief and POM tiers
+    /// then draw the banks above the snow top too.
+    pub(super) fn rims(&self) -> bool {
+        self.view.desc.material.rim_fraction().is_some()
+    }
+
+    /// Its banks: the geometry's, with the share of the pushed volume set by the material's
+    /// compressibility where the material states one (`Material::rim_fraction`).
+    pub(super) fn banks(&self) -> crate::render::BankSettings {
+        let banks = self.geometry.banks;
+        match self.view.desc.material.rim_fraction() {
+            Some(fraction) => crate::render::BankSettings { fraction, ..banks },
+            None => banks,
+        }
+    }
 }
 
 /// The frame uniform's buffer, its layouts and bind groups (with the shadow map and samplers).

@@ -38,11 +38,11 @@ impl SnowPass {
         let layout =
             crate::wgsl::SURFACE.bind_group_layout_for(device, "snow surface", 1, filterable);
         let module = pipeline::shader(device, "surface.wgsl", crate::wgsl::SURFACE.wgsl());
-        let snow = |label, fs, constants| {
+        let snow = |label, vs, fs, constants| {
             pipeline::Raster {
                 label,
                 module: &module,
-                vs: "vs_surface",
+                vs,
                 fs,
                 buffers: &[],
                 groups: &[frame_layout, &layout],
@@ -53,9 +53,10 @@ impl SnowPass {
             }
             .build(device)
         };
-        let basic = snow("snow basic", "fs_basic", &[]);
+        let basic = snow("snow basic", "vs_surface", "fs_basic", &[]);
         let deformable = snow(
             "snow deformable",
+            "vs_surface_deformable",
             "fs_deformable",
             pipeline::manual_filter(filterable),
         );
@@ -120,6 +121,7 @@ impl SnowPass {
                         SurfaceUniform::block(&self.uniforms.buffer, s),
                         wgpu::BindingResource::TextureView(&tex.shape),
                         wgpu::BindingResource::TextureView(&tex.light),
+                        wgpu::BindingResource::TextureView(&tex.bank),
                     ],
                 ))
             })

@@ -9,7 +9,9 @@
 // functions that read one surface's heightmap:
 //
 //   // Fraction of the snow depth pressed down at `uv` (0 = untouched, 1 = ground), filtered.
-//   // Called by the relief search, several times per pixel: make it one texture tap.
+//   // Called by the relief search, several times per pixel: make it one texture tap. Where the
+//   // material has rims (`s.translucency.w` > 0, the room the slab rises by), subtract their
+//   // height over the depth to draw them (surface.wgsl does, from the banks pass).
 //   fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32
 //   // (depression, normal.x, normal.z, ambient occlusion) at `uv`, normal in the surface's local
 //   // frame, as smooth as you can afford (the renderer uses a 4-tap bicubic B-spline). Called
@@ -23,7 +25,7 @@
 // smallest x / z, as the heightmap pool stores them). The snowprint renderer fills all three from
 // textures that `heightfield.wgsl` derives from the pool each frame.
 //
-// Then, per pixel of the box drawn for a surface (top face at y = snow_depth, sides down to y = 0,
+// Then, per pixel of the box drawn for a surface (top face at y = snow_top(s), the snow depth raised by any room for rims, sides down to y = 0,
 // in the surface's local frame; `tier` SNOW_TIER_RELIEF or SNOW_TIER_POM, `light_local` the unit
 // direction towards the light in the local frame, `pixel` the pixel's footprint in metres):
 //   let hit = snow_trace(s, local_position, local_view_direction, tier, light_local);
@@ -66,7 +68,7 @@ struct SnowSurface {
     albedo: vec4<f32>,      // xyz: untouched albedo, w: dry roughness
     disturbed: vec4<f32>,   // xyz: disturbed albedo at the bottom of prints, w: wet roughness
     grain: vec4<f32>,       // x: grain, y: sparkle, z: wetness, w: water depth below the top (m, 0: none)
-    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), yzw unused
+    translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), y: depression where the material's ground starts to show (0: look.x's), z: where it shows fully, w: room for rims above the snow top (m, 0: none)
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
@@ -187,6 +189,13 @@ fn snow_uv(s: SnowSurface, xz: vec2<f32>) -> vec2<f32> {
     return (xz + s.half_size) / (2.0 * s.half_size);
 }
 
+// Top of the slab the view ray is traced through: the snow top, raised by the room for rims
+// (`translucency.w`, metres) where the material throws them (their banks are in
+// `snow_depression`).
+fn snow_top(s: SnowSurface) -> f32 {
+    return s.snow_depth + s.translucency.w;
+}
+
 // Snow height above the ground at a local (x, z), metres.
 fn snow_height(s: SnowSurface, xz: vec2<f32>) -> f32 {
     return s.snow_depth * (1.0 - snow_depression(s, snow_uv(s, xz)));
@@ -197,7 +206,7 @@ fn snow_inside(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t: f32) -> bool {
     return p.y <= snow_height(s, p.xz) + SNOW_EPSILON;
 }
 
-// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, 0 <= y <= depth:
+// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, 0 <= y <= snow_top(s):
 // (t, 1 when it reaches the ground first). Must match `slab_exit` in cpu.rs.
 fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     var t = 3.0e38;
@@ -206,7 +215,7 @@ fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
         t = o.y / -d.y;
         ground = 1.0;
     } else if d.y > 0.0 {
-        t = (s.snow_depth - o.y) / d.y;
+        t = (snow_top(s) - o.y) / d.y;
     }
     if d.x != 0.0 {
         let tx = (select(-s.half_size.x, s.half_size.x, d.x > 0.0) - o.x) / d.x;
@@ -310,7 +319,7 @@ fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f3
         return 1.0;
     }
     let start = p + vec3<f32>(0.0, 0.5 * s.texel, 0.0);
-    let t_top = (s.snow_depth - start.y) / l.y;
+    let t_top = (snow_top(s) - start.y) / l.y;
     if t_top <= 0.0 {
         return 1.0;
     }
@@ -335,7 +344,7 @@ fn snow_water_level(s: SnowSurface) -> f32 {
 // Trace the view ray entering the surface's box at local `o` with unit local direction `d`.
 fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_local: vec3<f32>) -> SnowHit {
     // The rasterized point can lie a hair outside the box: pull it in.
-    let o = clamp(o_in, vec3<f32>(-s.half_size.x, 0.0, -s.half_size.y), vec3<f32>(s.half_size.x, s.snow_depth, s.half_size.y));
+    let o = clamp(o_in, vec3<f32>(-s.half_size.x, 0.0, -s.half_size.y), vec3<f32>(s.half_size.x, snow_top(s), s.half_size.y));
     var hit: SnowHit;
     hit.shadow = 1.0;
     hit.side = 0u;
@@ -365,7 +374,13 @@ fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_lo
         hit.position = o + d * hit.t;
         hit.water = 1u;
     }
-    if hit.found == 1u && hit.side == 0u {
+    if hit.water == 1u {
+        // The moon over the water surface: the floor's visibility, scaled by the walls above it.
+        let uv = snow_uv(s, hit.position.xz);
+        let floor_lit = snow_light_visibility(s, uv);
+        hit.shadow = mix(1.0, floor_lit, snow_water_enclosed(s, snow_depression(s, uv)));
+        hit.taps += 1u;
+    } else if hit.found == 1u && hit.side == 0u {
         hit.shadow = snow_light_visibility(s, snow_uv(s, hit.position.xz));
         hit.taps += 1u;
         if tier == SNOW_TIER_POM {
@@ -517,15 +532,31 @@ fn snow_sparkle(q: vec2<f32>, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, pixel: f
     return 40.0 * mirror * dot_size * fade * max(dot(n, l), 0.0);
 }
 
-// The flat water filling a deep print: dark, smooth, a mirror of the sky (added in lighting from
-// `mirror`), tinted by the mud under it.
+// Share of a print's walls (its floor `dep` deep, a fraction of the depth) that stand above the
+// water table: the water surface is that much less enclosed than the floor under it, so its
+// occlusion and the moon's shadow over it are the floor's scaled by it.
+fn snow_water_enclosed(s: SnowSurface, dep: f32) -> f32 {
+    return clamp(s.grain.w / max(dep * s.snow_depth, 1e-4), 0.0, 1.0);
+}
+
+// The flat water filling a deep print: smooth, a mirror of the sky (added in lighting from
+// `mirror`), over the soaked floor of the print seen through it, darker where the water is deeper
+// (`hf.x`: the floor's depression). Lit as the water surface, not as the floor: its occlusion is
+// the floor's, scaled by the walls that stand above the water.
 fn snow_water(s: SnowSurface, hf: vec4<f32>) -> SnowSample {
     var m: SnowSample;
-    m.albedo = s.disturbed.xyz * 0.5;
+    let column = max(hf.x * s.snow_depth - s.grain.w, 0.0);
+    let floor_albedo = s.disturbed.xyz * (1.0 - 0.35 * s.grain.z);
+    m.albedo = floor_albedo * mix(0.45, 1.0, exp(-column / 0.1));
     m.roughness = 0.06;
-    m.normal = vec3<f32>(0.0, 1.0, 0.0);
+    // The meniscus: near its edge (up to 2 cm of water over the floor) the water curves up the print's wall
+    // (`hf.yz`, the heightmap's slope there), so its rim mirrors the brighter sky low over the
+    // horizon: the line that tells a surface of water from a hole.
+    let hn = vec3<f32>(hf.y, hf.z, sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)));
+    let rim = 1.0 - smoothstep(0.0, 0.02, column);
+    m.normal = snow_ts_to_local(normalize(mix(vec3<f32>(0.0, 0.0, 1.0), hn, 0.6 * rim)));
     m.f0 = 0.02;
-    m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z);
+    m.ao = mix(1.0, clamp(hf.w, 0.0, 1.0), s.look.z * snow_water_enclosed(s, hf.x));
     m.ground = 0.0;
     m.transition = 0.0;
     m.wrap = 0.0;
@@ -627,7 +658,15 @@ fn snow_deformable(s: SnowSurface, hit: SnowHit, hf: vec4<f32>, face: vec3<f32>,
     // filtered `hf.x` is smoother but rounds off the bottoms of narrow prints).
     let dep = clamp(max(hf.x, 1.0 - p.y / s.snow_depth), 0.0, 1.0);
     // Stage weights: how much ground shows, and the transition (walls and rims of prints).
-    let ground = smoothstep(s.look.x, s.look.y, dep);
+    // Where the ground shows: the renderer's look, or the material's own (sand and mud show
+    // themselves at the bottom of prints until pressed almost through).
+    var ground_from = s.look.x;
+    var ground_full = s.look.y;
+    if s.translucency.y > 0.0 {
+        ground_from = s.translucency.y;
+        ground_full = s.translucency.z;
+    }
+    let ground = smoothstep(ground_from, ground_full, dep);
     let rim = smoothstep(0.01, 0.12, dep);
     let transition = rim * (1.0 - ground) * (0.55 + 0.45 * (1.0 - smoothstep(0.3, 0.9, dep))) * s.translucency.x;
 

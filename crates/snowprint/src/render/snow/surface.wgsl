@@ -1,5 +1,6 @@
 // surface.wgsl: the snow pass. Each surface is drawn as the box of its snow slab (top face at
-// y = snow_depth, four sides down to the ground) in its local frame; every fragment of the
+// y = snow_depth, raised by the room for rims where the material throws them, four sides down to
+// the ground) in its local frame; every fragment of the
 // deformable material traces its view ray through the heightfield (snow.wgsl) and writes the depth
 // of the point it hits, so characters standing in prints and bodies lying in trenches are hidden
 // and shown correctly.
@@ -11,12 +12,16 @@
 @group(1) @binding(0) var<uniform> surface: SnowSurface;
 @group(1) @binding(1) var heightfield: texture_2d<f32>;
 @group(1) @binding(2) var heightfield_light: texture_2d<f32>;
+// Bank heights (metres, .x; banks.wgsl): the tessellated tier's banks, and the rims of materials
+// that throw them (`translucency.w` > 0) in the relief and POM tiers.
+@group(1) @binding(3) var bank_texture: texture_2d<f32>;
 
 // Set when the device cannot filter Rgba16Float: bilinear filtering is then done by hand.
 override MANUAL_FILTER: bool = false;
 
-// Corners of the five visible faces of the box (no bottom): face k uses vertices 6k..6k+5.
-fn box_vertex(i: u32) -> array<vec3<f32>, 2> {
+// Corners of the five visible faces of the box (no bottom): face k uses vertices 6k..6k+5. The
+// deformable material's box rises `rim_room` above the snow top, the room for rims.
+fn box_vertex(i: u32, rim_room: f32) -> array<vec3<f32>, 2> {
     let face = i / 6u;
     let corner = array<vec2<f32>, 6>(
         vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
@@ -25,7 +30,7 @@ fn box_vertex(i: u32) -> array<vec3<f32>, 2> {
     let a = corner * 2.0 - 1.0;
     let hx = surface.half_size.x;
     let hz = surface.half_size.y;
-    let top = surface.snow_depth;
+    let top = surface.snow_depth + rim_room;
     let y = corner.y * top;
     var p: vec3<f32>;
     var n: vec3<f32>;
@@ -63,13 +68,50 @@ struct SurfaceVarying {
 
 @vertex
 fn vs_surface(@builtin(vertex_index) i: u32) -> SurfaceVarying {
-    let v = box_vertex(i);
+    return surface_box(i, 0.0);
+}
+
+// The deformable material's box: raised by the room for rims (snow.wgsl's `snow_top`).
+@vertex
+fn vs_surface_deformable(@builtin(vertex_index) i: u32) -> SurfaceVarying {
+    return surface_box(i, surface.translucency.w);
+}
+
+fn surface_box(i: u32, rim_room: f32) -> SurfaceVarying {
+    let v = box_vertex(i, rim_room);
     var out: SurfaceVarying;
     let world = surface.local_to_world * vec4<f32>(v[0], 1.0);
     out.clip = frame.view_proj * world;
     out.local = v[0];
     out.face = v[1];
     return out;
+}
+
+fn bank_texel(c: vec2<i32>) -> f32 {
+    let size = vec2<i32>(surface.grid);
+    return textureLoad(bank_texture, clamp(c, vec2<i32>(0), size - 1), 0).x;
+}
+
+// Bank height (metres) at uv, bilinear by hand (also usable in the vertex stage).
+fn bank_height(uv: vec2<f32>) -> f32 {
+    let p = uv * surface.grid - 0.5;
+    let i = floor(p);
+    let f = p - i;
+    let c = vec2<i32>(i);
+    let a = mix(bank_texel(c), bank_texel(c + vec2<i32>(1, 0)), f.x);
+    let b = mix(bank_texel(c + vec2<i32>(0, 1)), bank_texel(c + vec2<i32>(1, 1)), f.x);
+    return mix(a, b, f.y);
+}
+
+// Slope of the banks at uv (metres per metre along local x and z), central differences.
+fn bank_gradient(uv: vec2<f32>) -> vec2<f32> {
+    let du = vec2<f32>(1.0 / surface.grid.x, 0.0);
+    let dv = vec2<f32>(0.0, 1.0 / surface.grid.y);
+    let step = 2.0 * surface.half_size / surface.grid;
+    return vec2<f32>(
+        (bank_height(uv + du) - bank_height(uv - du)) / (2.0 * step.x),
+        (bank_height(uv + dv) - bank_height(uv - dv)) / (2.0 * step.y),
+    );
 }
 
 fn load_texel(c: vec2<i32>) -> vec4<f32> {
@@ -97,9 +139,14 @@ fn sample_bilinear(uv: vec2<f32>) -> vec4<f32> {
 
 // The heightfield contract of snow.wgsl, for the search: one bilinear tap of the smoothed
 // depression. (A smoothstep remap of the weights would remove the creases at texel boundaries,
-// but its flat spots at texel centres pull the rims of deep pits onto the texel grid.)
+// but its flat spots at texel centres pull the rims of deep pits onto the texel grid.) Where the
+// material throws rims, the banks raise the top: less depression, below zero on a rim.
 fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {
-    return sample_bilinear(uv).x;
+    let dep = sample_bilinear(uv).x;
+    if s.translucency.w > 0.0 {
+        return dep - bank_height(uv) / s.snow_depth;
+    }
+    return dep;
 }
 
 // ... and for shading: a cubic B-spline from four bilinear taps (smooth normals and occlusion,
@@ -175,7 +222,15 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
     if hit.found == 0u {
         discard;
     }
-    let hf = snow_heightfield(surface, snow_uv(surface, hit.position.xz));
+    let uv = snow_uv(surface, hit.position.xz);
+    var hf = snow_heightfield(surface, uv);
+    if surface.translucency.w > 0.0 {
+        // Rims: the heightmap's slope tilted by the banks', as the tessellated tier shades them.
+        let ny = max(sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)), 1e-3);
+        let g = vec2<f32>(-hf.y, -hf.z) / ny + bank_gradient(uv);
+        let n = normalize(vec3<f32>(-g.x, 1.0, -g.y));
+        hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
+    }
     let m = snow_deformable(surface, hit, hf, in.face, sky_tint(), pixel);
     let c = deformable_view(shade(m, hit.position, hit.shadow, pixel), m, hf.x, f32(hit.taps) / 48.0);
     var out: SnowOut;

@@ -1,15 +1,16 @@
 //! `[[material]]` tables: materials of the scene's own, each a preset (`like`, default `snow`) with
-//! the keys it sets changed, named for surfaces' `material` key.
+//! the keys it sets changed (how it moves, its compressibility and its look), named for surfaces'
+//! `material` key.
 
 use std::collections::HashMap;
 
 use toml::Spanned;
 
-use super::values::{number, required, unique};
+use super::values::{number, required, unique, vector};
 use crate::error::Result;
-use crate::material::Material;
+use crate::material::{Material, MaterialLook};
 use crate::scene::diagnose::Source;
-use crate::scene::raw::{RawMaterial, Str};
+use crate::scene::raw::{Num, Nums, RawMaterial, Str};
 
 /// The presets' names, for messages.
 pub(super) const PRESETS: &str = "\"snow\", \"packed_snow\", \"powder\", \"sand\", \"mud\"";
@@ -23,11 +24,11 @@ pub(super) fn materials(
     let mut out = HashMap::new();
     for m in raw {
         let table = m.span();
-        let m = m.into_inner();
+        let mut m = m.into_inner();
         let name = required(
             src,
             &table,
-            m.name,
+            m.name.take(),
             "this [[material]]",
             "name",
             "add name = \"<a name for surfaces' material key>\"",
@@ -65,9 +66,80 @@ pub(super) fn materials(
         if let Some(v) = &m.settle_updates {
             material.settle_updates = count(src, v, &who, "settle_updates", 100_000)?;
         }
+        if let Some(v) = &m.compressibility {
+            material.compressibility = Some(share(src, v, &who, "compressibility")?);
+        }
+        look(src, &m, &who, &mut material.look)?;
         out.insert(name.into_inner(), material);
     }
     Ok(out)
+}
+
+/// A number from 0 to 1.
+fn share(src: &Source<'_>, v: &Num, who: &str, key: &str) -> Result<f32> {
+    number(
+        src,
+        v,
+        who,
+        key,
+        |x| (0.0..=1.0).contains(&x),
+        &format!("{key} must be a number from 0 to 1"),
+    )
+}
+
+/// The look's keys the table sets (`MaterialLook`), each checked with its line.
+fn look(src: &Source<'_>, m: &RawMaterial, who: &str, look: &mut MaterialLook) -> Result<()> {
+    let colour = |v: &Nums, key: &str| {
+        vector::<3>(
+            src,
+            v,
+            who,
+            key,
+            "[red, green, blue] in linear light",
+            |x| (0.0..=1.0).contains(&x),
+            &format!("{key} must be three numbers from 0 to 1"),
+        )
+    };
+    if let Some(v) = &m.albedo {
+        look.albedo = colour(v, "albedo")?;
+    }
+    if let Some(v) = &m.disturbed_albedo {
+        look.disturbed_albedo = colour(v, "disturbed_albedo")?;
+    }
+    let shares: [(&Option<Num>, &str, &mut f32); 6] = [
+        (&m.roughness, "roughness", &mut look.roughness),
+        (&m.wet_roughness, "wet_roughness", &mut look.wet_roughness),
+        (&m.grain, "grain", &mut look.grain),
+        (&m.sparkle, "sparkle", &mut look.sparkle),
+        (&m.wetness, "wetness", &mut look.wetness),
+        (&m.translucency, "translucency", &mut look.translucency),
+    ];
+    for (v, key, field) in shares {
+        if let Some(v) = v {
+            *field = share(src, v, who, key)?;
+        }
+    }
+    if let Some(v) = &m.ground_from {
+        look.ground_from = Some(number(
+            src,
+            v,
+            who,
+            "ground_from",
+            |x| x > 0.0 && x < 1.0,
+            "ground_from must be a fraction of the depth above 0 and below 1",
+        )?);
+    }
+    if let Some(v) = &m.water_depth {
+        look.water_depth = Some(number(
+            src,
+            v,
+            who,
+            "water_depth",
+            |x| x > 0.0,
+            "water_depth must be a number of metres above 0",
+        )?);
+    }
+    Ok(())
 }
 
 /// A whole number from 0 to `max`.

@@ -41,8 +41,10 @@ impl BanksPass {
         }
     }
 
-    /// Upload each diced surface's bank parameters and bind its heightfield textures (nothing
-    /// outside the tessellated tier, `active` false).
+    /// Upload the bank parameters of each surface that draws banks and bind its heightfield
+    /// textures: in the tessellated tier (`active`) every diced surface, in the others the
+    /// surfaces whose material throws rims (`Material::compressibility`), which the relief and
+    /// POM searches raise above the snow top.
     pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -52,13 +54,20 @@ impl BanksPass {
         heightfields: &HeightfieldPass,
     ) {
         self.bind_groups.clear();
-        if !active {
+        let banked = |surface: &FrameSurface<'_>| {
+            if active {
+                surface.tessellated
+            } else {
+                surface.rims()
+            }
+        };
+        if !surfaces.iter().any(banked) {
             return;
         }
         let stride = UNIFORM_STRIDE as usize;
         let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
         for (s, surface) in surfaces.iter().enumerate() {
-            if !surface.tessellated {
+            if !banked(surface) {
                 continue;
             }
             let (desc, layout) = (surface.view.desc, surface.view.layout);
@@ -67,7 +76,7 @@ impl BanksPass {
                 layout.height,
                 surface.texel(),
                 desc.snow_depth,
-                surface.geometry.banks,
+                surface.banks(),
             );
             bytes[s * stride..s * stride + std::mem::size_of::<BankParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&bank));
@@ -79,7 +88,7 @@ impl BanksPass {
             .iter()
             .enumerate()
             .map(|(s, surface)| {
-                if !surface.tessellated {
+                if !banked(surface) {
                     return None;
                 }
                 let tex = heightfields.texture(surface.view.id)?;

@@ -2,19 +2,21 @@
 // The vertex stage displaces each vertex of the top to the snow there: the base height, plus the
 // snow depth minus the depression (the heightfield pass's smoothed depression), plus the banks
 // (banks.wgsl), plus the macro "waves" of snow.wgsl's `snow_macro_height` (the same function whose
-// normal the relief tier shades with), pressed flat where the snow is packed. Skirt vertices at
-// the base stay there. The fragment stage shades the real surface with the deformable material
+// normal the relief tier shades with), pressed flat where the snow is packed. Where the material
+// has water (mud) and a print is deeper than its water depth, the top is the flat water surface at
+// the water table instead, so the water is real geometry (in the shadow map too) and the fragment
+// stage shades it as the relief tier's water: a mirror of the sky. Skirt vertices at the base stay
+// there. The fragment stage shades the real surface with the deformable material
 // (snow.wgsl) without any search: the heightmap's normal tilted by the banks' slope, RNM detail,
 // the heightmap's AO, and the moon's shadow from the shadow map, which holds this same displaced
 // geometry (vs_tess_shadow), so trails shadow themselves and characters' shadows bend into them.
-// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-2 of group 1 and
-// its heightfield contract are reused.
+// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-3 of group 1 (the
+// bank texture and `bank_height` included) and its heightfield contract are reused.
 // Reads: frame uniforms, shadow map, the surface's heightfield, light and bank textures, the
 // surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade.
 
 // import surface
 
-@group(1) @binding(3) var bank_texture: texture_2d<f32>;
 @group(1) @binding(4) var<storage, read> surface_state: array<u32>;
 
 // Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
@@ -35,25 +37,9 @@ fn tess_touched() -> bool {
     return surface_state[surface.index * STATE_WORDS + STATE_TOUCHED] != 0u;
 }
 
-fn bank_texel(c: vec2<i32>) -> f32 {
-    let size = vec2<i32>(surface.grid);
-    return textureLoad(bank_texture, clamp(c, vec2<i32>(0), size - 1), 0).x;
-}
-
-// Bank height (metres) at uv, bilinear by hand (also usable in the vertex stage).
-fn bank_height(uv: vec2<f32>) -> f32 {
-    let p = uv * surface.grid - 0.5;
-    let i = floor(p);
-    let f = p - i;
-    let c = vec2<i32>(i);
-    let a = mix(bank_texel(c), bank_texel(c + vec2<i32>(1, 0)), f.x);
-    let b = mix(bank_texel(c + vec2<i32>(0, 1)), bank_texel(c + vec2<i32>(1, 1)), f.x);
-    return mix(a, b, f.y);
-}
-
 // Snow top above the base at local xz, metres: depth minus depression, plus banks, plus the
 // macro waves (scaled by pattern.w, flattened where the snow is pressed).
-fn tess_snow_height(xz: vec2<f32>) -> f32 {
+fn tess_material_height(xz: vec2<f32>) -> f32 {
     var dep = 0.0;
     var bank = 0.0;
     if tess_touched() {
@@ -64,6 +50,22 @@ fn tess_snow_height(xz: vec2<f32>) -> f32 {
     let flatten = 1.0 - smoothstep(0.0, 0.5, dep);
     let waves = surface.pattern.w * (snow_macro_height(xz + surface.pattern.xy) - MACRO_MEAN) * flatten;
     return surface.snow_depth * (1.0 - dep) + bank + waves;
+}
+
+// Whether the material at local xz lies under the water table (snow.wgsl's `snow_water_level`):
+// a print deeper than the material's water depth, filled with water up to it.
+fn tess_under_water(xz: vec2<f32>) -> bool {
+    let level = snow_water_level(surface);
+    return level >= 0.0 && tess_touched() && tess_material_height(xz) < level;
+}
+
+// The top above the base at local xz: the material's, or the water's flat surface over it.
+fn tess_snow_height(xz: vec2<f32>) -> f32 {
+    let h = tess_material_height(xz);
+    if tess_under_water(xz) {
+        return snow_water_level(surface);
+    }
+    return h;
 }
 
 fn tess_local(v: TessVertex) -> vec3<f32> {
@@ -96,17 +98,6 @@ fn vs_tess_shadow(v: TessVertex) -> @builtin(position) vec4<f32> {
     return m * (surface.local_to_world * vec4<f32>(tess_local(v), 1.0));
 }
 
-// Slope of the banks at uv (metres per metre along local x and z), central differences.
-fn bank_gradient(uv: vec2<f32>) -> vec2<f32> {
-    let du = vec2<f32>(1.0 / surface.grid.x, 0.0);
-    let dv = vec2<f32>(0.0, 1.0 / surface.grid.y);
-    let step = 2.0 * surface.half_size / surface.grid;
-    return vec2<f32>(
-        (bank_height(uv + du) - bank_height(uv - du)) / (2.0 * step.x),
-        (bank_height(uv + dv) - bank_height(uv - dv)) / (2.0 * step.y),
-    );
-}
-
 @fragment
 fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
     let pixel = length(fwidth(in.local));
@@ -136,8 +127,8 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
         hit.shadow = 1.0;
         hit.taps = 0u;
         hit.t = 0.0;
-        // No water in this tier yet: the diced surface has no water plane.
-        hit.water = 0u;
+        // Water: the diced top is the flat water surface where the material lies under it.
+        hit.water = select(0u, 1u, tess_under_water(in.local.xz));
         m = snow_deformable(surface, hit, hf, vec3<f32>(0.0, 1.0, 0.0), sky_tint(), pixel);
     }
     // No search in this tier: no taps.
