@@ -113,6 +113,9 @@ pub struct CaptureBuffers<'a> {
     pub tiles: &'a wgpu::Buffer,
     /// Tile list with its indirect dispatch (written).
     pub tile_list: &'a wgpu::Buffer,
+    /// `[base, bare]` per texel of the surfaces on ground that is not flat (read; any buffer when
+    /// every view's `ground` is [`super::NO_GROUND`]).
+    pub ground: &'a wgpu::Buffer,
     /// The atlas's depth view (places the viewports only).
     pub atlas: &'a wgpu::TextureView,
 }
@@ -140,6 +143,7 @@ pub fn encode(
             buffers.winding.as_entire_binding(),
             buffers.tiles.as_entire_binding(),
             buffers.tile_list.as_entire_binding(),
+            buffers.ground.as_entire_binding(),
         ],
     );
     let draw_bg = bind_group(

@@ -14,6 +14,8 @@ const WORKGROUP: u32 = 8u;
 const TILE_LIST_HEADER: u32 = 4u;
 // `record` of a capture view whose flagged tiles are not listed (the update runs its grid).
 const NO_LIST: u32 = 0xffffffffu;
+// `ground` of a capture view whose surface lies on flat ground (no ground field is read).
+const NO_GROUND: u32 = 0xffffffffu;
 // `batch` of a surface record that nothing touched this update.
 const NO_CAPTURE: u32 = 0xffffffffu;
 // `normals` of a surface record whose pool keeps no normals.

@@ -361,6 +361,7 @@ impl SnowWorld {
                 elapsed: u.elapsed,
                 deformers: u.deformers,
                 settle: s.settle,
+                ground: s.ground.as_ref().map(|g| g.plan()),
             })
         });
         let meshes = &self.meshes;
@@ -432,6 +433,7 @@ impl SnowWorld {
             winding: &self.winding.buffer,
             tiles: &self.tiles.buffer,
             tile_list: &self.tile_list.buffer,
+            ground: &self.grounds.buffer,
             atlas: &self.atlases[atlas].2,
         };
         capture::encode(
