@@ -558,3 +558,93 @@ fn scene_keys_lay_a_surface_on_a_heightmap_and_refuse_bad_ground_with_its_line()
     assert!(e.contains("s.toml:8:") && e.contains("no ground"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_pitched_roof_scene_leaves_trenches_that_follow_the_roof() {
+    // scenes/pitched_roof.toml: two 30-degree planes from a glTF, a ball dragged up one side and
+    // down the other 0.1 m deep, and one dragged across a side along its contour 0.2 m deep.
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pitched_roof.toml");
+    let scene = snowprint::scene::Scene::load(&path).unwrap();
+    let mut w = world();
+    let desc = scene.surfaces[0].clone();
+    let id = w.add_surface(desc.clone()).unwrap();
+    let g = scene.grounds[0].as_ref().expect("the roof mesh");
+    w.set_ground(id, &g.ground, g.slope).unwrap();
+    let field = w.ground(id).unwrap().unwrap().clone();
+    let l = desc.layout();
+    let t30 = 30f32.to_radians().tan();
+    // The rasterised roof is (3 - |z|) tan 30 at every texel centre, and holds all its snow.
+    for (i, h) in field.ground.iter().enumerate() {
+        let p = cap_cpu::texel_center(
+            i as u32 % l.width,
+            i as u32 / l.width,
+            l.width,
+            l.height,
+            desc.size * 0.5,
+        );
+        assert!((h - (3.0 - p.y.abs()) * t30).abs() < 1e-4, "texel {i}: {h}");
+    }
+    // The ridge row's slope is a mean of the two sides (0): it holds all its snow too.
+    assert!(field.columns.iter().all(|c| c[1] == 0.0));
+    let dt = 1.0 / 60.0;
+    let mut prev: Vec<Option<Pose>> = vec![None; scene.deformers.len()];
+    for f in 1..=240 {
+        let t = f as f32 * dt;
+        let ds: Vec<Deformer> = scene
+            .deformers
+            .iter()
+            .zip(&mut prev)
+            .map(|(d, p)| {
+                let snowprint::scene::SceneShape::Sphere { radius } = d.shape else {
+                    panic!("spheres")
+                };
+                let pose = d.pose_at(t);
+                match p.replace(pose) {
+                    Some(before) => Deformer::moving(Shape::Sphere { radius }, before, pose),
+                    None => Deformer::new(Shape::Sphere { radius }, pose),
+                }
+            })
+            .collect();
+        w.step(dt, &ds).unwrap();
+    }
+    let map = w.read_heightmap(id).unwrap();
+    let at = |x: f32, z: f32| {
+        let c = ((x + 4.0) / 8.0 * l.width as f32) as u32;
+        let r = ((z + 3.0) / 6.0 * l.height as f32) as u32;
+        map.fraction(c, r) * DEPTH
+    };
+    // Up the side, the ball's centre runs 0.2 m below the local top plus its radius, parallel to
+    // the roof: swept, it is a cylinder whose bottom lies sqrt(r^2 - dx^2) / cos 30 below its axis
+    // over a line dx off it, so the trench is 0.3 - 0.4 + sqrt(r^2 - dx^2) / cos 30 deep there
+    // (0.131 m on the axis, not the ball's 0.1 at rest). The texel at x = -2 has its centre 2 cm off
+    // the axis and the blur mixes its neighbours at 2 and 6 cm.
+    let r = 0.2f32;
+    let trench = |dx: f32| 0.3 - 0.4 + (r * r - dx * dx).sqrt() / 30f32.to_radians().cos();
+    let (shallow, deep) = (trench(0.06), trench(0.02));
+    for z in [-2.2f32, -1.0, 1.0, 2.2] {
+        let d = at(-2.0, z);
+        assert!(
+            d >= shallow - 1e-3 && d <= deep + 1e-3,
+            "up-and-over trench at z = {z}: {d} m, not in [{shallow}, {deep}]"
+        );
+    }
+    // Across the slope the axis is level: over the axis row (its centres at z = -1.5 exactly) the
+    // ball is 0.2 m deep; the rows 4 cm up and down the slope are 0.2 + 0.023 - 0.004 and
+    // 0.2 - 0.023 - 0.004 m deep (the top moves by 0.04 tan 30, the ball's bottom by
+    // r - sqrt(r^2 - 0.04^2)), and the blur weighs them 1/4 each against the axis row's 1/2.
+    let up = 0.04 * t30;
+    let rise = r - (r * r - 0.04f32 * 0.04).sqrt();
+    let across = 0.5 * 0.2 + 0.25 * (0.2 + up - rise) + 0.25 * (0.2 - up - rise);
+    for x in [-3.0f32, -1.0, 0.5, 3.0] {
+        let d = at(x, -1.5);
+        assert!(
+            (d - across).abs() < 2e-3,
+            "trail across at x = {x}: {d} m, not {across}"
+        );
+        assert_eq!(at(x, -0.9), 0.0, "beside the trail at x = {x}");
+    }
+    assert_eq!(at(0.0, 1.5), 0.0);
+    // Never below the roof.
+    assert!(map.depression.iter().all(|&v| v < 65535));
+}

@@ -156,7 +156,7 @@ fn grid_size(src: &Source<'_>, g: &Nums, who: &str) -> Result<[u32; 2]> {
         who,
         "ground_grid",
         "[columns, rows]",
-        |x| x >= 2.0 && x <= 65536.0 && x.fract() == 0.0,
+        |x| (2.0..=65536.0).contains(&x) && x.fract() == 0.0,
         "ground_grid must be two whole numbers of samples from 2 to 65536, [columns, rows]",
     )?;
     Ok([v[0] as u32, v[1] as u32])
