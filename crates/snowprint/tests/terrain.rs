@@ -648,3 +648,53 @@ fn the_pitched_roof_scene_leaves_trenches_that_follow_the_roof() {
     // Never below the roof.
     assert!(map.depression.iter().all(|&v| v < 65535));
 }
+
+#[test]
+fn footsteps_land_on_the_local_snow_top() {
+    // A 30-degree plane rising along x: at local x = 0.5 the ground is 0.289 m above the centre and
+    // the snow top 0.589. A ball coming down to 0.1 m below that top lands 0.1 deep; on the flat
+    // surface's top (0.3) it would not have landed at all.
+    let desc = SurfaceDesc::new("slope", [1.0, 3.0, -2.0], [2.0, 2.0], DEPTH);
+    let t = 30f32.to_radians().tan();
+    let g = move |x: f32, _z: f32| x * t;
+    let mut w = world();
+    let id = w.add_surface(desc.clone()).unwrap();
+    w.set_ground(id, &Ground::Grid(grid_of(&desc, g)), SlopeRule::default())
+        .unwrap();
+    let r = 0.1f32;
+    // x = 0.5 is the centre of texel 37 (4 cm texels from x = -1), where the field is exact.
+    let x = 0.5f32;
+    let top = 3.0 + g(x, 0.0) + DEPTH;
+    let above = Pose::at([1.0 + x, top + 0.3, -2.0]);
+    let down = Pose::at([1.0 + x, top - 0.1 + r, -2.0]);
+    let ball = Shape::Sphere { radius: r };
+    w.step(1.0 / 60.0, &[Deformer::moving(ball, above, down)])
+        .unwrap();
+    let steps = w.footsteps();
+    assert_eq!(steps.len(), 1, "{steps:?}");
+    assert!((steps[0].depth_m - 0.1).abs() < 1e-4, "{:?}", steps[0]);
+    // On a 50-degree plane holding 0.4 of the depth, a ball driven 0.3 m below the local top
+    // lands as deep as the snow there, 0.12 m.
+    let t50 = 50f32.to_radians().tan();
+    let steep = move |x: f32, _z: f32| x * t50;
+    let mut w = world();
+    let id = w.add_surface(desc.clone()).unwrap();
+    w.set_ground(
+        id,
+        &Ground::Grid(grid_of(&desc, steep)),
+        SlopeRule::default(),
+    )
+    .unwrap();
+    let top = 3.0 + steep(x, 0.0) + 0.4 * DEPTH;
+    let above = Pose::at([1.0 + x, top + 0.3, -2.0]);
+    let down = Pose::at([1.0 + x, top - 0.3 + r, -2.0]);
+    w.step(1.0 / 60.0, &[Deformer::moving(ball, above, down)])
+        .unwrap();
+    let steps = w.footsteps();
+    assert_eq!(steps.len(), 1, "{steps:?}");
+    assert!(
+        (steps[0].depth_m - 0.4 * DEPTH).abs() < 1e-3,
+        "{:?}",
+        steps[0]
+    );
+}

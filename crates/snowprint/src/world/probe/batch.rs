@@ -173,7 +173,10 @@ impl SnowWorld {
         let all: Vec<_> = layers.iter().flat_map(|l| l.iter().copied()).collect();
         crate::world::footstep::footsteps(
             &all,
-            |id| self.state(id).ok().map(|s| &s.desc),
+            |id| {
+                let s = self.state(id).ok()?;
+                Some((&s.desc, s.ground.as_ref().map(|g| &g.field)))
+            },
             |m| meshes.get(m.0 as usize)?.as_deref(),
             &mut steps,
         );
