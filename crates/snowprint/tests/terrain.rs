@@ -698,3 +698,42 @@ fn footsteps_land_on_the_local_snow_top() {
         steps[0]
     );
 }
+
+#[test]
+fn probes_read_the_snow_over_the_ground() {
+    // A 50-degree plane rising along z holds 0.4 of the 0.3 m: 0.12 m of snow, the base tilted 50
+    // degrees. Untouched, a probe there reads 0.12 m of snow and a normal leaning 50 degrees back
+    // along -z; a point below the local ground (but above the flat rectangle) is under no surface.
+    let desc = SurfaceDesc::new("steep", [0.0, 2.0, 0.0], [2.0, 2.0], DEPTH);
+    let t = 50f32.to_radians().tan();
+    let mut w = world();
+    let id = w.add_surface(desc.clone()).unwrap();
+    w.set_ground(
+        id,
+        &Ground::Grid(grid_of(&desc, move |_, z| z * t)),
+        SlopeRule::default(),
+    )
+    .unwrap();
+    w.step(1.0 / 60.0, &[]).unwrap();
+    // z = 0.5 is the centre of row 37: ground 0.5 tan 50 = 0.596 above the centre.
+    let on = Vec3::new(0.1, 2.0 + 0.5 * t + 0.05, 0.5);
+    let below = Vec3::new(0.1, 2.0 + 0.5 * t - 0.2, 0.5);
+    let ticket = w.probe(&[on, below]).unwrap();
+    let samples = loop {
+        if let snowprint::ProbeStatus::Ready(s) = w.probe_result(ticket).unwrap() {
+            break s;
+        }
+        w.step(1.0 / 60.0, &[]).unwrap();
+    };
+    assert_eq!(samples[0].surface, Some(id));
+    assert!(
+        (samples[0].snow_depth_m - 0.4 * DEPTH).abs() < 1e-5,
+        "{:?}",
+        samples[0]
+    );
+    assert_eq!(samples[0].depression_m, 0.0);
+    let lean = samples[0].normal.angle_between(Vec3::Y).to_degrees();
+    assert!((lean - 50.0).abs() < 0.1, "normal leans {lean} degrees");
+    assert!(samples[0].normal.z < 0.0);
+    assert_eq!(samples[1].surface, None);
+}
