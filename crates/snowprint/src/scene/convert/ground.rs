@@ -59,7 +59,9 @@ pub(super) fn ground(
         return Ok(None);
     };
     let span = path.span();
-    let (resolved, root) = resolve(src, path, &who, dir)?;
+    // The mesh loader's messages name the key as "path".
+    let whose = format!("the ground of surface {:?}", desc.name);
+    let (resolved, root) = resolve(src, path, &whose, dir)?;
     let lower = resolved.to_string_lossy().to_ascii_lowercase();
     let bad = |reason: String, todo: &str| {
         src.error(
@@ -70,7 +72,7 @@ pub(super) fn ground(
     };
     let ground = if lower.ends_with(".gltf") || lower.ends_with(".glb") {
         let mesh = Mesh::load_gltf_within(&resolved, &root)
-            .map_err(|e| load_error(src, path, &who, &resolved, e))?;
+            .map_err(|e| load_error(src, path, &whose, &resolved, e))?;
         if mesh.indices.len() < 3 {
             return Err(bad(
                 "has no triangles".into(),
