@@ -737,3 +737,70 @@ fn probes_read_the_snow_over_the_ground() {
     assert!(samples[0].normal.z < 0.0);
     assert_eq!(samples[1].surface, None);
 }
+
+#[test]
+fn a_mesh_pressed_into_the_rock_of_a_bare_slope_stops_at_the_ground() {
+    // A 50-degree plane holding 0.4 of the depth, and a cube mesh of half side 0.2 sunk so far into
+    // it that its bottom is below the rock over most of its footprint: where the ground point lies
+    // inside the cube the snow is pressed to the ground (a depression of 0.4, what the slope holds),
+    // never below it; the GPU capture is the CPU reference's.
+    let desc = SurfaceDesc::new("steep", [0.0, 2.0, 0.0], [2.0, 2.0], DEPTH);
+    let t = 50f32.to_radians().tan();
+    let g = move |_x: f32, z: f32| z * t;
+    let mut w = world();
+    let id = w.add_surface(desc.clone()).unwrap();
+    w.set_ground(id, &Ground::Grid(grid_of(&desc, g)), SlopeRule::default())
+        .unwrap();
+    let cube = snowprint::Mesh::cuboid(Vec3::splat(0.2));
+    let m = w.add_mesh("cube", &cube).unwrap();
+    // At x = 0.11 no column of texel centres lies on a side of the cube.
+    let pose = Pose::at([0.11, 2.0 + g(0.0, 0.0) + 0.05, 0.0]);
+    w.step(1.0 / 60.0, &[Deformer::new(Shape::Mesh(m), pose)])
+        .unwrap();
+    let map = w.read_heightmap(id).unwrap();
+    let k = 0.4f32;
+    let deepest = map.depression.iter().copied().max().unwrap() as f32 / 65535.0;
+    assert!(
+        (deepest - k).abs() < 2.0 / 65535.0,
+        "deepest {deepest}, not the ground's {k}"
+    );
+    let pressed_to_ground = map
+        .depression
+        .iter()
+        .filter(|&&v| (v as f32 / 65535.0 - k).abs() < 2.0 / 65535.0)
+        .count();
+    // The ground point is inside the cube where -0.15 < z tan 50 < 0.25 over |z| < 0.2: about 8 rows
+    // of 10 texels, of which the blur leaves the inner 6 x 8 wholly at the ground.
+    assert!(pressed_to_ground >= 40, "{pressed_to_ground}");
+    // The capture against the reference's winding on the field.
+    let l = desc.layout();
+    let field = w.ground(id).unwrap().unwrap();
+    let to_local = desc.world_to_local() * glam::Mat4::from_translation(pose.position);
+    let t = cube.transformed(to_local);
+    let tris: Vec<[Vec3; 3]> = t
+        .indices
+        .chunks(3)
+        .map(|i| [0, 1, 2].map(|k| t.positions[i[k] as usize]))
+        .collect();
+    let gpu = w.read_last_capture(id).unwrap().unwrap();
+    let cpu = cap_cpu::capture_on_ground(
+        l.width,
+        l.height,
+        desc.size * 0.5,
+        DEPTH + ANKLE,
+        &[],
+        &tris,
+        Some(&field.columns),
+    );
+    let mut differ = 0;
+    for (a, b) in gpu.iter().zip(&cpu) {
+        if (*a < 1.0) != (*b < 1.0) || (a - b).abs() > 1e-4 {
+            differ += 1;
+        }
+    }
+    // Only texel centres on the cube's edges may fall either way.
+    assert!(
+        differ <= 2 * l.width as usize / 10,
+        "{differ} texels differ"
+    );
+}

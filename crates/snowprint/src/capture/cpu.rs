@@ -271,9 +271,8 @@ fn triangles_depth_on(
         }
     }
     if winding > 0 {
-        // The accumulation presses a contained ground point to the column's base (see
-        // `capture_read.wgsl`), as on flat ground.
-        return Some(0.0);
+        // A contained ground point is pressed to the ground, the bare depth above the base.
+        return Some(bare / frustum_height);
     }
     lowest.map(|y| (y - base) / frustum_height)
 }

@@ -434,6 +434,7 @@ impl SnowWorld {
             tiles: &self.tiles.buffer,
             tile_list: &self.tile_list.buffer,
             ground: &self.grounds.buffer,
+            ground_codes: &self.ground_codes.buffer,
             atlas: &self.atlases[atlas].2,
         };
         capture::encode(

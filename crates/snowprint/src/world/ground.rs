@@ -4,6 +4,7 @@
 
 use super::SnowWorld;
 use super::plan::PlanGround;
+use crate::capture::encode_depth;
 use crate::error::{Result, SnowError};
 use crate::ground::raster::GroundRaster;
 use crate::ground::{Ground, GroundField, SlopeRule, sample_grid};
@@ -93,11 +94,17 @@ impl SnowWorld {
 
     /// Pack every live surface's field into the ground buffer, one after the other, and write it.
     fn upload_grounds(&mut self) {
+        let ankle = self.config.capture.ankle_height;
         let mut columns: Vec<[f32; 2]> = Vec::new();
+        let mut codes: Vec<u32> = Vec::new();
         for s in self.surfaces.iter_mut().flatten() {
             if let Some(g) = s.ground.as_mut() {
                 g.offset = columns.len() as u32;
                 columns.extend_from_slice(&g.field.columns);
+                // Where a mesh solid holds the ground point the snow is pressed to the ground:
+                // the bare depth above the base, as a capture code (`capture::encode_depth`).
+                let frustum = s.desc.snow_depth + ankle;
+                codes.extend(g.field.columns.iter().map(|c| encode_depth(c[1] / frustum)));
             }
         }
         if columns.is_empty() {
@@ -106,5 +113,8 @@ impl SnowWorld {
         let bytes: &[u8] = bytemuck::cast_slice(&columns);
         self.grounds.ensure(&self.device, bytes.len() as u64);
         self.queue.write_buffer(&self.grounds.buffer, 0, bytes);
+        let bytes: &[u8] = bytemuck::cast_slice(&codes);
+        self.ground_codes.ensure(&self.device, bytes.len() as u64);
+        self.queue.write_buffer(&self.ground_codes.buffer, 0, bytes);
     }
 }

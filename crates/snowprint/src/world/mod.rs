@@ -125,6 +125,8 @@ pub struct SnowWorld {
     scratch: Growable,
     /// The ground fields of the surfaces that are not on flat ground, `[base, bare]` per texel.
     grounds: Growable,
+    /// The capture code of the ground at each texel of those fields, parallel to `grounds`.
+    ground_codes: Growable,
     /// The ground mesh rasterisation, built the first time a mesh ground is set.
     ground_raster: Option<crate::ground::raster::GroundRaster>,
     last: LastFrame,
@@ -277,6 +279,7 @@ impl SnowWorld {
             ),
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
             grounds: Growable::new(&device, "ground fields", U::STORAGE | U::COPY_DST, 16),
+            ground_codes: Growable::new(&device, "ground codes", U::COPY_SRC | U::COPY_DST, 16),
             ground_raster: None,
             queue: gpu.queue.clone(),
             caps: gpu.caps.clone(),

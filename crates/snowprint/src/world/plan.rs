@@ -20,7 +20,8 @@ use crate::deformer::{Deformer, Shape};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::mesh::MeshId;
 use crate::pool::{
-    MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+    MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER,
+    TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceLayout};
@@ -316,7 +317,12 @@ impl FramePlan {
         let mode = match settings.capture.mode {
             CaptureMode::Depth => 0,
             CaptureMode::Mask => 1,
-        } | if d1 > d0 { MODE_MESHES } else { 0 };
+        } | if d1 > d0 { MODE_MESHES } else { 0 }
+            | if d1 > d0 && s.ground.is_some() {
+                MODE_GROUND
+            } else {
+                0
+            };
         self.jobs.push(Job {
             surface: PlannedSurface {
                 index: s.index,
@@ -375,6 +381,12 @@ impl FramePlan {
             r.batch = p.batch;
             r.scratch = c.texels;
             c.texels += r.width * r.height;
+            if r.mode & MODE_GROUND != 0 {
+                // The winding region's second half: the ground's codes, copied before the capture.
+                c.ground_copies
+                    .push((job.ground_offset, c.texels, r.width * r.height));
+                c.texels += r.width * r.height;
+            }
             r.tiles = c.tile_flags;
             c.tile_flags += r.tile_count();
         }
