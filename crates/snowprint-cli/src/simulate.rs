@@ -57,6 +57,13 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             camera.line
         );
     }
+    if managed && let Some(g) = scene.grounds.iter().flatten().next() {
+        return Err(format!(
+            "{}:{}: a surface on ground that is not flat runs only without the surface manager for now; remove [budget], --report, --save and --load, or the ground key",
+            scene.path.display(),
+            g.line
+        ));
+    }
     let outputs = Outputs::prepare(&scene, &args.dump, args.report.as_deref())?;
     if let Some(save) = &args.save {
         crate::output::check_file_target(save, "--save")?;
@@ -240,8 +247,14 @@ pub fn simulate(
     )
     .map_err(|e| e.to_string())?;
     let mut ids = Vec::new();
-    for s in &scene.surfaces {
-        ids.push(world.add_surface(s.clone()).map_err(|e| e.to_string())?);
+    for (i, s) in scene.surfaces.iter().enumerate() {
+        let id = world.add_surface(s.clone()).map_err(|e| e.to_string())?;
+        if let Some(g) = scene.grounds.get(i).and_then(Option::as_ref) {
+            world
+                .set_ground(id, &g.ground, g.slope)
+                .map_err(|e| format!("{}:{}: {e}", scene.path.display(), g.line))?;
+        }
+        ids.push(id);
     }
     let shapes = scene_shapes(scene, |d, mesh| match &d.animation {
         Some(a) => world.add_skinned_mesh(&d.name, &a.skinned),

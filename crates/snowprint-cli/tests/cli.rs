@@ -553,3 +553,46 @@ fn the_shore_demo_renders_its_four_strips() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The pitched roof: `simulate` lays the surface on its glTF roof and the trench runs over the
+/// ridge (the library's `tests/terrain.rs` checks its depths by hand); under the manager, ground
+/// that is not flat is refused with the line of its key.
+#[test]
+fn a_surface_on_a_roof_mesh_runs_and_is_refused_under_the_manager() {
+    let _serial = serial();
+    let out = scratch("roof");
+    let status = snowprint()
+        .args(["simulate", "--scene"])
+        .arg(repo().join("scenes/pitched_roof.toml"))
+        .args(["--frames", "240", "--dump"])
+        .arg(&out)
+        .status()
+        .expect("run snowprint");
+    assert!(status.success());
+    let map = snowprint::Heightmap::load_png(&out.join("roof.png")).expect("roof.png");
+    // Column 50 (x = -2) is pressed from row 5 (z = -2.8) to row 144 (z = 2.8), over the ridge.
+    for row in [10, 40, 75, 110, 140] {
+        assert!(
+            map.fraction(50, row) > 0.35,
+            "row {row}: {}",
+            map.fraction(50, row)
+        );
+    }
+    let report = out.with_extension("json");
+    let run = snowprint()
+        .args(["simulate", "--scene"])
+        .arg(repo().join("scenes/pitched_roof.toml"))
+        .args(["--frames", "2", "--dump"])
+        .arg(out.join("managed"))
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .expect("run snowprint");
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("pitched_roof.toml:21:") && err.contains("without the surface manager"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -99,6 +99,14 @@ pub enum SnowError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A surface's ground (heights, mesh or slope rule) is not usable.
+    #[error("surface {name:?}: {reason}")]
+    InvalidGround {
+        /// Name of the surface.
+        name: String,
+        /// What is wrong, with the value and what to do.
+        reason: String,
+    },
     /// A mesh file could not be read.
     #[error("mesh file {}: {reason}", path.display())]
     MeshFile {

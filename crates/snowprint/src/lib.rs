@@ -46,6 +46,7 @@ mod deformer;
 mod error;
 mod extract;
 mod gpu;
+mod ground;
 mod heightmap;
 pub mod manager;
 mod material;
@@ -68,6 +69,7 @@ pub use deformer::{Deformer, MAX_DEFORMER_SIZE, Pose, Shape};
 pub use error::{Result, SnowError};
 pub use extract::{FrameView, SurfaceView};
 pub use gpu::{Capabilities, GpuContext, GpuOptions, required_features, required_limits};
+pub use ground::{Ground, GroundField, GroundMesh, HeightGrid, SlopeRule};
 pub use heightmap::Heightmap;
 pub use manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, TickStats, ZoneId,
@@ -135,6 +137,10 @@ pub mod reference {
     pub mod skin {
         pub use crate::skin::cpu::*;
     }
+    /// The ground: a mesh rasterised over a surface's texel centres.
+    pub mod ground {
+        pub use crate::ground::cpu::*;
+    }
 }
 
 /// The pieces an engine or a tool may need that are not the everyday API: the world's frame plan,
@@ -145,6 +151,11 @@ pub mod low_level {
     /// The world's plan of a frame, made on the CPU before anything is encoded.
     pub mod world {
         pub use crate::world::plan::*;
+    }
+    /// The ground mesh rasterisation pass and its uniform.
+    pub mod ground {
+        pub use crate::ground::raster::{GroundRaster, RasterView, decode_height};
+        pub use crate::ground::sample_grid;
     }
     /// The capture pass: pipelines, primitives, atlas packing and `encode`.
     pub mod capture {
@@ -170,8 +181,8 @@ pub mod low_level {
     /// The heightmap pool: slot allocator and the per-surface record the passes read.
     pub mod pool {
         pub use crate::pool::{
-            MODE_MESHES, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN, Slot, SlotAllocator, SurfaceRecord,
-            TILE_LIST_HEADER, TILE_SIDE,
+            MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN, Slot, SlotAllocator,
+            SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
         };
     }
     /// The render graph: the pass table and its check.

@@ -77,6 +77,7 @@ fn volume(desc: &SurfaceDesc) -> CaptureVolume {
         world_to_local: desc.world_to_local(),
         half_size: desc.size * 0.5,
         frustum_height: desc.snow_depth + ANKLE,
+        ground: (0.0, 0.0),
     }
 }
 

@@ -11,6 +11,11 @@ fn depression(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     var code = capture[i];
     if (rec.mode & MODE_MESHES) != 0u && winding[i] > 0 {
         code = ONE_BITS; // depth 0: the ground
+        if (rec.mode & MODE_GROUND) != 0u {
+            // Ground that is not flat: the ground is the bare depth above the column's base, its
+            // code in the second half of the surface's winding region.
+            code = bitcast<u32>(winding[i + rec.width * rec.height]);
+        }
     }
     return capture_depression(rec, code);
 }

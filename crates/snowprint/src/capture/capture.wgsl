@@ -24,7 +24,7 @@ struct CaptureView {
     tiles: u32,             // first tile flag of the surface in `tiles`
     tiles_x: u32,           // tiles a row
     record: u32,            // the surface's record in the update, or NO_LIST
-    pad: u32,
+    ground: u32,            // first texel of the surface's ground field in `ground`, or NO_GROUND
 }
 // Must match `CaptureView` in capture/mod.rs.
 
@@ -48,6 +48,20 @@ struct Primitive {
 // Words 0-2: indirect dispatch arguments (written by the update's seal pass); 3: entries; from 4:
 // two words an entry, the record and (tile y << 16 | tile x). TILE_LIST_HEADER is 4.
 @group(0) @binding(5) var<storage, read_write> tile_list: array<atomic<u32>>;
+// Per texel of each surface on ground that is not flat (ground/mod.rs, `GroundField::columns`):
+// the base of the snow column (local metres: depth 0 of the frustum is there) and its bare depth
+// (the rock between the base and the ground, where a slope holds less snow).
+@group(0) @binding(6) var<storage, read> ground: array<vec2<f32>>;
+
+// Base and bare depth under a fragment's texel; flat ground is (0, 0), which leaves the maths below
+// exactly as on a flat surface.
+fn ground_at(frag: vec2<f32>) -> vec2<f32> {
+    if view.ground == NO_GROUND {
+        return vec2<f32>(0.0);
+    }
+    let cell = vec2<u32>(frag - view.origin);
+    return ground[view.ground + cell.y * u32(view.texels.x) + cell.x];
+}
 
 // Flag every tile holding a texel within one of this one (the blur's reach).
 fn mark_tiles(frag: vec2<f32>) {
@@ -238,12 +252,15 @@ fn fs_prim(in: PrimOut) {
     } else {
         iv = box_interval(p.p0.xyz, p.p1, p.p2, p.p3, c.x, c.y);
     }
-    // Keep only the part inside the frustum: a solid reaching below the ground is clamped to the
-    // ground, one entirely below it or above the frustum leaves nothing.
-    if iv.x > iv.y || iv.y < 0.0 || iv.x >= view.frustum_height {
+    // Heights above the texel's base. Keep only the part inside the frustum: a solid reaching below
+    // the ground (the bare depth above the base) is clamped to the ground, one entirely below it or
+    // above the frustum leaves nothing.
+    let g = ground_at(in.clip.xy);
+    iv -= vec2<f32>(g.x);
+    if iv.x > iv.y || iv.y < g.y || iv.x >= view.frustum_height {
         return;
     }
-    keep_lowest(in.clip.xy, max(iv.x, 0.0) / view.frustum_height);
+    keep_lowest(in.clip.xy, max(iv.x, g.y) / view.frustum_height);
 }
 
 struct MeshDraw {
@@ -277,10 +294,14 @@ fn fs_mesh(in: MeshOut, @builtin(front_facing) front: bool) {
     // positive the snow is pressed to the ground (depth clamping), however high the rest of the
     // solid reaches. Above the ground, the lowest entering face is the lowest point of the solids
     // that start there. A solid wholly inside the frustum presses exactly to its lowest point.
-    if in.height < 0.0 {
+    // On ground that is not flat, heights are measured from the texel's base and "below the
+    // ground" is below its bare depth.
+    let g = ground_at(in.clip.xy);
+    let height = in.height - g.x;
+    if height < g.y {
         mark_tiles(in.clip.xy);
         atomicAdd(&winding[texel_index(in.clip.xy)], select(-1, 1, front));
-    } else if front && in.height <= view.frustum_height {
-        keep_lowest(in.clip.xy, in.height / view.frustum_height);
+    } else if front && height <= view.frustum_height {
+        keep_lowest(in.clip.xy, height / view.frustum_height);
     }
 }

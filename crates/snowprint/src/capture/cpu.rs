@@ -170,23 +170,111 @@ pub fn capture(
     primitives: &[GpuPrimitive],
     triangles: &[LocalTriangle],
 ) -> Vec<f32> {
+    capture_on_ground(
+        width,
+        height,
+        half_size,
+        frustum_height,
+        primitives,
+        triangles,
+        None,
+    )
+}
+
+/// Depth a column of snow on ground that is not flat takes from a solid occupying heights
+/// `(lo, hi)` (local metres) over its texel: the column rises from `base`, its lowest `bare` metres
+/// are rock. A solid that reaches into the rock presses the snow to the ground (depth
+/// `bare / frustum_height`), one wholly in the rock or above the frustum leaves nothing.
+pub fn column_depth(
+    (lo, hi): (f32, f32),
+    base: f32,
+    bare: f32,
+    frustum_height: f32,
+) -> Option<f32> {
+    let ground = base + bare;
+    if lo > hi || hi < ground || lo >= base + frustum_height {
+        return None;
+    }
+    Some((lo.max(ground) - base) / frustum_height)
+}
+
+/// [`capture`] on a ground field: `columns` holds `[base, bare]` per texel (see
+/// [`crate::GroundField`]), `None` for flat ground. Written from the solids' intervals in local
+/// metres (not by shifting them as the shader does).
+pub fn capture_on_ground(
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+    frustum_height: f32,
+    primitives: &[GpuPrimitive],
+    triangles: &[LocalTriangle],
+    columns: Option<&[[f32; 2]]>,
+) -> Vec<f32> {
     let mut out = vec![1.0f32; (width * height) as usize];
     for row in 0..height {
         for col in 0..width {
+            let i = (row * width + col) as usize;
             let c = texel_center(col, row, width, height, half_size);
             let mut d = 1.0f32;
+            let Some(columns) = columns else {
+                for p in primitives {
+                    if let Some(v) = primitive_depth(p, c.x, c.y, frustum_height) {
+                        d = d.min(v);
+                    }
+                }
+                if let Some(v) = triangles_depth(triangles, c.x, c.y, frustum_height) {
+                    d = d.min(v);
+                }
+                out[i] = d;
+                continue;
+            };
+            let [base, bare] = columns[i];
             for p in primitives {
-                if let Some(v) = primitive_depth(p, c.x, c.y, frustum_height) {
+                let iv = if p.kind[0] == PRIM_CAPSULE {
+                    let (a, b) = (Vec3::from_slice(&p.p0[..3]), Vec3::from_slice(&p.p1[..3]));
+                    capsule_interval(a, b, p.p0[3], c.x, c.y)
+                } else {
+                    box_interval(p, c.x, c.y)
+                };
+                if let Some(v) = column_depth(iv, base, bare, frustum_height) {
                     d = d.min(v);
                 }
             }
-            if let Some(v) = triangles_depth(triangles, c.x, c.y, frustum_height) {
+            if let Some(v) = triangles_depth_on(triangles, c.x, c.y, base, bare, frustum_height) {
                 d = d.min(v);
             }
-            out[(row * width + col) as usize] = d;
+            out[i] = d;
         }
     }
     out
+}
+
+/// [`triangles_depth`] over a column rising from `base` with `bare` metres of rock.
+fn triangles_depth_on(
+    triangles: &[LocalTriangle],
+    x: f32,
+    z: f32,
+    base: f32,
+    bare: f32,
+    frustum_height: f32,
+) -> Option<f32> {
+    let mut winding = 0i32;
+    let mut lowest: Option<f32> = None;
+    for t in triangles {
+        let Some((y, enters)) = triangle_crossing(t, x, z) else {
+            continue;
+        };
+        if y < base + bare {
+            winding += if enters { 1 } else { -1 };
+        } else if enters && y <= base + frustum_height {
+            lowest = Some(lowest.map_or(y, |l: f32| l.min(y)));
+        }
+    }
+    if winding > 0 {
+        // A contained ground point is pressed to the ground, the bare depth above the base.
+        return Some(bare / frustum_height);
+    }
+    lowest.map(|y| (y - base) / frustum_height)
 }
 
 #[cfg(test)]

@@ -68,6 +68,10 @@ pub struct CapturePlan {
     pub texels: u32,
     /// Tile flags of the captured surfaces.
     pub tile_flags: u32,
+    /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
+    /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`):
+    /// `(first code in the ground codes buffer, first word in the winding buffer, texels)`.
+    pub ground_copies: Vec<(u32, u32, u32)>,
 }
 
 impl CapturePlan {
@@ -82,6 +86,7 @@ impl CapturePlan {
         self.batches = 0;
         self.texels = 0;
         self.tile_flags = 0;
+        self.ground_copies.clear();
     }
 
     /// Texels of the winding buffer: it counts only mesh solids, so a frame of analytic deformers
@@ -113,6 +118,12 @@ pub struct CaptureBuffers<'a> {
     pub tiles: &'a wgpu::Buffer,
     /// Tile list with its indirect dispatch (written).
     pub tile_list: &'a wgpu::Buffer,
+    /// `[base, bare]` per texel of the surfaces on ground that is not flat (read; any buffer when
+    /// every view's `ground` is [`super::NO_GROUND`]).
+    pub ground: &'a wgpu::Buffer,
+    /// The capture code of the ground at each texel of those surfaces, parallel to `ground` (the
+    /// source of [`CapturePlan::ground_copies`]).
+    pub ground_codes: &'a wgpu::Buffer,
     /// The atlas's depth view (places the viewports only).
     pub atlas: &'a wgpu::TextureView,
 }
@@ -140,6 +151,7 @@ pub fn encode(
             buffers.winding.as_entire_binding(),
             buffers.tiles.as_entire_binding(),
             buffers.tile_list.as_entire_binding(),
+            buffers.ground.as_entire_binding(),
         ],
     );
     let draw_bg = bind_group(
@@ -157,6 +169,15 @@ pub fn encode(
     let winding = plan.winding_texels();
     if winding > 0 {
         enc.clear_buffer(buffers.winding, 0, Some(winding as u64 * 4));
+    }
+    for &(from, to, texels) in &plan.ground_copies {
+        enc.copy_buffer_to_buffer(
+            buffers.ground_codes,
+            from as u64 * 4,
+            buffers.winding,
+            to as u64 * 4,
+            texels as u64 * 4,
+        );
     }
     enc.clear_buffer(buffers.tiles, 0, Some(plan.tile_flags.max(1) as u64 * 4));
     enc.clear_buffer(buffers.tile_list, 0, Some(TILE_LIST_HEADER * 4));

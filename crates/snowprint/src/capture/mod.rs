@@ -104,9 +104,13 @@ pub struct CaptureView {
     pub tiles_x: u32,
     /// The surface's record in the update (listed with each flagged tile), or [`NO_LIST`].
     pub record: u32,
-    /// Padding to the uniform's 16-byte size.
-    pub pad: u32,
+    /// First texel of the surface's ground field in the capture's ground buffer, or [`NO_GROUND`]
+    /// on flat ground.
+    pub ground: u32,
 }
+
+/// `ground` of a [`CaptureView`] on flat ground.
+pub const NO_GROUND: u32 = crate::wgsl::consts::NO_GROUND;
 
 /// An analytic deformer in surface-local coordinates. Must match `Primitive` in `capture.wgsl`.
 #[repr(C)]
@@ -178,7 +182,7 @@ impl GpuPrimitive {
 }
 
 /// The capture volume of a surface in its local frame: `|x| <= half.x`, `|z| <= half.z`,
-/// `0 <= y <= frustum_height`.
+/// `ground.0 <= y <= ground.1 + frustum_height`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaptureVolume {
     /// World to surface-local transform.
@@ -187,6 +191,9 @@ pub struct CaptureVolume {
     pub half_size: glam::Vec2,
     /// Snow depth plus ankle height.
     pub frustum_height: f32,
+    /// The lowest base and the highest base of the surface's ground (local metres; `(0, 0)` on flat
+    /// ground): the frustum of each texel rises from its base (see [`crate::GroundField`]).
+    pub ground: (f32, f32),
 }
 
 impl CaptureVolume {
@@ -196,8 +203,8 @@ impl CaptureVolume {
             && lo.x <= self.half_size.x
             && hi.z >= -self.half_size.y
             && lo.z <= self.half_size.y
-            && hi.y >= 0.0
-            && lo.y < self.frustum_height
+            && hi.y >= self.ground.0
+            && lo.y < self.ground.1 + self.frustum_height
     }
 
     /// Whether a world-space ball overlaps the volume.
@@ -536,6 +543,7 @@ mod tests {
             world_to_local: Mat4::IDENTITY,
             half_size: glam::Vec2::new(5.0, 5.0),
             frustum_height: 0.5,
+            ground: (0.0, 0.0),
         };
         let d = Deformer::moving(
             Shape::Sphere { radius: 0.2 },

@@ -243,7 +243,7 @@ pub struct SurfaceRecord {
     pub atlas_x: u32,
     /// Capture atlas y of the surface's rectangle.
     pub atlas_y: u32,
-    /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`].
+    /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`]; bit 2: [`MODE_GROUND`].
     pub mode: u32,
     /// Depression units refilled this update.
     pub replenish_units: u32,
@@ -275,6 +275,10 @@ pub const NO_CAPTURE: u32 = crate::wgsl::consts::NO_CAPTURE;
 /// Bit of [`SurfaceRecord::mode`] set when mesh solids were drawn over the surface this update:
 /// only then does the update read the capture's winding buffer.
 pub const MODE_MESHES: u32 = crate::wgsl::consts::MODE_MESHES;
+/// Bit of [`SurfaceRecord::mode`] set when mesh solids press a surface on ground that is not flat:
+/// its capture and winding regions are then twice its texels, the winding's second half holding
+/// the capture code of the ground at each texel (what a texel inside a solid is pressed to).
+pub const MODE_GROUND: u32 = crate::wgsl::consts::MODE_GROUND;
 /// `normals` of a record in a pool that keeps no normals.
 pub const NO_NORMALS: u32 = crate::wgsl::consts::NO_NORMALS;
 

@@ -63,6 +63,20 @@ pub struct Scene {
     pub budget: Option<SceneBudget>,
     /// The camera (`[camera]`), which decides what the manager counts as visible.
     pub camera: Option<SceneCamera>,
+    /// The ground of each surface (`ground` and the slope keys), in the order of `surfaces`; `None`
+    /// on flat ground.
+    pub grounds: Vec<Option<SceneGround>>,
+}
+
+/// The ground a scene lays a surface on: see `docs/SCENES.md`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneGround {
+    /// The ground (a mesh's triangles already in world metres).
+    pub ground: crate::ground::Ground,
+    /// How much snow its slopes hold.
+    pub slope: crate::ground::SlopeRule,
+    /// Line of the surface's `ground` key (for messages).
+    pub line: usize,
 }
 
 /// `[budget]` of a scene: see `docs/SCENES.md` and `docs/MANAGER.md`.
@@ -428,6 +442,7 @@ mod tests {
             zones: vec![],
             budget: None,
             camera: None,
+            grounds: vec![],
         };
         assert_eq!(scene.duration(), 0.0);
         let empty = deformer(vec![]);

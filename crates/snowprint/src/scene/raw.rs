@@ -98,6 +98,11 @@ pub(super) struct RawSurface {
     pub replenish_rate: Option<Num>,
     pub material: Option<Str>,
     pub zone: Option<Spanned<i64>>,
+    pub ground: Option<Str>,
+    pub ground_heights: Option<Nums>,
+    pub ground_grid: Option<Nums>,
+    pub full_slope_degrees: Option<Num>,
+    pub bare_slope_degrees: Option<Num>,
 }
 
 /// One `[[deformer]]`.
@@ -169,6 +174,11 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "replenish_rate",
             "material",
             "zone",
+            "ground",
+            "ground_heights",
+            "ground_grid",
+            "full_slope_degrees",
+            "bare_slope_degrees",
         ],
     ),
     (

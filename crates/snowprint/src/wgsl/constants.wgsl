@@ -14,6 +14,8 @@ const WORKGROUP: u32 = 8u;
 const TILE_LIST_HEADER: u32 = 4u;
 // `record` of a capture view whose flagged tiles are not listed (the update runs its grid).
 const NO_LIST: u32 = 0xffffffffu;
+// `ground` of a capture view whose surface lies on flat ground (no ground field is read).
+const NO_GROUND: u32 = 0xffffffffu;
 // `batch` of a surface record that nothing touched this update.
 const NO_CAPTURE: u32 = 0xffffffffu;
 // `normals` of a surface record whose pool keeps no normals.
@@ -24,6 +26,8 @@ const MODE_DEPTH: u32 = 0u;
 const MODE_MASK: u32 = 1u;
 // Bit of `mode` set when mesh solids were drawn over the surface: only then is `winding` read.
 const MODE_MESHES: u32 = 2u;
+// Mode bit of a surface record: meshes press a surface on ground that is not flat (pool/mod.rs).
+const MODE_GROUND: u32 = 4u;
 // Primitive kind of a capture primitive (`kind.x`): a capsule (a sphere is a capsule of zero length).
 const PRIM_CAPSULE: u32 = 0u;
 // Primitive kind of a capture primitive: an oriented box.

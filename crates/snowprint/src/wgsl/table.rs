@@ -31,6 +31,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("relax", "relax/relax.wgsl", true),
     // Skinned mesh deformers: the bind pose blended by the joints into the capture's vertices.
     ("skin", "skin/skin.wgsl", true),
+    // Ground meshes rasterised into surfaces' texels (`ground/`).
+    ("ground_raster", "ground/raster.wgsl", true),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe/probe.wgsl", true),
     // The renderer.

@@ -6,13 +6,16 @@
 //! A mesh posed with [`crate::SnowWorld::pose_mesh`] is judged with its vertices as last posed at
 //! both poses (the capture, too, draws meshes at their current pose only).
 //!
-//! The snow top is the fresh snow top (ground + [`SurfaceDesc::snow_depth`]): a foot that comes down
-//! into an older print lands when it passes that height, and its depth is measured from it.
+//! The snow top is the fresh snow top (ground + [`SurfaceDesc::snow_depth`]; on ground that is not
+//! flat, the local top of the texel under the lowest point, [`crate::GroundField`]): a foot that
+//! comes down into an older print lands when it passes that height, and its depth is measured from
+//! it, at most the snow the texel holds.
 
 use glam::{Vec2, Vec3};
 
 use super::SurfaceUpdate;
 use crate::deformer::{Pose, Shape};
+use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::surface::{SurfaceDesc, SurfaceId};
 
@@ -93,7 +96,9 @@ pub fn over_surface(desc: &SurfaceDesc, point: Vec3) -> bool {
     Vec2::new(local.x, local.z).abs().cmple(half).all()
 }
 
-/// The footstep of one deformer over one surface, if it landed there during `elapsed` seconds.
+/// The footstep of one deformer over one surface on flat ground, if it landed there during
+/// `elapsed` seconds.
+#[cfg(test)]
 pub fn landing<'a>(
     desc: &SurfaceDesc,
     shape: &Shape,
@@ -102,17 +107,55 @@ pub fn landing<'a>(
     elapsed: f32,
     mesh_vertices: impl Fn(MeshId) -> Option<&'a [Vec3]> + Copy,
 ) -> Option<(Vec3, f32, f32)> {
+    landing_on(desc, None, shape, previous, pose, elapsed, mesh_vertices)
+}
+
+/// The fresh snow top's world height over `point` and the snow depth it holds there: the flat
+/// surface's, or on a ground field the local top of the texel under the point.
+fn top_over(desc: &SurfaceDesc, ground: Option<&GroundField>, point: Vec3) -> (f32, f32) {
+    let Some(g) = ground else {
+        return (desc.center.y + desc.snow_depth, desc.snow_depth);
+    };
+    let local = desc.world_to_local().transform_point3(point);
+    let cell = |v: f32, side: f32, n: u32| {
+        (((v / side + 0.5) * n as f32).floor().max(0.0) as u32).min(n - 1)
+    };
+    let (c, r) = (
+        cell(local.x, desc.size.x, g.width),
+        cell(local.z, desc.size.y, g.height),
+    );
+    let [base, bare] = g.columns[(r * g.width + c) as usize];
+    (
+        desc.center.y + base + desc.snow_depth,
+        desc.snow_depth - bare,
+    )
+}
+
+/// [`landing`] on a surface that may lie on a ground field.
+#[allow(clippy::too_many_arguments)]
+pub fn landing_on<'a>(
+    desc: &SurfaceDesc,
+    ground: Option<&GroundField>,
+    shape: &Shape,
+    previous: &Pose,
+    pose: &Pose,
+    elapsed: f32,
+    mesh_vertices: impl Fn(MeshId) -> Option<&'a [Vec3]> + Copy,
+) -> Option<(Vec3, f32, f32)> {
     // The current pose first: a deformer above the snow or beside the surface needs no more.
     let now = lowest_point(shape, pose, mesh_vertices)?;
-    let top = desc.center.y + desc.snow_depth;
-    if !(now.y < top && over_surface(desc, now)) {
+    if !over_surface(desc, now) {
+        return None;
+    }
+    let (top, held) = top_over(desc, ground, now);
+    if now.y >= top {
         return None;
     }
     let before = lowest_point(shape, previous, mesh_vertices)?;
     if before.y <= top {
         return None;
     }
-    let depth = (top - now.y).min(desc.snow_depth);
+    let depth = (top - now.y).min(held);
     let speed = if elapsed > 0.0 {
         (now - before).length() / elapsed
     } else {
@@ -126,19 +169,22 @@ pub fn landing<'a>(
 /// vertices.
 pub fn footsteps<'a, 'm>(
     updates: &[SurfaceUpdate<'_>],
-    desc: impl Fn(SurfaceId) -> Option<&'a SurfaceDesc>,
+    desc: impl Fn(SurfaceId) -> Option<(&'a SurfaceDesc, Option<&'a GroundField>)>,
     mesh_vertices: impl Fn(MeshId) -> Option<&'m [Vec3]> + Copy,
     out: &mut Vec<Footstep>,
 ) {
     out.clear();
     for u in updates {
-        let Some(d) = desc(u.surface) else { continue };
+        let Some((d, ground)) = desc(u.surface) else {
+            continue;
+        };
         for (i, deformer) in u.deformers.iter().enumerate() {
             let Some(previous) = deformer.previous.as_ref() else {
                 continue;
             };
-            if let Some((point, depth_m, speed)) = landing(
+            if let Some((point, depth_m, speed)) = landing_on(
                 d,
+                ground,
                 &deformer.shape,
                 previous,
                 &deformer.pose,

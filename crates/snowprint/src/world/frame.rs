@@ -361,6 +361,7 @@ impl SnowWorld {
                 elapsed: u.elapsed,
                 deformers: u.deformers,
                 settle: s.settle,
+                ground: s.ground.as_ref().map(|g| g.plan()),
             })
         });
         let meshes = &self.meshes;
@@ -433,6 +434,8 @@ impl SnowWorld {
             winding: &self.winding.buffer,
             tiles: &self.tiles.buffer,
             tile_list: &self.tile_list.buffer,
+            ground: &self.grounds.buffer,
+            ground_codes: &self.ground_codes.buffer,
             atlas: &self.atlases[atlas].2,
         };
         capture::encode(

@@ -18,6 +18,7 @@
 mod config;
 mod footstep;
 mod frame;
+mod ground;
 mod meshes;
 pub(crate) mod plan;
 pub(crate) mod probe;
@@ -55,6 +56,9 @@ struct SurfaceState {
     /// How long and where a slumping material still relaxes (see [`crate::Material`]); not kept
     /// by snapshots (a surface paged back in has settled).
     settle: crate::relax::Settle,
+    /// Its ground field and where it lies in the capture's ground buffer, when it is not flat
+    /// (`ground.rs`).
+    ground: Option<ground::SurfaceGround>,
 }
 
 /// What the last frame did, for debug readbacks.
@@ -119,6 +123,12 @@ pub struct SnowWorld {
     /// The flagged tiles as a list with its indirect dispatch (see `accumulate::TILE_LIST_HEADER`).
     tile_list: Growable,
     scratch: Growable,
+    /// The ground fields of the surfaces that are not on flat ground, `[base, bare]` per texel.
+    grounds: Growable,
+    /// The capture code of the ground at each texel of those fields, parallel to `grounds`.
+    ground_codes: Growable,
+    /// The ground mesh rasterisation, built the first time a mesh ground is set.
+    ground_raster: Option<crate::ground::raster::GroundRaster>,
     last: LastFrame,
     scratch_cpu: FrameScratch,
     profiling: bool,
@@ -268,6 +278,9 @@ impl SnowWorld {
                 4 * 512,
             ),
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
+            grounds: Growable::new(&device, "ground fields", U::STORAGE | U::COPY_DST, 16),
+            ground_codes: Growable::new(&device, "ground codes", U::COPY_SRC | U::COPY_DST, 16),
+            ground_raster: None,
             queue: gpu.queue.clone(),
             caps: gpu.caps.clone(),
             device,
@@ -348,6 +361,7 @@ impl SnowWorld {
             slot,
             carry: 0.0,
             settle: Default::default(),
+            ground: None,
         }))
     }
 

@@ -20,7 +20,8 @@ use crate::deformer::{Deformer, Shape};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::mesh::MeshId;
 use crate::pool::{
-    MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+    MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER,
+    TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceLayout};
@@ -83,6 +84,18 @@ pub struct PlanSurface<'a> {
     /// How long and where it still slumps after the last update that pressed it (see
     /// [`crate::Material`]).
     pub settle: Settle,
+    /// Its ground field in the capture's ground buffer, or `None` on flat ground.
+    pub ground: Option<PlanGround>,
+}
+
+/// Where a surface's ground field lies for the capture, and the heights it spans.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanGround {
+    /// First texel of the field in the ground buffer.
+    pub offset: u32,
+    /// The lowest base and the highest ground of the field, local metres
+    /// ([`crate::GroundField::range`]).
+    pub range: (f32, f32),
 }
 
 /// A surface the plan updates.
@@ -129,6 +142,8 @@ struct Job {
     surface: PlannedSurface,
     record: SurfaceRecord,
     half_size: Vec2,
+    /// First texel of the ground field, or [`capture::NO_GROUND`].
+    ground_offset: u32,
     prims: Range<u32>,
     draws: Range<u32>,
     /// Relaxation steps this update (0: none), the material's repose angle (degrees) and the
@@ -238,6 +253,7 @@ impl FramePlan {
             world_to_local: s.desc.world_to_local(),
             half_size: s.desc.size * 0.5,
             frustum_height,
+            ground: s.ground.map_or((0.0, 0.0), |g| g.range),
         };
         let prims = &mut self.capture.prims;
         let (draws, draw_meshes) = (&mut self.capture.draws, &mut self.capture.draw_meshes);
@@ -303,7 +319,12 @@ impl FramePlan {
         let mode = match settings.capture.mode {
             CaptureMode::Depth => 0,
             CaptureMode::Mask => 1,
-        } | if d1 > d0 { MODE_MESHES } else { 0 };
+        } | if d1 > d0 { MODE_MESHES } else { 0 }
+            | if d1 > d0 && s.ground.is_some() {
+                MODE_GROUND
+            } else {
+                0
+            };
         self.jobs.push(Job {
             surface: PlannedSurface {
                 index: s.index,
@@ -328,6 +349,7 @@ impl FramePlan {
                 tiles: 0,
             },
             half_size: volume.half_size,
+            ground_offset: s.ground.map_or(capture::NO_GROUND, |g| g.offset),
             prims: p0..p1,
             draws: d0..d1,
             relax: if relaxes && !rect.is_empty() {
@@ -361,6 +383,12 @@ impl FramePlan {
             r.batch = p.batch;
             r.scratch = c.texels;
             c.texels += r.width * r.height;
+            if r.mode & MODE_GROUND != 0 {
+                // The winding region's second half: the ground's codes, copied before the capture.
+                c.ground_copies
+                    .push((job.ground_offset, c.texels, r.width * r.height));
+                c.texels += r.width * r.height;
+            }
             r.tiles = c.tile_flags;
             c.tile_flags += r.tile_count();
         }
@@ -416,7 +444,7 @@ impl FramePlan {
                 tiles: r.tiles,
                 tiles_x: r.width.div_ceil(TILE_SIDE),
                 record: if listed { j as u32 } else { capture::NO_LIST },
-                pad: 0,
+                ground: job.ground_offset,
             });
         }
         if self.jobs.is_empty() {

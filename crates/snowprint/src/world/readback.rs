@@ -104,12 +104,29 @@ impl SnowWorld {
         };
         let codes: &[u32] = bytemuck::cast_slice(&bytes);
         let winding: &[i32] = bytemuck::cast_slice(&winding);
-        // As capture_read.wgsl reads it: inside a mesh solid at the ground, depth 0.
+        // As capture_read.wgsl reads it: inside a mesh solid at the ground, depth 0, or on ground
+        // that is not flat the ground's own code.
+        let on_ground = r.mode & crate::pool::MODE_GROUND != 0;
+        let ground = if on_ground {
+            self.download(
+                &self.winding.buffer,
+                (r.scratch + r.width * r.height) as u64 * 4,
+                (r.width * r.height) as u64 * 4,
+            )?
+        } else {
+            vec![0; (r.width * r.height) as usize * 4]
+        };
+        let ground: &[u32] = bytemuck::cast_slice(&ground);
         Ok(Some(
             codes
                 .iter()
                 .zip(winding)
-                .map(|(&v, &n)| if n > 0 { 0.0 } else { capture::decode_depth(v) })
+                .zip(ground)
+                .map(|((&v, &n), &g)| match (n > 0, on_ground) {
+                    (true, false) => 0.0,
+                    (true, true) => capture::decode_depth(g),
+                    _ => capture::decode_depth(v),
+                })
                 .collect(),
         ))
     }

@@ -288,6 +288,7 @@ impl SnowWorld {
             slot,
             carry: snapshot.carry,
             settle: Default::default(),
+            ground: None,
         }))
     }
 }

@@ -34,7 +34,12 @@ pub(super) fn skinned_mesh(
 
 /// A mesh path resolved against the scene's folder and checked to stay under it: the file and the
 /// folder it may read from.
-fn resolve(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<(PathBuf, PathBuf)> {
+pub(super) fn resolve(
+    src: &Source<'_>,
+    path: &Str,
+    who: &str,
+    dir: &Path,
+) -> Result<(PathBuf, PathBuf)> {
     let span = path.span();
     let written = path.get_ref();
     if written.trim().is_empty() {
@@ -116,7 +121,13 @@ fn resolve(src: &Source<'_>, path: &Str, who: &str, dir: &Path) -> Result<(PathB
 }
 
 /// The loader's error as the scene's sentence, at the path's line.
-fn load_error(src: &Source<'_>, path: &Str, who: &str, resolved: &Path, e: SnowError) -> SnowError {
+pub(super) fn load_error(
+    src: &Source<'_>,
+    path: &Str,
+    who: &str,
+    resolved: &Path,
+    e: SnowError,
+) -> SnowError {
     let span = path.span();
     if let SnowError::MeshUri {
         what,

@@ -16,6 +16,7 @@ use crate::world::CaptureConfig;
 
 mod camera;
 mod deformer;
+mod ground;
 mod material;
 mod mesh;
 mod surface;
@@ -57,13 +58,22 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
     let materials = material::materials(src, raw.material)?;
     let mut names = HashMap::new();
     let surface_spans: Vec<Range<usize>> = raw.surface.iter().map(Spanned::span).collect();
-    let (surfaces, zones): (Vec<SurfaceDesc>, Vec<u32>) = raw
-        .surface
-        .into_iter()
-        .map(|s| surface(src, s, &mut names, &materials))
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .unzip();
+    let mut surfaces: Vec<SurfaceDesc> = Vec::new();
+    let mut zones = Vec::new();
+    let mut grounds = Vec::new();
+    for s in raw.surface {
+        let table = s.span();
+        let (keys, rest) = ground::GroundKeys::take(s.into_inner());
+        let (desc, zone) = surface(
+            src,
+            Spanned::new(table.clone(), rest),
+            &mut names,
+            &materials,
+        )?;
+        grounds.push(ground::ground(src, keys, &desc, dir)?);
+        surfaces.push(desc);
+        zones.push(zone);
+    }
     if surfaces.is_empty() {
         return Err(src.error_at_line(
             1,
@@ -129,6 +139,7 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
         zones,
         budget,
         camera,
+        grounds,
     })
 }
 

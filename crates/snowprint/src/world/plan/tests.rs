@@ -34,6 +34,7 @@ fn inputs<'a>(
                 elapsed,
                 deformers,
                 settle: Default::default(),
+                ground: None,
             };
             word += layout.width * layout.height;
             s

@@ -19,7 +19,8 @@ impl SnowWorld {
         let mut best: Option<(f32, usize)> = None;
         for (i, s) in self.surfaces.iter().enumerate() {
             let Some(s) = s else { continue };
-            match cpu::over(&s.desc, point) {
+            let field = s.ground.as_ref().map(|g| &g.field);
+            match cpu::over_on(&s.desc, field, point) {
                 Some(ground) if best.is_none_or(|b| b.0 < ground) => best = Some((ground, i)),
                 _ => {}
             }
@@ -33,6 +34,7 @@ impl SnowWorld {
             precision,
             s.slot.heights_word(),
             Some(id),
+            s.ground.as_ref().map(|g| &g.field),
             point,
         ))
     }
@@ -71,6 +73,8 @@ impl SnowWorld {
                         snow_depth: 0.0,
                         rotation: Quat::IDENTITY,
                         channel_max: 1.0,
+                        bare: 0.0,
+                        base_slope: glam::Vec2::ZERO,
                     },
                 ));
                 queries.push(query);
@@ -173,7 +177,10 @@ impl SnowWorld {
         let all: Vec<_> = layers.iter().flat_map(|l| l.iter().copied()).collect();
         crate::world::footstep::footsteps(
             &all,
-            |id| self.state(id).ok().map(|s| &s.desc),
+            |id| {
+                let s = self.state(id).ok()?;
+                Some((&s.desc, s.ground.as_ref().map(|g| &g.field)))
+            },
             |m| meshes.get(m.0 as usize)?.as_deref(),
             &mut steps,
         );

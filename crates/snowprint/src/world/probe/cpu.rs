@@ -5,13 +5,29 @@
 use glam::{Vec2, Vec3};
 
 use super::{GROUND_SLACK, PointInfo, ProbeQuery, ProbeSample, decode_over};
+use crate::ground::GroundField;
 use crate::pool::Precision;
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 
 /// Whether a point is over a surface: inside its rectangle and not below its ground (1 cm of
 /// slack). Returns the surface's ground height.
 pub(crate) fn over(desc: &SurfaceDesc, point: Vec3) -> Option<f32> {
-    let ground = desc.center.y;
+    over_on(desc, None, point)
+}
+
+/// [`over`] on a surface that may lie on a ground field: its ground under the point's texel.
+pub(crate) fn over_on(desc: &SurfaceDesc, field: Option<&GroundField>, point: Vec3) -> Option<f32> {
+    let ground = match field {
+        None => desc.center.y,
+        Some(f) => {
+            let layout = SurfaceLayout {
+                width: f.width,
+                height: f.height,
+            };
+            let ([c, r], _) = texel_under(desc, &layout, point);
+            desc.center.y + f.ground[(r * f.width + c) as usize]
+        }
+    };
     if ground > point.y + GROUND_SLACK {
         return None;
     }
@@ -42,15 +58,19 @@ pub(crate) fn texel_under(
 
 /// What the probe pass needs of a point over a surface whose heights start at `base` (a word of
 /// the pool), and what decodes its result.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn query(
     desc: &SurfaceDesc,
     layout: &SurfaceLayout,
     precision: Precision,
     base: u32,
     surface: Option<SurfaceId>,
+    field: Option<&GroundField>,
     point: Vec3,
 ) -> (ProbeQuery, PointInfo) {
     let ([column, row], texel) = texel_under(desc, layout, point);
+    let (bare, base_slope) =
+        field.map_or((0.0, Vec2::ZERO), |f| ground_under(f, column, row, texel));
     let query = ProbeQuery {
         base,
         width: layout.width,
@@ -67,6 +87,8 @@ pub(super) fn query(
         snow_depth: desc.snow_depth,
         rotation: desc.rotation(),
         channel_max: precision.channel_max() as f64,
+        bare,
+        base_slope,
     };
     (query, info)
 }
@@ -82,7 +104,7 @@ pub(crate) fn sample(
     surface: Option<SurfaceId>,
     point: Vec3,
 ) -> ProbeSample {
-    let (q, info) = query(desc, layout, precision, 0, surface, point);
+    let (q, info) = query(desc, layout, precision, 0, surface, None, point);
     let (w, h) = (q.width, q.height);
     let (x, y) = (q.texel & 0xffff, q.texel >> 16);
     let at = |x: u32, y: u32| (y * w + x) as usize;
@@ -107,6 +129,26 @@ pub(crate) fn sample(
         dz.to_bits(),
     ];
     decode_over(&info, raw)
+}
+
+/// The bare depth of texel `(x, y)` of a ground field and the slope of its column's base, by the
+/// probe's own central differences (one-sided at the edges).
+fn ground_under(f: &GroundField, x: u32, y: u32, texel: Vec2) -> (f32, Vec2) {
+    let (w, h) = (f.width, f.height);
+    let base = |x: u32, y: u32| f.columns[(y * w + x) as usize][0];
+    let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+    let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+    let dx = if x1 > x0 {
+        (base(x1, y) - base(x0, y)) / ((x1 - x0) as f32 * texel.x)
+    } else {
+        0.0
+    };
+    let dz = if y1 > y0 {
+        (base(x, y1) - base(x, y0)) / ((y1 - y0) as f32 * texel.y)
+    } else {
+        0.0
+    };
+    (f.columns[(y * w + x) as usize][1], Vec2::new(dx, dz))
 }
 
 /// The sample over a surface that never held a heightmap: untouched snow, its normal the

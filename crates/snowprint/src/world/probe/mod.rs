@@ -123,6 +123,11 @@ struct PointInfo {
     rotation: Quat,
     /// The value of a channel pressed to the ground at the pool's precision.
     channel_max: f64,
+    /// On ground that is not flat: the texel's bare depth (rock under the snow column's top, of a
+    /// slope that holds less snow), metres, and the slope of the column's base (local
+    /// `d/dx`, `d/dz`), which the snow top's slope rides on. Zero on flat ground.
+    bare: f32,
+    base_slope: glam::Vec2,
 }
 
 /// Points asked for by one ticket (or one keyed probe).
@@ -376,12 +381,15 @@ fn decode(info: &PointInfo, raw: [u32; 4]) -> ProbeSample {
 fn decode_over(info: &PointInfo, raw: [u32; 4]) -> ProbeSample {
     let metres = |v: u32| (v as f64 / info.channel_max * info.snow_depth as f64) as f32;
     let depression_m = metres(raw[0]).min(info.snow_depth);
-    let (dx, dz) = (f32::from_bits(raw[2]), f32::from_bits(raw[3]));
+    let (dx, dz) = (
+        f32::from_bits(raw[2]) + info.base_slope.x,
+        f32::from_bits(raw[3]) + info.base_slope.y,
+    );
     let local = Vec3::new(-dx, 1.0, -dz).normalize_or(Vec3::Y);
     ProbeSample {
         point: info.point,
         surface: info.surface,
-        snow_depth_m: info.snow_depth - depression_m,
+        snow_depth_m: (info.snow_depth - info.bare - depression_m).max(0.0),
         depression_m,
         displaced_m: metres(raw[1]),
         normal: info.rotation * local,

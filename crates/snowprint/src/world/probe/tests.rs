@@ -49,6 +49,8 @@ fn decode_by_hand() {
         snow_depth: 0.4,
         rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
         channel_max: 255.0,
+        bare: 0.0,
+        base_slope: glam::Vec2::ZERO,
     };
     // A quarter pressed, a tenth displaced (of 255), rising 1 m per m along local x.
     let raw = [51u32 + 12, 25 + 1, 1f32.to_bits(), 0f32.to_bits()];
@@ -68,4 +70,22 @@ fn decode_by_hand() {
         raw,
     );
     assert_eq!(none, ProbeSample::outside(info.point));
+    // On a slope of the ground holding 0.1 m less (bare), rising 1 m per m along local z under the
+    // same snow: the snow left is 0.1 less, and the normal leans on both slopes.
+    let on_ground = decode(
+        &PointInfo {
+            bare: 0.1,
+            base_slope: glam::Vec2::new(0.0, 1.0),
+            ..info
+        },
+        raw,
+    );
+    assert!((on_ground.snow_depth_m - (0.4 - 0.1 - s.depression_m)).abs() < 1e-6);
+    let local = Vec3::new(-1.0, 1.0, -1.0).normalize();
+    let want = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2) * local;
+    assert!(
+        (on_ground.normal - want).length() < 1e-5,
+        "{}",
+        on_ground.normal
+    );
 }

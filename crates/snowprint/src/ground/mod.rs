@@ -1,0 +1,361 @@
+//! Ground that is not flat: the terrain under a surface's snow, one height per heightmap texel, and
+//! how much snow each texel's slope holds.
+//!
+//! A surface's ground is [`Ground::Flat`] (its rectangle at the height of its centre, as every
+//! surface was before), a [`HeightGrid`] of heights over the rectangle (read from a 16-bit PNG with
+//! its height range, or a raw grid of little-endian `f32`), or a [`GroundMesh`] of triangles (a
+//! terrain or a pitched roof) rasterised into the surface's texels on the GPU ([`raster`]). Heights
+//! are metres along the surface's local `y`, 0 at its centre.
+//!
+//! [`GroundField::build`] turns a ground into what the capture reads per texel: the *base* of the
+//! snow column and its *bare* depth. On ground no steeper than [`SlopeRule::full_degrees`] the base
+//! is the ground and nothing is bare: the snow top is the ground plus the snow depth. Steeper, the
+//! texel holds a fraction `k` of the snow depth `D`, falling linearly with the slope angle to none at
+//! [`SlopeRule::bare_degrees`]; its column is lowered to the base `ground - (1 - k) D`, of which the
+//! lowest `(1 - k) D` is rock. So the snow top is `ground + k D`, a depression is still a fraction of
+//! `D` measured from that top, and the capture's depth clamp holds at the ground itself (the bare
+//! depth above the base): a foot never digs below the terrain. Capture: `capture/capture.wgsl`.
+
+pub(crate) mod cpu;
+pub(crate) mod raster;
+
+use glam::Vec3;
+
+use crate::error::{Result, SnowError};
+use crate::surface::SurfaceLayout;
+
+/// What lies under a surface's snow.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Ground {
+    /// The surface's rectangle, flat at its centre's height (every surface's ground before this).
+    #[default]
+    Flat,
+    /// Heights sampled over the surface's rectangle (bilinearly between the grid's samples).
+    Grid(HeightGrid),
+    /// Triangles in world metres, rasterised into the surface's texels on the GPU: each texel takes
+    /// the highest face over its centre; texels no face covers keep the flat ground (0).
+    Mesh(GroundMesh),
+}
+
+/// A grid of ground heights covering a surface's rectangle: sample `(c, r)` lies at the centre of
+/// cell `(c, r)` of a `columns x rows` division of the rectangle (column 0 the smallest local `x`,
+/// row 0 the smallest `z`), as a PNG's pixels lie over its image. Heights are metres along local `y`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeightGrid {
+    /// Samples along local `x`.
+    pub columns: u32,
+    /// Samples along local `z`.
+    pub rows: u32,
+    /// `columns * rows` heights, row after row, metres.
+    pub heights: Vec<f32>,
+}
+
+/// A ground mesh: triangles in world metres, any winding (the highest face over a texel is the
+/// ground there).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GroundMesh {
+    /// The triangles.
+    pub triangles: Vec<[Vec3; 3]>,
+}
+
+/// How much snow a slope holds: all of it up to `full_degrees`, none from `bare_degrees`, linearly
+/// less in the angle between. The default (35 and 60 degrees) lets a 30-degree roof keep its snow
+/// and leaves cliffs bare.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeRule {
+    /// Steepest slope that holds the whole snow depth, degrees.
+    pub full_degrees: f32,
+    /// Gentlest slope that holds none, degrees (above `full_degrees`).
+    pub bare_degrees: f32,
+}
+
+impl Default for SlopeRule {
+    fn default() -> Self {
+        Self {
+            full_degrees: 35.0,
+            bare_degrees: 60.0,
+        }
+    }
+}
+
+impl SlopeRule {
+    /// A rule that never bares a slope (every texel holds the whole depth).
+    pub const NEVER_BARE: Self = Self {
+        full_degrees: 90.0,
+        bare_degrees: 91.0,
+    };
+
+    /// Fraction of the snow depth a slope of `degrees` holds.
+    pub fn holds(&self, degrees: f32) -> f32 {
+        if degrees <= self.full_degrees {
+            return 1.0;
+        }
+        ((self.bare_degrees - degrees) / (self.bare_degrees - self.full_degrees)).clamp(0.0, 1.0)
+    }
+
+    /// Check the angles, naming the surface.
+    pub fn validate(&self, surface: &str) -> Result<()> {
+        let ok = |a: f32| a.is_finite() && a >= 0.0;
+        if !(ok(self.full_degrees)
+            && ok(self.bare_degrees)
+            && self.bare_degrees > self.full_degrees)
+        {
+            return Err(SnowError::InvalidGround {
+                name: surface.to_owned(),
+                reason: format!(
+                    "the slope rule holds full snow to {} degrees and none from {} degrees; both must be 0 or more and the second larger",
+                    self.full_degrees, self.bare_degrees
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
+impl HeightGrid {
+    /// Check the grid's size against its heights, naming the surface.
+    pub fn validate(&self, surface: &str) -> Result<()> {
+        let bad = |reason: String| {
+            Err(SnowError::InvalidGround {
+                name: surface.to_owned(),
+                reason,
+            })
+        };
+        if self.columns < 2 || self.rows < 2 {
+            return bad(format!(
+                "the height grid is {} x {} samples; it needs at least 2 x 2",
+                self.columns, self.rows
+            ));
+        }
+        let n = self.columns as u64 * self.rows as u64;
+        if self.heights.len() as u64 != n {
+            return bad(format!(
+                "the height grid says {} x {} samples ({n}) but holds {} heights",
+                self.columns,
+                self.rows,
+                self.heights.len()
+            ));
+        }
+        if let Some(h) = self.heights.iter().find(|h| !h.is_finite()) {
+            return bad(format!("the height grid holds {h}; heights must be finite"));
+        }
+        Ok(())
+    }
+
+    /// A grid from a 16-bit greyscale PNG: 0 is `low` metres, 65535 is `high`, linearly between.
+    pub fn from_png16(bytes: &[u8], low: f32, high: f32) -> std::result::Result<Self, String> {
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let mut reader = decoder
+            .read_info()
+            .map_err(|e| format!("is not a readable PNG ({e})"))?;
+        let info = reader.info();
+        let (columns, rows) = (info.width, info.height);
+        if info.bit_depth != png::BitDepth::Sixteen || info.color_type != png::ColorType::Grayscale
+        {
+            return Err(format!(
+                "is a {:?} {:?} PNG; a heightmap must be 16-bit greyscale",
+                info.bit_depth, info.color_type
+            ));
+        }
+        let mut buf = vec![0u8; reader.output_buffer_size().unwrap_or(0)];
+        reader
+            .next_frame(&mut buf)
+            .map_err(|e| format!("is not a readable PNG ({e})"))?;
+        let scale = (high - low) / 65535.0;
+        let heights = buf
+            .chunks_exact(2)
+            .take(columns as usize * rows as usize)
+            .map(|p| low + u16::from_be_bytes([p[0], p[1]]) as f32 * scale)
+            .collect();
+        Ok(Self {
+            columns,
+            rows,
+            heights,
+        })
+    }
+
+    /// A grid from raw little-endian `f32` heights, `columns * rows` of them row after row.
+    pub fn from_raw_f32(
+        bytes: &[u8],
+        columns: u32,
+        rows: u32,
+    ) -> std::result::Result<Self, String> {
+        let want = columns as u64 * rows as u64 * 4;
+        if bytes.len() as u64 != want {
+            return Err(format!(
+                "holds {} bytes, but a {columns} x {rows} grid of f32 heights is {want} bytes",
+                bytes.len()
+            ));
+        }
+        let heights = bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        Ok(Self {
+            columns,
+            rows,
+            heights,
+        })
+    }
+
+    /// The height at a point of the rectangle given as fractions `(u, v)` of its sides in `[0, 1]`:
+    /// bilinear between the four nearest samples, clamped at the edges.
+    pub fn sample(&self, u: f32, v: f32) -> f32 {
+        let x = (u * self.columns as f32 - 0.5).clamp(0.0, (self.columns - 1) as f32);
+        let y = (v * self.rows as f32 - 0.5).clamp(0.0, (self.rows - 1) as f32);
+        let (x0, y0) = (
+            (x.floor() as u32).min(self.columns - 2),
+            (y.floor() as u32).min(self.rows - 2),
+        );
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let at = |c: u32, r: u32| self.heights[(r * self.columns + c) as usize];
+        let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1, y0) * fx;
+        let bottom = at(x0, y0 + 1) * (1.0 - fx) + at(x0 + 1, y0 + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+}
+
+/// What the capture reads of a surface's ground, per heightmap texel (row-major).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroundField {
+    /// Texels along local `x`.
+    pub width: u32,
+    /// Texels along local `z`.
+    pub height: u32,
+    /// Ground height at each texel centre, metres along local `y`.
+    pub ground: Vec<f32>,
+    /// `[base, bare]` at each texel: the bottom of the snow column (`ground - bare`) and its bare
+    /// depth, metres (see the module's documentation). Must match `ground` in `capture.wgsl`.
+    pub columns: Vec<[f32; 2]>,
+}
+
+impl GroundField {
+    /// The field of `ground` heights (one per texel of `layout`) under snow `snow_depth` deep on a
+    /// surface of `size` metres, bared by `slope`.
+    pub fn build(
+        layout: SurfaceLayout,
+        size: glam::Vec2,
+        ground: Vec<f32>,
+        snow_depth: f32,
+        slope: SlopeRule,
+    ) -> Self {
+        let (w, h) = (layout.width, layout.height);
+        let texel = size / glam::Vec2::new(w as f32, h as f32);
+        let columns = (0..h)
+            .flat_map(|r| (0..w).map(move |c| (c, r)))
+            .map(|(c, r)| {
+                let degrees = slope_degrees(&ground, w, h, texel, c, r);
+                let bare = (1.0 - slope.holds(degrees)) * snow_depth;
+                [ground[(r * w + c) as usize] - bare, bare]
+            })
+            .collect();
+        Self {
+            width: w,
+            height: h,
+            ground,
+            columns,
+        }
+    }
+
+    /// Lowest base and highest ground: the capture volume reaches from the first to the second plus
+    /// the snow depth and the ankle height.
+    pub fn range(&self) -> (f32, f32) {
+        let low = self
+            .columns
+            .iter()
+            .map(|c| c[0])
+            .fold(f32::INFINITY, f32::min);
+        let high = self
+            .ground
+            .iter()
+            .copied()
+            .fold(f32::NEG_INFINITY, f32::max);
+        (low, high)
+    }
+}
+
+/// Heights at the centres of a surface's texels from a grid.
+pub fn sample_grid(grid: &HeightGrid, layout: SurfaceLayout) -> Vec<f32> {
+    let (w, h) = (layout.width, layout.height);
+    (0..h)
+        .flat_map(|r| (0..w).map(move |c| (c, r)))
+        .map(|(c, r)| grid.sample((c as f32 + 0.5) / w as f32, (r as f32 + 0.5) / h as f32))
+        .collect()
+}
+
+/// Slope angle at texel `(c, r)`, degrees, from central differences of the heights (one-sided at
+/// the edges).
+fn slope_degrees(g: &[f32], w: u32, h: u32, texel: glam::Vec2, c: u32, r: u32) -> f32 {
+    let at = |c: u32, r: u32| g[(r * w + c) as usize];
+    let (cl, cr) = (c.saturating_sub(1), (c + 1).min(w - 1));
+    let (rb, rf) = (r.saturating_sub(1), (r + 1).min(h - 1));
+    let dx = if cr > cl {
+        (at(cr, r) - at(cl, r)) / ((cr - cl) as f32 * texel.x)
+    } else {
+        0.0
+    };
+    let dz = if rf > rb {
+        (at(c, rf) - at(c, rb)) / ((rf - rb) as f32 * texel.y)
+    } else {
+        0.0
+    };
+    (dx * dx + dz * dz).sqrt().atan().to_degrees()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_rule_is_linear_between_its_angles() {
+        let r = SlopeRule::default();
+        assert_eq!(r.holds(30.0), 1.0);
+        assert_eq!(r.holds(35.0), 1.0);
+        assert!((r.holds(47.5) - 0.5).abs() < 1e-6);
+        assert_eq!(r.holds(60.0), 0.0);
+        assert_eq!(r.holds(80.0), 0.0);
+        assert!(SlopeRule::NEVER_BARE.holds(89.0) == 1.0);
+        assert!(
+            SlopeRule {
+                full_degrees: 50.0,
+                bare_degrees: 40.0
+            }
+            .validate("s")
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn grid_sampling_is_bilinear_between_sample_centres() {
+        let g = HeightGrid {
+            columns: 2,
+            rows: 2,
+            heights: vec![0.0, 1.0, 2.0, 3.0],
+        };
+        // Sample centres at u = 0.25 and 0.75: the middle is the mean, the edges clamp.
+        assert_eq!(g.sample(0.5, 0.5), 1.5);
+        assert_eq!(g.sample(0.25, 0.25), 0.0);
+        assert_eq!(g.sample(0.0, 1.0), 2.0);
+        assert_eq!(g.sample(0.5, 0.25), 0.5);
+    }
+
+    #[test]
+    fn a_steep_plane_lowers_its_base_by_the_bare_depth() {
+        // A 1 m x 1 m surface of 25 x 25 texels on a 50-degree plane holds 0.4 of the depth: 0.6 of
+        // 0.5 m is bare.
+        let layout = SurfaceLayout::for_size(glam::Vec2::ONE);
+        let t = 50f32.to_radians().tan();
+        let g: Vec<f32> = (0..25 * 25).map(|i| (i % 25) as f32 * 0.04 * t).collect();
+        let f = GroundField::build(
+            layout,
+            glam::Vec2::ONE,
+            g.clone(),
+            0.5,
+            SlopeRule::default(),
+        );
+        for (i, c) in f.columns.iter().enumerate() {
+            assert!((c[1] - 0.3).abs() < 1e-4, "{i}: {c:?}");
+            assert!((c[0] - (g[i] - c[1])).abs() < 1e-6);
+        }
+    }
+}
