@@ -1,0 +1,270 @@
+//! The snow world in Bevy's render world: created on Bevy's own device and queue, its update
+//! recorded each frame into the render graph's command encoder ahead of the cameras, and each
+//! surface's heights copied where its material reads them.
+//!
+//! Per frame:
+//! 1. `ExtractSchedule`: [`extract`] copies the surfaces and deformers (their `GlobalTransform`s)
+//!    and the frame's time step out of the main world.
+//! 2. `RenderGraph`, before Bevy's `camera_driver`: [`record`] adds and removes surfaces, sends
+//!    the probes asked, records `SnowWorld::encode_step` into the render context's encoder, then
+//!    (`copy.rs`) each surface's `SurfaceUniform` and heights into its material's buffers.
+//! 3. `RenderGraph`, after Bevy submitted: [`finish`] tells the world the frame was submitted and
+//!    hands the probes' newest answers to the main world.
+
+mod copy;
+pub(crate) mod exchange;
+
+use std::collections::HashMap;
+
+use bevy::prelude::*;
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::renderer::{
+    RenderAdapter, RenderContext, RenderDevice, RenderGraph, RenderGraphSystems, RenderQueue,
+};
+use bevy::render::storage::GpuShaderBuffer;
+use bevy::render::{Extract, ExtractSchedule, RenderApp, RenderStartup};
+use snowprint::{Deformer, GpuContext, PendingFrame, Pose, SnowWorld, SurfaceId, WorldConfig};
+
+use crate::components::pose_of;
+use crate::material::SnowSurfaceBuffers;
+use crate::{SnowDeformer, SnowSurface};
+use exchange::{SharedExchange, SnowStatus, SnowUnder};
+
+/// Register the render world's resources and systems.
+pub(crate) fn build(app: &mut App, shared: SharedExchange, config: WorldConfig) {
+    let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+        shared.lock().status = SnowStatus::Unavailable(
+            "the snow needs Bevy's RenderPlugin (DefaultPlugins with the bevy_render feature)"
+                .into(),
+        );
+        return;
+    };
+    render_app
+        .insert_resource(shared)
+        .insert_resource(SnowSettings(config))
+        .init_resource::<ExtractedSnow>()
+        .add_systems(RenderStartup, start)
+        .add_systems(ExtractSchedule, extract)
+        .add_systems(
+            RenderGraph,
+            (
+                record
+                    .in_set(RenderGraphSystems::Render)
+                    .before(bevy::core_pipeline::schedule::camera_driver),
+                finish.in_set(RenderGraphSystems::Finish),
+            ),
+        );
+}
+
+/// The world's settings, kept until the render device exists.
+#[derive(Resource)]
+struct SnowSettings(WorldConfig);
+
+/// One surface as extracted from the main world.
+struct ExtractedSurface {
+    entity: Entity,
+    desc: snowprint::SurfaceDesc,
+    buffers: Option<SnowSurfaceBuffers>,
+}
+
+/// The main world's snow this frame.
+#[derive(Resource, Default)]
+struct ExtractedSnow {
+    surfaces: Vec<ExtractedSurface>,
+    deformers: Vec<(Entity, snowprint::Shape, Pose)>,
+    dt: f32,
+}
+
+/// The snow world and what it remembers between frames.
+#[derive(Resource)]
+pub(crate) struct RenderSnow {
+    world: SnowWorld,
+    surfaces: HashMap<Entity, SurfaceId>,
+    /// Surfaces refused (bad settings): said once, not asked again.
+    refused: HashMap<Entity, String>,
+    previous: HashMap<Entity, Pose>,
+    pending: Option<PendingFrame>,
+    keys: Vec<u64>,
+}
+
+/// Create the snow world on Bevy's device, checked against snowprint's required features and
+/// limits; what falls short is said in one sentence and the snow stays off.
+fn start(
+    mut commands: Commands,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    adapter: Res<RenderAdapter>,
+    settings: Res<SnowSettings>,
+    shared: Res<SharedExchange>,
+) {
+    let created = GpuContext::from_device(&adapter, device.wgpu_device().clone(), (**queue).clone())
+        .and_then(|gpu| SnowWorld::new(&gpu, settings.0.clone()));
+    match created {
+        Ok(world) => {
+            commands.insert_resource(RenderSnow {
+                world,
+                surfaces: HashMap::new(),
+                refused: HashMap::new(),
+                previous: HashMap::new(),
+                pending: None,
+                keys: Vec::new(),
+            });
+            shared.lock().status = SnowStatus::Running;
+        }
+        Err(e) => {
+            let sentence = unavailable(&e);
+            error!("{sentence}");
+            shared.lock().status = SnowStatus::Unavailable(sentence);
+        }
+    }
+}
+
+/// Why the snow cannot run on Bevy's device, and what to do.
+pub(crate) fn unavailable(e: &snowprint::SnowError) -> String {
+    match e {
+        snowprint::SnowError::DeviceLimit { limit, required, available } => format!(
+            "the snow needs the render device's {limit} to be at least {required} but Bevy's device has {available}: raise it in WgpuSettings::limits (or leave WgpuSettingsPriority::Functionality, which takes the adapter's)"
+        ),
+        other => format!("the snow cannot run on Bevy's render device: {other}"),
+    }
+}
+
+fn extract(
+    mut extracted: ResMut<ExtractedSnow>,
+    surfaces: Extract<
+        Query<(
+            Entity,
+            &SnowSurface,
+            &GlobalTransform,
+            Option<&SnowSurfaceBuffers>,
+        )>,
+    >,
+    deformers: Extract<Query<(Entity, &SnowDeformer, &GlobalTransform)>>,
+    time: Extract<Res<Time>>,
+) {
+    extracted.surfaces.clear();
+    for (entity, surface, transform, buffers) in &surfaces {
+        extracted.surfaces.push(ExtractedSurface {
+            entity,
+            desc: surface.desc(&format!("{entity}"), transform),
+            buffers: buffers.cloned(),
+        });
+    }
+    extracted.deformers.clear();
+    for (entity, deformer, transform) in &deformers {
+        extracted
+            .deformers
+            .push((entity, deformer.shape.to_library(), pose_of(transform)));
+    }
+    extracted.dt = time.delta_secs();
+}
+
+/// Record the snow's update into the render graph's encoder, ahead of the cameras.
+fn record(
+    mut ctx: RenderContext,
+    snow: Option<ResMut<RenderSnow>>,
+    extracted: Res<ExtractedSnow>,
+    shader_buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    queue: Res<RenderQueue>,
+    shared: Res<SharedExchange>,
+) {
+    let Some(mut snow) = snow else { return };
+    let snow = &mut *snow;
+    if snow.pending.take().is_some() {
+        // The last frame's `finish` did not run (no submit): its encoder is gone.
+        snow.world.abandon_pending();
+    }
+    sync_surfaces(snow, &extracted.surfaces);
+    let deformers = deformers(snow, &extracted.deformers);
+    for (key, point) in std::mem::take(&mut shared.lock().asked) {
+        let point = snowprint::glam::Vec3::from_array(point.to_array());
+        match snow.world.probe_keyed(key, point) {
+            Ok(()) if !snow.keys.contains(&key) => snow.keys.push(key),
+            Ok(()) => {}
+            Err(e) => warn!("a snow probe was not sent: {e}"),
+        }
+    }
+    let encoder = ctx.command_encoder();
+    match snow.world.encode_step(encoder, extracted.dt, &deformers) {
+        Ok(pending) => snow.pending = Some(pending),
+        Err(e) => {
+            error!("the snow's update was not recorded: {e}");
+            return;
+        }
+    }
+    copy::surfaces_to_materials(
+        &snow.world,
+        &snow.surfaces,
+        &extracted.surfaces,
+        &shader_buffers,
+        &queue,
+        encoder,
+    );
+}
+
+/// Add the surfaces seen for the first time, remove those gone from the main world.
+fn sync_surfaces(snow: &mut RenderSnow, surfaces: &[ExtractedSurface]) {
+    for s in surfaces {
+        if snow.surfaces.contains_key(&s.entity) || snow.refused.contains_key(&s.entity) {
+            continue;
+        }
+        match snow.world.add_surface(s.desc.clone()) {
+            Ok(id) => {
+                snow.surfaces.insert(s.entity, id);
+            }
+            Err(e) => {
+                let sentence = format!("snow surface on entity {} was refused: {e}", s.entity);
+                error!("{sentence}");
+                snow.refused.insert(s.entity, sentence);
+            }
+        }
+    }
+    let gone: Vec<Entity> = snow
+        .surfaces
+        .keys()
+        .filter(|e| !surfaces.iter().any(|s| s.entity == **e))
+        .copied()
+        .collect();
+    for entity in gone {
+        if let Some(id) = snow.surfaces.remove(&entity)
+            && let Err(e) = snow.world.remove_surface(id)
+        {
+            warn!("snow surface of entity {entity} could not be removed: {e}");
+        }
+    }
+    snow.refused
+        .retain(|e, _| surfaces.iter().any(|s| s.entity == *e));
+}
+
+/// The frame's deformers, each swept from where it was last frame.
+fn deformers(snow: &mut RenderSnow, extracted: &[(Entity, snowprint::Shape, Pose)]) -> Vec<Deformer> {
+    let list = extracted
+        .iter()
+        .map(|&(entity, shape, pose)| match snow.previous.get(&entity) {
+            Some(&previous) => Deformer::moving(shape, previous, pose),
+            None => Deformer::new(shape, pose),
+        })
+        .collect();
+    snow.previous = extracted.iter().map(|&(e, _, pose)| (e, pose)).collect();
+    list
+}
+
+/// After Bevy's submit: the frame is on the GPU; hand the probes' answers to the main world.
+fn finish(snow: Option<ResMut<RenderSnow>>, shared: Res<SharedExchange>) {
+    let Some(mut snow) = snow else { return };
+    let Some(pending) = snow.pending.take() else {
+        return;
+    };
+    if let Err(e) = snow.world.submitted(pending) {
+        error!("the snow's frame could not be completed: {e}");
+    }
+    let mut exchange = shared.lock();
+    exchange.updates += 1;
+    for &key in &snow.keys {
+        if let Some((sample, age)) = snow.world.under(key) {
+            exchange
+                .answers
+                .insert(key, SnowUnder::from_sample(&sample, age));
+        }
+    }
+}

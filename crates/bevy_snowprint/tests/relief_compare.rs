@@ -1,0 +1,283 @@
+//! The plugin's snow against snowprint's own relief tier on one scene: a 10 m x 8 m surface
+//! filling the view, pressed by five boot soles and a ball held for eight frames, seen at 256x144
+//! from above at an angle, lit by one directional light and an ambient term matched to the
+//! library's moon and sky (`Environment` with the same direction, radiance and exposure; Bevy's
+//! units converted through its camera exposure). The library renders it with `Renderer` (relief
+//! tier, on a device of its own); the plugin in a headless Bevy app (no window: the camera
+//! renders into an image, read back with Bevy's screenshot). The two are scored with NVIDIA FLIP
+//! as the goldens are (`crates/snowprint/tests/golden_support`); the bounds, and why they are
+//! wider than the goldens', are data in `tests/relief_compare.json`. Both images and the FLIP map
+//! are written to `target/bevy/relief-compare/` to be looked at.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::time::TimeUpdateStrategy;
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use bevy_snowprint::snowprint::{self, glam as sg};
+use bevy_snowprint::{SnowDeformer, SnowSurface, SnowprintPlugin};
+
+const WIDTH: u32 = 256;
+const HEIGHT: u32 = 144;
+const SURFACE: [f32; 2] = [10.0, 8.0];
+const DEPTH: f32 = 0.15;
+/// Frames the deformers press before they are lifted away.
+const PRESS_FRAMES: u32 = 8;
+const EYE: [f32; 3] = [0.4, 2.6, 2.4];
+const TARGET: [f32; 3] = [0.4, 0.0, -0.3];
+const FOV_Y_DEGREES: f32 = 52.0;
+/// Towards the light (unnormalised), its radiance on white facing it, the sky's on white facing
+/// up (both linear RGB, the library's units).
+const LIGHT: [f32; 3] = [0.8, 0.6, 0.42];
+const LIGHT_RADIANCE: [f32; 3] = [0.62, 0.66, 0.72];
+const SKY_RADIANCE: [f32; 3] = [0.16, 0.19, 0.26];
+
+/// The deformers: (shape, position), held still for the pressing frames.
+fn deformers() -> Vec<(snowprint::Shape, [f32; 3])> {
+    let mut d = vec![(snowprint::Shape::Sphere { radius: 0.3 }, [1.2, 0.2, -0.4])];
+    for i in 0..5 {
+        let side = if i % 2 == 0 { 0.1 } else { -0.1 };
+        d.push((
+            snowprint::Shape::Box {
+                half_extents: sg::Vec3::new(0.13, 0.03, 0.05),
+            },
+            [-1.3 + 0.55 * i as f32, 0.03, 0.4 + side],
+        ));
+    }
+    d
+}
+
+fn library_render() -> image::RgbImage {
+    use snowprint::render::{Environment, RenderConfig, RenderFrame, Renderer, Tier};
+    let gpu = snowprint::GpuContext::new(&snowprint::GpuOptions::default()).expect("a GPU");
+    let mut world = snowprint::SnowWorld::new(&gpu, snowprint::WorldConfig::default()).expect("world");
+    let surface = world
+        .add_surface(snowprint::SurfaceDesc::new("yard", [0.0; 3], SURFACE, DEPTH))
+        .expect("surface");
+    let pressing: Vec<snowprint::Deformer> = deformers()
+        .into_iter()
+        .map(|(shape, at)| snowprint::Deformer::new(shape, snowprint::Pose::at(at)))
+        .collect();
+    for _ in 0..PRESS_FRAMES {
+        world.step(1.0 / 30.0, &pressing).expect("step");
+    }
+    world.step(1.0 / 30.0, &[]).expect("step");
+    let mut renderer = Renderer::new(&gpu, RenderConfig::new(WIDTH, HEIGHT, Tier::Relief)).expect("renderer");
+    let environment = Environment {
+        moon_direction: sg::Vec3::from(LIGHT).normalize(),
+        moon_color: sg::Vec3::from(LIGHT_RADIANCE),
+        sky_ambient: sg::Vec3::from(SKY_RADIANCE),
+        ground_bounce: sg::Vec3::from(SKY_RADIANCE),
+        exposure: 1.0,
+        fog_density: 0.0,
+        city_glow: 0.0,
+        ..Environment::moonlit_night()
+    };
+    let frame = RenderFrame {
+        camera: snowprint::Camera {
+            eye: sg::Vec3::from(EYE),
+            target: sg::Vec3::from(TARGET),
+            fov_y_degrees: FOV_Y_DEGREES,
+        },
+        time: 1.0,
+        surfaces: &[(surface, snowprint::GroundMaterial::RoofTiles)],
+        instances: &[],
+        lights: &[],
+        environment,
+        snowfall: false,
+    };
+    let out = renderer.render(&world, &frame).expect("render");
+    let rgb = out.rgba8.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+    image::RgbImage::from_raw(out.width, out.height, rgb).expect("image")
+}
+
+#[derive(Resource)]
+struct Run {
+    frame: u32,
+    target: Handle<Image>,
+    shot: Arc<Mutex<Option<image::RgbImage>>>,
+    requested: bool,
+}
+
+fn bevy_render() -> image::RgbImage {
+    let shot = Arc::new(Mutex::new(None));
+    let mut app = App::new();
+    app.add_plugins((
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .disable::<WinitPlugin>(),
+        ScheduleRunnerPlugin::run_loop(Duration::ZERO),
+        SnowprintPlugin::default(),
+    ))
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f32(1.0 / 30.0)))
+    .insert_resource(ClearColor(Color::BLACK))
+    .add_systems(Startup, setup)
+    .add_systems(Update, drive);
+    let target = {
+        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+        images.add(Image::new_target_texture(
+            WIDTH,
+            HEIGHT,
+            TextureFormat::Rgba8UnormSrgb,
+            None,
+        ))
+    };
+    app.insert_resource(Run {
+        frame: 0,
+        target,
+        shot: shot.clone(),
+        requested: false,
+    });
+    app.run();
+    let image = shot.lock().unwrap().take();
+    image.expect("the screenshot came back")
+}
+
+fn setup(mut commands: Commands, run: Res<Run>) {
+    commands.spawn((
+        SnowSurface::new(Vec2::from(SURFACE), DEPTH),
+        Transform::default(),
+    ));
+    for (shape, at) in deformers() {
+        let deformer = match shape {
+            snowprint::Shape::Sphere { radius } => SnowDeformer::sphere(radius),
+            snowprint::Shape::Box { half_extents } => {
+                SnowDeformer::cuboid(Vec3::from_array(half_extents.to_array()))
+            }
+            _ => unreachable!("the scene has spheres and boxes"),
+        };
+        commands.spawn((deformer, Transform::from_translation(Vec3::from(at))));
+    }
+    // Bevy lights in lux and scales by the camera's exposure; a white Lambertian surface facing a
+    // directional light reflects illuminance / pi times that exposure, its ambient term
+    // brightness times it: matched to the library's radiances.
+    let exposure = bevy::camera::Exposure::default().exposure();
+    let light = Vec3::from(LIGHT_RADIANCE);
+    let sky = Vec3::from(SKY_RADIANCE);
+    commands.spawn((
+        DirectionalLight {
+            color: Color::linear_rgb(light.x, light.y, light.z) .with_luminance(1.0),
+            illuminance: 0.0,
+            shadow_maps_enabled: false,
+            ..default()
+        },
+        Transform::default().looking_to(-Vec3::from(LIGHT).normalize(), Vec3::Y),
+        LightRadiance(light, exposure),
+    ));
+    commands.insert_resource(GlobalAmbientLight {
+        color: Color::linear_rgb(sky.x / sky.max_element(), sky.y / sky.max_element(), sky.z / sky.max_element()),
+        brightness: sky.max_element() / exposure,
+        ..default()
+    });
+    commands.spawn((
+        Camera3d::default(),
+        RenderTarget::Image(run.target.clone().into()),
+        Tonemapping::AcesFitted,
+        Projection::Perspective(PerspectiveProjection {
+            fov: FOV_Y_DEGREES.to_radians(),
+            ..default()
+        }),
+        Transform::from_translation(Vec3::from(EYE)).looking_at(Vec3::from(TARGET), Vec3::Y),
+    ));
+}
+
+/// The light's radiance and the exposure it is converted with.
+#[derive(Component)]
+struct LightRadiance(Vec3, f32);
+
+fn drive(
+    mut commands: Commands,
+    mut run: ResMut<Run>,
+    deformers: Query<Entity, With<SnowDeformer>>,
+    mut lights: Query<(&mut DirectionalLight, &LightRadiance)>,
+) {
+    for (mut light, radiance) in &mut lights {
+        // Per channel the colour carries the ratio; the illuminance the largest channel.
+        let c = radiance.0 / radiance.0.max_element();
+        light.color = Color::linear_rgb(c.x, c.y, c.z);
+        light.illuminance = std::f32::consts::PI * radiance.0.max_element() / radiance.1;
+    }
+    run.frame += 1;
+    if run.frame == PRESS_FRAMES + 1 {
+        for e in &deformers {
+            commands.entity(e).despawn();
+        }
+    }
+    if run.frame == PRESS_FRAMES + 6 && !run.requested {
+        run.requested = true;
+        let shot = run.shot.clone();
+        commands.spawn(Screenshot::image(run.target.clone())).observe(
+            move |captured: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                let image = captured.image.clone().try_into_dynamic().expect("an RGBA8 image");
+                *shot.lock().unwrap() = Some(image.to_rgb8());
+                exit.write(AppExit::Success);
+            },
+        );
+    }
+    if run.frame > PRESS_FRAMES + 300 {
+        panic!("the screenshot did not come back within 300 frames");
+    }
+}
+
+/// FLIP's mean and 99th percentile, as `golden_support::score` computes them.
+fn flip(reference: &image::RgbImage, test: &image::RgbImage) -> (nv_flip::FlipImageFloat, f32, f32) {
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(WIDTH, HEIGHT, reference.as_raw()),
+        nv_flip::FlipImageRgb8::with_data(WIDTH, HEIGHT, test.as_raw()),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let pool = nv_flip::FlipPool::from_image(&error);
+    (error, pool.mean(), pool.get_weighted_percentile(0.99) as f32)
+}
+
+fn out_dir() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
+    let dir = target.join("relief-compare");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn the_plugins_snow_matches_the_librarys_relief_tier() {
+    let library = library_render();
+    let plugin = bevy_render();
+    assert_eq!(plugin.dimensions(), (WIDTH, HEIGHT));
+    let (error, mean, p99) = flip(&library, &plugin);
+    let dir = out_dir();
+    library.save(dir.join("library.png")).unwrap();
+    plugin.save(dir.join("plugin.png")).unwrap();
+    let map = error.apply_color_lut(&nv_flip::magma_lut());
+    image::RgbImage::from_raw(WIDTH, HEIGHT, map.to_vec())
+        .unwrap()
+        .save(dir.join("flip.png"))
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/relief_compare.json"))
+            .unwrap(),
+    )
+    .unwrap();
+    let (max_mean, max_p99) = (
+        v["mean"].as_f64().unwrap() as f32,
+        v["p99"].as_f64().unwrap() as f32,
+    );
+    eprintln!(
+        "FLIP of the plugin's snow against the library's relief tier: mean {mean:.4}, p99 {p99:.4} (bounds {max_mean}, {max_p99}); images in {}",
+        dir.display()
+    );
+    assert!(mean <= max_mean, "FLIP mean {mean} above {max_mean}");
+    assert!(p99 <= max_p99, "FLIP p99 {p99} above {max_p99}");
+}
