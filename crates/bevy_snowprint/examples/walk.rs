@@ -64,6 +64,12 @@ fn main() -> ExitCode {
                 ..default()
             }),
             ..default()
+        })
+        .set(bevy::render::RenderPlugin {
+            // A scripted run's pictures must not depend on how fast the machine compiles
+            // shaders: every pipeline is ready on the frame it is first asked for.
+            synchronous_pipeline_compilation: options.script.is_some(),
+            ..default()
         }),
         SnowprintPlugin::default(),
     ))
@@ -85,16 +91,20 @@ fn main() -> ExitCode {
         )));
     }
     app.insert_resource(options);
-    let exit = app.run();
-    let outcome = app.world().resource::<Outcome>();
-    if let Some(sentence) = &outcome.failure {
-        eprintln!("walk: {sentence}");
-        return ExitCode::FAILURE;
-    }
-    if exit.is_error() {
+    // A failure is said in one sentence where it happens (`fail`) and ends the run with an error.
+    if app.run().is_error() {
         return ExitCode::FAILURE;
     }
     ExitCode::SUCCESS
+}
+
+/// Say why the run cannot go on, and end it with an error.
+fn fail(sentence: String, outcome: &mut Outcome, exit: &mut MessageWriter<AppExit>) {
+    if outcome.failure.is_none() {
+        eprintln!("walk: {sentence}");
+        outcome.failure = Some(sentence);
+    }
+    exit.write(AppExit::error());
 }
 
 /// The command line.
@@ -506,9 +516,10 @@ fn ask_probes(
     mut window: Single<&mut Window>,
     mut outcome: ResMut<Outcome>,
     options: Res<Options>,
+    mut exit: MessageWriter<AppExit>,
 ) {
     if let SnowStatus::Unavailable(sentence) = probes.status() {
-        outcome.failure = Some(sentence);
+        fail(sentence, &mut outcome, &mut exit);
         return;
     }
     for boot in 0..2 {
@@ -539,7 +550,6 @@ fn script_end(
         return;
     };
     if outcome.failure.is_some() {
-        exit.write(AppExit::error());
         return;
     }
     let settle = script.frames() + 8;
@@ -553,10 +563,9 @@ fn script_end(
             .observe(save_to_disk(path));
     }
     if outcome.frame > settle + 240 {
-        outcome.failure = Some(format!(
-            "the screenshot did not come back within 240 frames of frame {settle}"
-        ));
-        exit.write(AppExit::error());
+        let sentence =
+            format!("the screenshot did not come back within 240 frames of frame {settle}");
+        fail(sentence, &mut outcome, &mut exit);
         return;
     }
     if outcome.frame < settle || outcome.shot_requested {
@@ -594,8 +603,11 @@ fn script_end(
     if let Some(path) = &script.report
         && let Err(e) = std::fs::write(path, report.to_string())
     {
-        outcome.failure = Some(format!("cannot write {}: {e}", path.display()));
-        exit.write(AppExit::error());
+        fail(
+            format!("cannot write {}: {e}", path.display()),
+            &mut outcome,
+            &mut exit,
+        );
         return;
     }
     match &script.screenshot {
