@@ -555,7 +555,8 @@ fn script_end(
     let settle = script.frames() + 8;
     if let Some(dir) = &script.frames_dir
         && outcome.frame % script.every == 0
-        && outcome.frame <= settle
+        // Not on the frame of the final screenshot: one capture a window a frame.
+        && outcome.frame < settle
     {
         let path = dir.join(format!("frame_{:04}.png", outcome.frame / script.every));
         commands
