@@ -55,22 +55,24 @@ fn main() -> ExitCode {
     let mut app = App::new();
     let (width, height) = options.size;
     app.add_plugins((
-        DefaultPlugins.set(WindowPlugin {
-            primary_window: Some(Window {
-                title: "bevy_snowprint: walk (WASD)".into(),
-                resolution: WindowResolution::new(width, height).with_scale_factor_override(1.0),
-                present_mode: PresentMode::AutoNoVsync,
-                resizable: options.script.is_none(),
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: Some(Window {
+                    title: "bevy_snowprint: walk (WASD)".into(),
+                    resolution: WindowResolution::new(width, height)
+                        .with_scale_factor_override(1.0),
+                    present_mode: PresentMode::AutoNoVsync,
+                    resizable: options.script.is_none(),
+                    ..default()
+                }),
+                ..default()
+            })
+            .set(bevy::render::RenderPlugin {
+                // A scripted run's pictures must not depend on how fast the machine compiles
+                // shaders: every pipeline is ready on the frame it is first asked for.
+                synchronous_pipeline_compilation: options.script.is_some(),
                 ..default()
             }),
-            ..default()
-        })
-        .set(bevy::render::RenderPlugin {
-            // A scripted run's pictures must not depend on how fast the machine compiles
-            // shaders: every pipeline is ready on the frame it is first asked for.
-            synchronous_pipeline_compilation: options.script.is_some(),
-            ..default()
-        }),
         SnowprintPlugin::default(),
     ))
     // Under Xvfb the window may never have focus: keep updating regardless.
@@ -315,7 +317,10 @@ fn setup(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
-    commands.spawn((SnowSurface::new(Vec2::splat(YARD), SNOW_DEPTH), Transform::default()));
+    commands.spawn((
+        SnowSurface::new(Vec2::splat(YARD), SNOW_DEPTH),
+        Transform::default(),
+    ));
     // Frozen ground around the yard.
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(60.0, 60.0))),
@@ -554,7 +559,7 @@ fn script_end(
     }
     let settle = script.frames() + 8;
     if let Some(dir) = &script.frames_dir
-        && outcome.frame % script.every == 0
+        && outcome.frame.is_multiple_of(script.every)
         // Not on the frame of the final screenshot: one capture a window a frame.
         && outcome.frame < settle
     {

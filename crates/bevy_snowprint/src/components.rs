@@ -54,7 +54,7 @@ impl SnowSurface {
             yaw_degrees: yaw.to_degrees(),
             snow_depth: self.snow_depth,
             replenish_rate: self.replenish_rate,
-            material: self.material.clone(),
+            material: self.material,
         }
     }
 }
@@ -159,7 +159,11 @@ mod tests {
                     .with_rotation(Quat::from_rotation_y(degrees.to_radians())),
             );
             let desc = surface.desc("s", &t);
-            assert!((desc.yaw_degrees - degrees).abs() < 1e-3, "{degrees}: {}", desc.yaw_degrees);
+            assert!(
+                (desc.yaw_degrees - degrees).abs() < 1e-3,
+                "{degrees}: {}",
+                desc.yaw_degrees
+            );
             assert_eq!(desc.center.to_array(), [1.0, 2.0, 3.0]);
         }
     }

@@ -19,7 +19,10 @@ fn walk() -> Command {
 /// `target/<profile>/examples/walk` next to this test's own binary (`target/<profile>/deps/`).
 fn example_path() -> PathBuf {
     let me = std::env::current_exe().expect("the test's path");
-    let profile = me.parent().and_then(Path::parent).expect("target/<profile>");
+    let profile = me
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>");
     profile.join("examples").join("walk")
 }
 
@@ -221,7 +224,10 @@ fn a_scripted_walk_leaves_a_trail_in_the_bevy_window() {
         .expect("run the walk example");
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "the walk example failed: {stderr}");
-    eprintln!("the walk example ran {:.1} s", start.elapsed().as_secs_f32());
+    eprintln!(
+        "the walk example ran {:.1} s",
+        start.elapsed().as_secs_f32()
+    );
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     let clip: Vec<f32> = r["clip_from_world"]
@@ -264,7 +270,10 @@ fn a_scripted_walk_leaves_a_trail_in_the_bevy_window() {
             "the snow left {left} and the depression {depression} do not add up to the snow's depth {}",
             shot.top
         );
-        assert!(left >= sole - 0.02, "{left} m left under a sole {sole} m above the ground");
+        assert!(
+            left >= sole - 0.02,
+            "{left} m left under a sole {sole} m above the ground"
+        );
     }
 
     // Samples every 5 cm of the path, from 0.3 m after the start to 0.9 m before the person.
@@ -344,7 +353,12 @@ fn bad_flags_get_one_sentence_before_any_window() {
     assert!(e.contains("`q` is not one of the keys"), "{e}");
     let e = refused(&["--size", "12"]);
     assert!(e.contains("--size 12 is not WIDTHxHEIGHT"), "{e}");
-    let e = refused(&["--script", "w:1s", "--screenshot", "/no/such/folder/shot.png"]);
+    let e = refused(&[
+        "--script",
+        "w:1s",
+        "--screenshot",
+        "/no/such/folder/shot.png",
+    ]);
     assert!(e.contains("does not exist"), "{e}");
     let e = refused(&["--screenshot", "shot.png"]);
     assert!(e.contains("need a --script"), "{e}");

@@ -67,7 +67,9 @@ pub(crate) struct SharedExchange(pub Arc<Mutex<Exchange>>);
 impl SharedExchange {
     pub fn lock(&self) -> MutexGuard<'_, Exchange> {
         // A panic while holding the lock leaves plain data behind: keep using it.
-        self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+        self.0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 }
 

@@ -97,8 +97,9 @@ fn start(
     settings: Res<SnowSettings>,
     shared: Res<SharedExchange>,
 ) {
-    let created = GpuContext::from_device(&adapter, device.wgpu_device().clone(), (**queue).clone())
-        .and_then(|gpu| SnowWorld::new(&gpu, settings.0.clone()));
+    let created =
+        GpuContext::from_device(&adapter, device.wgpu_device().clone(), (**queue).clone())
+            .and_then(|gpu| SnowWorld::new(&gpu, settings.0.clone()));
     match created {
         Ok(world) => {
             commands.insert_resource(RenderSnow {
@@ -122,13 +123,19 @@ fn start(
 /// Why the snow cannot run on Bevy's device, and what to do.
 pub(crate) fn unavailable(e: &snowprint::SnowError) -> String {
     match e {
-        snowprint::SnowError::DeviceLimit { limit, required, available } => format!(
-            "the snow needs the render device's {limit} to be at least {required} but Bevy's device has {available}: raise it in WgpuSettings::limits (or leave WgpuSettingsPriority::Functionality, which takes the adapter's)"
+        snowprint::SnowError::DeviceLimit {
+            limit,
+            required,
+            available,
+        } => format!(
+            "the snow needs the render device's {limit} to be at least {required} but Bevy's device has {available}: allow it in RenderPlugin's WgpuSettings (limits and constrained_limits; WgpuSettingsPriority::Functionality takes the adapter's) or run on an adapter that has it"
         ),
         other => format!("the snow cannot run on Bevy's render device: {other}"),
     }
 }
 
+// Bevy's extract queries are tuples of what they read; naming them adds nothing.
+#[allow(clippy::type_complexity)]
 fn extract(
     mut extracted: ResMut<ExtractedSnow>,
     surfaces: Extract<
@@ -237,7 +244,10 @@ fn sync_surfaces(snow: &mut RenderSnow, surfaces: &[ExtractedSurface]) {
 }
 
 /// The frame's deformers, each swept from where it was last frame.
-fn deformers(snow: &mut RenderSnow, extracted: &[(Entity, snowprint::Shape, Pose)]) -> Vec<Deformer> {
+fn deformers(
+    snow: &mut RenderSnow,
+    extracted: &[(Entity, snowprint::Shape, Pose)],
+) -> Vec<Deformer> {
     let list = extracted
         .iter()
         .map(|&(entity, shape, pose)| match snow.previous.get(&entity) {

@@ -1,4 +1,11 @@
-//! The plugin's snow against snowprint's own relief tier on one scene: a 14 m x 12 m surface
+//! Headless Bevy apps (no window: cameras render into images), two tests.
+//!
+//! **A device short of snowprint's limits** (`a_device_short_of_the_limits_is_said_in_one_sentence`):
+//! Bevy's device constrained to four storage buffers a shader stage; the plugin refuses it with
+//! the library's own check and says so in one sentence through `SnowProbes::status`, and the app
+//! runs on without snow.
+//!
+//! **The plugin's snow against snowprint's own relief tier** on one scene: a 14 m x 12 m surface
 //! filling the view, pressed by five boot soles and a ball held for eight frames, seen at 256x144
 //! from above at an angle, lit by one directional light and an ambient term matched to the
 //! library's moon and sky (`Environment` with the same direction, radiance and exposure; Bevy's
@@ -58,9 +65,12 @@ fn deformers() -> Vec<(snowprint::Shape, [f32; 3])> {
 fn library_render() -> image::RgbImage {
     use snowprint::render::{Environment, RenderConfig, RenderFrame, Renderer, Tier};
     let gpu = snowprint::GpuContext::new(&snowprint::GpuOptions::default()).expect("a GPU");
-    let mut world = snowprint::SnowWorld::new(&gpu, snowprint::WorldConfig::default()).expect("world");
+    let mut world =
+        snowprint::SnowWorld::new(&gpu, snowprint::WorldConfig::default()).expect("world");
     let surface = world
-        .add_surface(snowprint::SurfaceDesc::new("yard", [0.0; 3], SURFACE, DEPTH))
+        .add_surface(snowprint::SurfaceDesc::new(
+            "yard", [0.0; 3], SURFACE, DEPTH,
+        ))
         .expect("surface");
     let pressing: Vec<snowprint::Deformer> = deformers()
         .into_iter()
@@ -70,7 +80,8 @@ fn library_render() -> image::RgbImage {
         world.step(1.0 / 30.0, &pressing).expect("step");
     }
     world.step(1.0 / 30.0, &[]).expect("step");
-    let mut renderer = Renderer::new(&gpu, RenderConfig::new(WIDTH, HEIGHT, Tier::Relief)).expect("renderer");
+    let mut renderer =
+        Renderer::new(&gpu, RenderConfig::new(WIDTH, HEIGHT, Tier::Relief)).expect("renderer");
     let environment = Environment {
         moon_direction: sg::Vec3::from(LIGHT).normalize(),
         moon_color: sg::Vec3::from(LIGHT_RADIANCE),
@@ -95,7 +106,11 @@ fn library_render() -> image::RgbImage {
         snowfall: false,
     };
     let out = renderer.render(&world, &frame).expect("render");
-    let rgb = out.rgba8.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+    let rgb = out
+        .rgba8
+        .chunks(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
     image::RgbImage::from_raw(out.width, out.height, rgb).expect("image")
 }
 
@@ -107,27 +122,93 @@ struct Run {
     requested: bool,
 }
 
-fn bevy_render() -> image::RgbImage {
-    let shot = Arc::new(Mutex::new(None));
+/// A headless app: Bevy's default plugins without winit, looping as fast as it can, the plugin.
+fn headless_app(render: bevy::render::RenderPlugin, log: bool) -> App {
     let mut app = App::new();
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: ExitCondition::DontExit,
+            ..default()
+        })
+        .set(render)
+        .disable::<WinitPlugin>();
+    // One global logger a process: the second app of a test binary goes without.
+    let plugins = if log {
+        plugins
+    } else {
+        plugins.disable::<bevy::log::LogPlugin>()
+    };
     app.add_plugins((
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(bevy::render::RenderPlugin {
-                // Every pipeline ready on the frame it is first asked for: the picture does not
-                // depend on how fast this machine compiles shaders.
-                synchronous_pipeline_compilation: true,
-                ..default()
-            })
-            .disable::<WinitPlugin>(),
+        plugins,
         ScheduleRunnerPlugin::run_loop(Duration::ZERO),
         SnowprintPlugin::default(),
-    ))
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f32(1.0 / 30.0)))
+    ));
+    app
+}
+
+#[test]
+fn a_device_short_of_the_limits_is_said_in_one_sentence() {
+    use bevy::render::settings::{WgpuLimits, WgpuSettings};
+    let settings = WgpuSettings {
+        constrained_limits: Some(WgpuLimits {
+            max_storage_buffers_per_shader_stage: 4,
+            ..WgpuLimits::default()
+        }),
+        ..default()
+    };
+    let mut app = headless_app(
+        bevy::render::RenderPlugin {
+            render_creation: settings.into(),
+            ..default()
+        },
+        false,
+    );
+    let status = Arc::new(Mutex::new(None));
+    let seen = status.clone();
+    let mut frames = 0;
+    app.add_systems(
+        Update,
+        move |probes: Res<bevy_snowprint::SnowProbes>, mut exit: MessageWriter<AppExit>| {
+            frames += 1;
+            let s = probes.status();
+            if s != bevy_snowprint::SnowStatus::Starting || frames > 200 {
+                *seen.lock().unwrap() = Some(s);
+                exit.write(AppExit::Success);
+            }
+        },
+    );
+    app.run();
+    let status = status.lock().unwrap().take();
+    match status {
+        Some(bevy_snowprint::SnowStatus::Unavailable(sentence)) => {
+            eprintln!("{sentence}");
+            assert!(
+                sentence.contains("max_storage_buffers_per_shader_stage to be at least 6")
+                    && sentence.contains("has 4")
+                    && sentence.contains("WgpuSettings"),
+                "{sentence}"
+            );
+            assert_eq!(sentence.lines().count(), 1, "{sentence}");
+        }
+        other => panic!("a device with four storage buffers a stage was not refused: {other:?}"),
+    }
+}
+
+fn bevy_render() -> image::RgbImage {
+    let shot = Arc::new(Mutex::new(None));
+    let mut app = headless_app(
+        bevy::render::RenderPlugin {
+            // Every pipeline ready on the frame it is first asked for: the picture does not
+            // depend on how fast this machine compiles shaders.
+            synchronous_pipeline_compilation: true,
+            ..default()
+        },
+        true,
+    );
+    app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f32(
+        1.0 / 30.0,
+    )))
     .insert_resource(ClearColor(Color::BLACK))
     .add_systems(Startup, setup)
     .add_systems(Update, drive);
@@ -174,7 +255,7 @@ fn setup(mut commands: Commands, run: Res<Run>) {
     let sky = Vec3::from(SKY_RADIANCE);
     commands.spawn((
         DirectionalLight {
-            color: Color::linear_rgb(light.x, light.y, light.z) .with_luminance(1.0),
+            color: Color::linear_rgb(light.x, light.y, light.z).with_luminance(1.0),
             illuminance: 0.0,
             shadow_maps_enabled: false,
             ..default()
@@ -183,7 +264,11 @@ fn setup(mut commands: Commands, run: Res<Run>) {
         LightRadiance(light, exposure),
     ));
     commands.insert_resource(GlobalAmbientLight {
-        color: Color::linear_rgb(sky.x / sky.max_element(), sky.y / sky.max_element(), sky.z / sky.max_element()),
+        color: Color::linear_rgb(
+            sky.x / sky.max_element(),
+            sky.y / sky.max_element(),
+            sky.z / sky.max_element(),
+        ),
         brightness: sky.max_element() / exposure,
         ..default()
     });
@@ -228,13 +313,19 @@ fn drive(
     if run.frame == PRESS_FRAMES + 6 && !run.requested {
         run.requested = true;
         let shot = run.shot.clone();
-        commands.spawn(Screenshot::image(run.target.clone())).observe(
-            move |captured: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
-                let image = captured.image.clone().try_into_dynamic().expect("an RGBA8 image");
-                *shot.lock().unwrap() = Some(image.to_rgb8());
-                exit.write(AppExit::Success);
-            },
-        );
+        commands
+            .spawn(Screenshot::image(run.target.clone()))
+            .observe(
+                move |captured: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                    let image = captured
+                        .image
+                        .clone()
+                        .try_into_dynamic()
+                        .expect("an RGBA8 image");
+                    *shot.lock().unwrap() = Some(image.to_rgb8());
+                    exit.write(AppExit::Success);
+                },
+            );
     }
     if run.frame > PRESS_FRAMES + 300 {
         panic!("the screenshot did not come back within 300 frames");
@@ -269,14 +360,21 @@ fn library_curve(bevy: &image::RgbImage) -> image::RgbImage {
 }
 
 /// FLIP's mean and 99th percentile, as `golden_support::score` computes them.
-fn flip(reference: &image::RgbImage, test: &image::RgbImage) -> (nv_flip::FlipImageFloat, f32, f32) {
+fn flip(
+    reference: &image::RgbImage,
+    test: &image::RgbImage,
+) -> (nv_flip::FlipImageFloat, f32, f32) {
     let error = nv_flip::flip(
         nv_flip::FlipImageRgb8::with_data(WIDTH, HEIGHT, reference.as_raw()),
         nv_flip::FlipImageRgb8::with_data(WIDTH, HEIGHT, test.as_raw()),
         nv_flip::DEFAULT_PIXELS_PER_DEGREE,
     );
     let pool = nv_flip::FlipPool::from_image(&error);
-    (error, pool.mean(), pool.get_weighted_percentile(0.99) as f32)
+    (
+        error,
+        pool.mean(),
+        pool.get_weighted_percentile(0.99) as f32,
+    )
 }
 
 /// The mean of FLIP's error over the box of pixels around the prints (12 pixels beyond the
@@ -337,8 +435,10 @@ fn the_plugins_snow_matches_the_librarys_relief_tier() {
         .save(dir.join("flip.png"))
         .unwrap();
     let v: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/relief_compare.json"))
-            .unwrap(),
+        &std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/relief_compare.json"),
+        )
+        .unwrap(),
     )
     .unwrap();
     let bound = |k: &str| {
