@@ -77,12 +77,8 @@ impl SharedExchange {
 /// every frame, read the newest answer, a frame or two later (the GPU reads the heightmap after
 /// the update and the answer comes back without waiting).
 ///
-/// ```ignore
-/// fn feet(mut probes: ResMut<SnowProbes>, walker: Single<&Transform, With<Walker>>) {
-///     probes.ask(LEFT_FOOT, walker.translation);
-///     if let Some(under) = probes.under(LEFT_FOOT) { /* under.snow_depth_m, under.depression_m */ }
-/// }
-/// ```
+/// `examples/walk.rs` asks under each planted boot every frame and shows the answers in the
+/// window's title; `docs/EMBEDDING.md` ("Bevy") has a short example.
 #[derive(Resource, Clone)]
 pub struct SnowProbes {
     pub(crate) shared: SharedExchange,
