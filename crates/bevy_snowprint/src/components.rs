@@ -60,7 +60,7 @@ impl SnowSurface {
 }
 
 /// The shape of a [`SnowDeformer`], in the entity's local frame (scale is ignored).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum DeformerShape {
     /// A ball of this radius, metres.
     Sphere {
@@ -79,11 +79,18 @@ pub enum DeformerShape {
         /// Half of each side, metres.
         half_extents: Vec3,
     },
+    /// A closed triangle mesh of Bevy's (a triangle list, wound counter-clockwise seen from
+    /// outside, as Bevy's primitives are), registered with the snow world the first frame it is
+    /// seen. It must keep its data in the main world (`RenderAssetUsages::MAIN_WORLD`, the
+    /// default).
+    Mesh(Handle<Mesh>),
 }
 
 impl DeformerShape {
-    pub(crate) fn to_library(self) -> snowprint::Shape {
-        match self {
+    /// The library's shape, for the analytic shapes (`None` for a mesh, which the render world
+    /// registers first).
+    pub(crate) fn analytic(&self) -> Option<snowprint::Shape> {
+        Some(match *self {
             DeformerShape::Sphere { radius } => snowprint::Shape::Sphere { radius },
             DeformerShape::Capsule {
                 radius,
@@ -95,14 +102,39 @@ impl DeformerShape {
             DeformerShape::Box { half_extents } => snowprint::Shape::Box {
                 half_extents: sg::Vec3::from_array(half_extents.to_array()),
             },
-        }
+            DeformerShape::Mesh(_) => return None,
+        })
     }
+}
+
+/// A Bevy mesh as the library's closed triangle list, or why it cannot be one.
+pub(crate) fn library_mesh(mesh: &Mesh) -> Result<snowprint::Mesh, String> {
+    use bevy::mesh::{PrimitiveTopology, VertexAttributeValues};
+    if mesh.primitive_topology() != PrimitiveTopology::TriangleList {
+        return Err(format!(
+            "is a {:?}; a snow deformer needs a triangle list",
+            mesh.primitive_topology()
+        ));
+    }
+    let Some(VertexAttributeValues::Float32x3(positions)) =
+        mesh.attribute(Mesh::ATTRIBUTE_POSITION)
+    else {
+        return Err("has no Float32x3 positions (or they live only in the render world)".into());
+    };
+    let indices: Vec<u32> = match mesh.indices() {
+        Some(indices) => indices.iter().map(|i| i as u32).collect(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    Ok(snowprint::Mesh {
+        positions: positions.iter().map(|p| sg::Vec3::from_array(*p)).collect(),
+        indices,
+    })
 }
 
 /// Something that presses the snow: a shape following the entity's `GlobalTransform`. Between
 /// two frames it is swept from its last pose to the new one, so a fast foot leaves a trench
-/// rather than a row of dents.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
+/// rather than a row of dents (meshes are pressed where they are, as the library does).
+#[derive(Component, Clone, Debug, PartialEq)]
 #[require(Transform)]
 pub struct SnowDeformer {
     /// Its geometry, in the entity's frame.
@@ -131,6 +163,13 @@ impl SnowDeformer {
     pub fn cuboid(half_extents: Vec3) -> Self {
         Self {
             shape: DeformerShape::Box { half_extents },
+        }
+    }
+
+    /// A closed triangle mesh of Bevy's (see [`DeformerShape::Mesh`]).
+    pub fn mesh(mesh: Handle<Mesh>) -> Self {
+        Self {
+            shape: DeformerShape::Mesh(mesh),
         }
     }
 }

@@ -195,6 +195,83 @@ fn a_device_short_of_the_limits_is_said_in_one_sentence() {
     }
 }
 
+/// A Bevy mesh (a 0.4 m cube) pressing the snow as a deformer leaves the print an analytic box of
+/// the same size leaves beside it: the probes under both read the same depression, the box's
+/// bottom 10 cm below the snow's top.
+#[test]
+fn a_mesh_deformer_presses_as_the_same_box_does() {
+    let mut app = headless_app(bevy::render::RenderPlugin::default(), false);
+    let top = 0.3;
+    let half = 0.2;
+    let centre_y = top - 0.1 + half;
+    let (at_mesh, at_box) = (
+        Vec3::new(-1.0, centre_y, 0.0),
+        Vec3::new(1.0, centre_y, 0.0),
+    );
+    let answers = Arc::new(Mutex::new(Vec::new()));
+    let seen = answers.clone();
+    app.add_systems(
+        Startup,
+        move |mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>| {
+            commands.spawn((
+                SnowSurface::new(Vec2::new(6.0, 4.0), top),
+                Transform::default(),
+            ));
+            commands.spawn((
+                SnowDeformer::mesh(meshes.add(Cuboid::from_length(2.0 * half))),
+                Transform::from_translation(at_mesh),
+            ));
+            commands.spawn((
+                SnowDeformer::cuboid(Vec3::splat(half)),
+                Transform::from_translation(at_box),
+            ));
+        },
+    );
+    let mut frames = 0;
+    app.add_systems(
+        Update,
+        move |mut probes: ResMut<bevy_snowprint::SnowProbes>, mut exit: MessageWriter<AppExit>| {
+            frames += 1;
+            probes.ask(1, Vec3::new(at_mesh.x, 0.0, at_mesh.z));
+            probes.ask(2, Vec3::new(at_box.x, 0.0, at_box.z));
+            // Twenty frames of pressing, then answers no older than the last of them.
+            if let (true, Some(m), Some(b)) = (frames > 20, probes.under(1), probes.under(2)) {
+                *seen.lock().unwrap() = vec![m, b];
+                exit.write(AppExit::Success);
+            }
+            if frames > 400 {
+                exit.write(AppExit::error());
+            }
+        },
+    );
+    app.run();
+    let answers = answers.lock().unwrap().clone();
+    assert_eq!(
+        answers.len(),
+        2,
+        "the probes did not answer within 400 frames"
+    );
+    let (mesh, cuboid) = (answers[0], answers[1]);
+    eprintln!(
+        "under the mesh cube {:.4} m pressed, under the analytic box {:.4} m",
+        mesh.depression_m, cuboid.depression_m
+    );
+    for u in [mesh, cuboid] {
+        assert!(u.on_snow);
+        assert!(
+            (u.depression_m - 0.1).abs() < 0.01,
+            "{} m pressed where the box's bottom is 0.1 m below the top",
+            u.depression_m
+        );
+    }
+    assert!(
+        (mesh.depression_m - cuboid.depression_m).abs() < 0.002,
+        "the mesh pressed {} m, the same box as a shape {} m",
+        mesh.depression_m,
+        cuboid.depression_m
+    );
+}
+
 fn bevy_render() -> image::RgbImage {
     let shot = Arc::new(Mutex::new(None));
     let mut app = headless_app(

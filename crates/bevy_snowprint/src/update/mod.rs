@@ -85,6 +85,31 @@ pub(crate) struct RenderSnow {
     previous: HashMap<Entity, Pose>,
     pending: Option<PendingFrame>,
     keys: Vec<u64>,
+    /// Bevy meshes registered as deformers, or why they could not be (said once).
+    meshes: HashMap<AssetId<Mesh>, Result<snowprint::MeshId, String>>,
+}
+
+impl RenderSnow {
+    /// The library's mesh of a Bevy mesh, registered the first time it is asked for; `None` (and
+    /// one warning) for a mesh that is not a closed triangle list, `None` without a word while
+    /// the asset is still loading.
+    fn mesh(&mut self, id: AssetId<Mesh>, meshes: &Assets<Mesh>) -> Option<snowprint::MeshId> {
+        if let Some(known) = self.meshes.get(&id) {
+            return known.as_ref().ok().copied();
+        }
+        let mesh = meshes.get(id)?;
+        let registered = crate::components::library_mesh(mesh).and_then(|m| {
+            self.world
+                .add_mesh(&format!("{id:?}"), &m)
+                .map_err(|e| e.to_string())
+        });
+        if let Err(e) = &registered {
+            warn!("the snow deformer's mesh {id:?} {e}");
+        }
+        let answer = registered.as_ref().ok().copied();
+        self.meshes.insert(id, registered);
+        answer
+    }
 }
 
 /// Create the snow world on Bevy's device, checked against snowprint's required features and
@@ -109,6 +134,7 @@ fn start(
                 previous: HashMap::new(),
                 pending: None,
                 keys: Vec::new(),
+                meshes: HashMap::new(),
             });
             shared.lock().status = SnowStatus::Running;
         }
@@ -147,7 +173,9 @@ fn extract(
         )>,
     >,
     deformers: Extract<Query<(Entity, &SnowDeformer, &GlobalTransform)>>,
+    meshes: Extract<Res<Assets<Mesh>>>,
     time: Extract<Res<Time>>,
+    snow: Option<ResMut<RenderSnow>>,
 ) {
     extracted.surfaces.clear();
     for (entity, surface, transform, buffers) in &surfaces {
@@ -158,10 +186,24 @@ fn extract(
         });
     }
     extracted.deformers.clear();
+    let mut snow = snow;
     for (entity, deformer, transform) in &deformers {
+        let shape = match (&deformer.shape, deformer.shape.analytic()) {
+            (_, Some(shape)) => shape,
+            (crate::DeformerShape::Mesh(handle), None) => {
+                let Some(snow) = snow.as_deref_mut() else {
+                    continue;
+                };
+                match snow.mesh(handle.id(), &meshes) {
+                    Some(id) => snowprint::Shape::Mesh(id),
+                    None => continue,
+                }
+            }
+            (_, None) => continue,
+        };
         extracted
             .deformers
-            .push((entity, deformer.shape.to_library(), pose_of(transform)));
+            .push((entity, shape, pose_of(transform)));
     }
     extracted.dt = time.delta_secs();
 }
@@ -251,8 +293,11 @@ fn deformers(
     let list = extracted
         .iter()
         .map(|&(entity, shape, pose)| match snow.previous.get(&entity) {
-            Some(&previous) => Deformer::moving(shape, previous, pose),
-            None => Deformer::new(shape, pose),
+            // Meshes are captured at their pose only (the library sweeps analytic shapes).
+            Some(&previous) if !matches!(shape, snowprint::Shape::Mesh(_)) => {
+                Deformer::moving(shape, previous, pose)
+            }
+            _ => Deformer::new(shape, pose),
         })
         .collect();
     snow.previous = extracted.iter().map(|&(e, _, pose)| (e, pose)).collect();
