@@ -433,7 +433,11 @@ fn input(
     options: Res<Options>,
     mut outcome: ResMut<Outcome>,
     mut walker: Single<&mut Walker>,
+    mut exit: MessageWriter<AppExit>,
 ) {
+    if keyboard.just_pressed(KeyCode::Escape) {
+        exit.write(AppExit::Success);
+    }
     walker.keys = match &options.script {
         Some(script) => script.keys_at(outcome.frame),
         None => Keys {
