@@ -25,7 +25,9 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_dis
 use bevy::time::TimeUpdateStrategy;
 use bevy::window::{PresentMode, WindowResolution};
 use bevy::winit::{UpdateMode, WinitSettings};
-use bevy_snowprint::{SnowDeformer, SnowProbes, SnowStatus, SnowSurface, SnowprintPlugin};
+use bevy_snowprint::{
+    SnowDeformer, SnowFootstep, SnowProbes, SnowStatus, SnowSurface, SnowprintPlugin,
+};
 
 /// Depth of the yard's snow, metres.
 const SNOW_DEPTH: f32 = 0.3;
@@ -85,7 +87,7 @@ fn main() -> ExitCode {
     .add_systems(Startup, setup)
     .add_systems(
         Update,
-        (input, walk, follow, ask_probes, script_end).chain(),
+        (input, walk, follow, ask_probes, hear_footsteps, script_end).chain(),
     );
     if let Some(script) = &options.script {
         app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f32(
@@ -309,6 +311,8 @@ struct Outcome {
     prints: Vec<[f32; 3]>,
     /// The person's place on the ground each frame it moved (x, z).
     path: Vec<[f32; 2]>,
+    /// The boots' landings heard (`SnowFootstep`): how deep below the fresh top each reached.
+    footsteps: Vec<f32>,
     shot_requested: bool,
 }
 
@@ -544,6 +548,13 @@ fn ask_probes(
     }
 }
 
+/// The boots' landings, for the report (a game would play a crunch here).
+fn hear_footsteps(mut heard: MessageReader<SnowFootstep>, mut outcome: ResMut<Outcome>) {
+    for step in heard.read() {
+        outcome.footsteps.push(step.depth_m);
+    }
+}
+
 /// In a scripted run: once the script is over and the person has stood still a few frames,
 /// write the report, take the screenshot, and leave once it is saved.
 fn script_end(
@@ -605,6 +616,7 @@ fn script_end(
         "walked_m": walker.moved,
         "prints": outcome.prints,
         "path": outcome.path,
+        "footsteps": outcome.footsteps,
         "planted": walker.planted.map(|p| p.to_array()),
         "probes": under,
         "snow_updates": probes.updates(),

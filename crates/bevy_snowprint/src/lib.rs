@@ -12,7 +12,8 @@
 //! - Every surface is drawn with [`SnowMaterial`], Bevy's `StandardMaterial` extended with
 //!   snowprint's relief tier (the library's WGSL material module), lit by Bevy's lights.
 //! - Gameplay asks what is under a point through [`SnowProbes`]; answers come a frame or two
-//!   later, without waiting for the GPU.
+//!   later, without waiting for the GPU. Deformers landing on the snow are [`SnowFootstep`]
+//!   messages.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -36,7 +37,7 @@ pub use snowprint;
 
 pub use components::{DeformerShape, SnowDeformer, SnowSurface};
 pub use material::{SnowExtension, SnowMaterial};
-pub use update::exchange::{SnowProbes, SnowStatus, SnowUnder};
+pub use update::exchange::{SnowFootstep, SnowProbes, SnowStatus, SnowUnder};
 
 use bevy::prelude::*;
 use update::exchange::SharedExchange;
@@ -55,7 +56,10 @@ impl Plugin for SnowprintPlugin {
         let shared = SharedExchange::default();
         app.insert_resource(SnowProbes {
             shared: shared.clone(),
-        });
+        })
+        .insert_resource(shared.clone())
+        .add_message::<SnowFootstep>()
+        .add_systems(PreUpdate, update::exchange::write_footsteps);
         material::build(app);
         update::build(app, shared, self.world.clone());
     }

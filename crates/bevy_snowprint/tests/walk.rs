@@ -276,6 +276,31 @@ fn a_scripted_walk_leaves_a_trail_in_the_bevy_window() {
         );
     }
 
+    // Footsteps: every print the boots left was heard landing once, below the fresh top (how far
+    // depends on where in the frame the falling boot crossed it) and no deeper than the snow.
+    let prints = r["prints"].as_array().unwrap().len();
+    let footsteps: Vec<f64> = r["footsteps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d.as_f64().unwrap())
+        .collect();
+    eprintln!(
+        "{} footsteps heard for {prints} prints, depths {footsteps:.3?}",
+        footsteps.len()
+    );
+    assert!(
+        footsteps.len() + 1 >= prints && footsteps.len() <= prints + 2,
+        "{} footsteps heard for {prints} prints",
+        footsteps.len()
+    );
+    assert!(
+        footsteps
+            .iter()
+            .all(|&d| d > 0.0 && d <= f64::from(shot.top) + 1e-4),
+        "a footstep above the snow or deeper than it: {footsteps:?}"
+    );
+
     // Samples every 5 cm of the path, from 0.3 m after the start to 0.9 m before the person.
     let (mut trail, mut control) = (Vec::new(), Vec::new());
     let mut marked = shot.image.clone();

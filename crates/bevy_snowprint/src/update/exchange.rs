@@ -49,8 +49,25 @@ impl SnowUnder {
     }
 }
 
+/// A deformer landed on the snow during an update: its lowest point crossed the fresh snow's
+/// top going down (snowprint's `Footstep`). Written as a Bevy message a frame or two after the
+/// update, for sounds and effects.
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct SnowFootstep {
+    /// The entity of the [`crate::SnowDeformer`] that landed.
+    pub deformer: Entity,
+    /// Its lowest point at the end of the update, world metres.
+    pub point: Vec3,
+    /// How far below the fresh snow's top that point reaches, metres (at most the snow depth).
+    pub depth_m: f32,
+    /// Speed of the lowest point over the update, metres per second.
+    pub speed: f32,
+}
+
 #[derive(Default)]
 pub(crate) struct Exchange {
+    /// Footsteps of the updates since the main world last looked.
+    pub footsteps: Vec<SnowFootstep>,
     /// Keyed points asked since the render world last looked.
     pub asked: Vec<(u64, Vec3)>,
     /// The newest answer of every key.
@@ -104,4 +121,10 @@ impl SnowProbes {
     pub fn updates(&self) -> u64 {
         self.shared.lock().updates
     }
+}
+
+/// Hand the footsteps the render world heard to the main world as messages.
+pub(crate) fn write_footsteps(shared: Res<SharedExchange>, mut out: MessageWriter<SnowFootstep>) {
+    let heard = std::mem::take(&mut shared.lock().footsteps);
+    out.write_batch(heard);
 }

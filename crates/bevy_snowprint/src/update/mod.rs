@@ -241,6 +241,22 @@ fn record(
             return;
         }
     }
+    // A footstep names its deformer by its index in the update's list: this frame's entities.
+    let heard: Vec<_> = snow
+        .world
+        .footsteps()
+        .iter()
+        .filter_map(|f| {
+            let &(entity, _, _) = extracted.deformers.get(f.deformer)?;
+            Some(exchange::SnowFootstep {
+                deformer: entity,
+                point: Vec3::from_array(f.point.to_array()),
+                depth_m: f.depth_m,
+                speed: f.speed,
+            })
+        })
+        .collect();
+    shared.lock().footsteps.extend(heard);
     copy::surfaces_to_materials(
         &snow.world,
         &snow.surfaces,
