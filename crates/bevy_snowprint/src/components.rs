@@ -82,7 +82,9 @@ pub enum DeformerShape {
     /// A closed triangle mesh of Bevy's (a triangle list, wound counter-clockwise seen from
     /// outside, as Bevy's primitives are), registered with the snow world the first frame it is
     /// seen. It must keep its data in the main world (`RenderAssetUsages::MAIN_WORLD`, the
-    /// default).
+    /// default). On an entity with Bevy's `SkinnedMesh` it is skinned as Bevy skins it (each
+    /// joint's `GlobalTransform` times its inverse bind pose, the entity's own transform unused)
+    /// by snowprint's skinning pass each frame, before the update.
     Mesh(Handle<Mesh>),
 }
 
@@ -215,4 +217,54 @@ mod tests {
             UVec2::new(200, 150)
         );
     }
+}
+
+/// A Bevy skinned mesh (joint indices and weights, one inverse bind pose a joint) as the
+/// library's skinned mesh: one flat node a joint, its matrices given each frame by the caller
+/// (`joint global * inverse bind`, Bevy's own skinning), so no animation of the library's.
+pub(crate) fn library_skinned_mesh(
+    mesh: &Mesh,
+    inverse_bindposes: &[Mat4],
+) -> Result<snowprint::SkinnedMesh, String> {
+    use bevy::mesh::VertexAttributeValues;
+    use snowprint::skeleton::{Influence, Joint, Node, Trs};
+    let triangles = library_mesh(mesh)?;
+    let Some(VertexAttributeValues::Uint16x4(joints)) = mesh.attribute(Mesh::ATTRIBUTE_JOINT_INDEX)
+    else {
+        return Err("has no Uint16x4 joint indices".into());
+    };
+    let Some(VertexAttributeValues::Float32x4(weights)) =
+        mesh.attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT)
+    else {
+        return Err("has no Float32x4 joint weights".into());
+    };
+    let influences = joints
+        .iter()
+        .zip(weights)
+        .map(|(j, w)| Influence {
+            joints: j.map(u32::from),
+            weights: *w,
+        })
+        .collect();
+    Ok(snowprint::SkinnedMesh {
+        mesh: triangles,
+        influences,
+        joints: inverse_bindposes
+            .iter()
+            .enumerate()
+            .map(|(node, m)| Joint {
+                node,
+                inverse_bind: sg::Mat4::from_cols_array(&m.to_cols_array()),
+            })
+            .collect(),
+        nodes: (0..inverse_bindposes.len())
+            .map(|_| Node {
+                name: None,
+                parent: None,
+                rest: Trs::IDENTITY,
+                matrix: None,
+            })
+            .collect(),
+        animations: Vec::new(),
+    })
 }

@@ -1,8 +1,8 @@
 //! # bevy_snowprint
 //!
 //! snowprint's deformable snow in a Bevy 0.20 game: put [`SnowSurface`] on the ground entities
-//! and [`SnowDeformer`] (a sphere, capsule, box or closed Bevy mesh) on what walks, rolls or
-//! falls through it, and add [`SnowprintPlugin`]. Skinned meshes are not deformers yet.
+//! and [`SnowDeformer`] (a sphere, capsule, box, or a closed Bevy mesh, skinned or not) on what
+//! walks, rolls or falls through it, and add [`SnowprintPlugin`].
 //!
 //! - The snow world lives in Bevy's render world, on Bevy's own `RenderDevice` and `RenderQueue`
 //!   (checked against snowprint's required limits; what falls short is [`SnowStatus::Unavailable`]

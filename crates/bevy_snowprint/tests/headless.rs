@@ -272,6 +272,111 @@ fn a_mesh_deformer_presses_as_the_same_box_does() {
     );
 }
 
+/// A skinned Bevy mesh as a deformer: a 0.4 m cube whose every vertex follows one joint, the
+/// skinned entity at the origin and the joint moved to where the cube presses 10 cm into the snow
+/// (Bevy skins by the joints' transforms, not the entity's). The probe under the joint reads the
+/// same depression as under the same box as an analytic shape; under the skinned entity's own
+/// place, none.
+#[test]
+fn a_skinned_mesh_deformer_follows_its_joints() {
+    use bevy::mesh::VertexAttributeValues;
+    use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
+    let mut app = headless_app(bevy::render::RenderPlugin::default(), false);
+    let top = 0.3;
+    let half = 0.2;
+    let centre_y = top - 0.1 + half;
+    let (at_joint, at_box) = (
+        Vec3::new(-1.0, centre_y, 0.5),
+        Vec3::new(1.0, centre_y, 0.5),
+    );
+    let answers = Arc::new(Mutex::new(Vec::new()));
+    let seen = answers.clone();
+    app.add_systems(
+        Startup,
+        move |mut commands: Commands,
+              mut meshes: ResMut<Assets<Mesh>>,
+              mut bindposes: ResMut<Assets<SkinnedMeshInverseBindposes>>| {
+            commands.spawn((
+                SnowSurface::new(Vec2::new(6.0, 4.0), top),
+                Transform::default(),
+            ));
+            let mut cube = Cuboid::from_length(2.0 * half).mesh().build();
+            let n = cube.count_vertices();
+            cube.insert_attribute(
+                Mesh::ATTRIBUTE_JOINT_INDEX,
+                VertexAttributeValues::Uint16x4(vec![[0, 0, 0, 0]; n]),
+            );
+            cube.insert_attribute(
+                Mesh::ATTRIBUTE_JOINT_WEIGHT,
+                vec![[1.0_f32, 0.0, 0.0, 0.0]; n],
+            );
+            let joint = commands.spawn(Transform::from_translation(at_joint)).id();
+            commands.spawn((
+                SnowDeformer::mesh(meshes.add(cube)),
+                SkinnedMesh {
+                    inverse_bindposes: bindposes.add(vec![Mat4::IDENTITY]),
+                    joints: vec![joint],
+                },
+                Transform::from_xyz(0.0, centre_y, -1.0),
+            ));
+            commands.spawn((
+                SnowDeformer::cuboid(Vec3::splat(half)),
+                Transform::from_translation(at_box),
+            ));
+        },
+    );
+    let mut frames = 0;
+    app.add_systems(
+        Update,
+        move |mut probes: ResMut<bevy_snowprint::SnowProbes>, mut exit: MessageWriter<AppExit>| {
+            frames += 1;
+            probes.ask(1, Vec3::new(at_joint.x, 0.0, at_joint.z));
+            probes.ask(2, Vec3::new(at_box.x, 0.0, at_box.z));
+            probes.ask(3, Vec3::new(0.0, 0.0, -1.0));
+            if let (true, Some(j), Some(b), Some(e)) = (
+                frames > 20,
+                probes.under(1),
+                probes.under(2),
+                probes.under(3),
+            ) {
+                *seen.lock().unwrap() = vec![j, b, e];
+                exit.write(AppExit::Success);
+            }
+            if frames > 400 {
+                exit.write(AppExit::error());
+            }
+        },
+    );
+    app.run();
+    let answers = answers.lock().unwrap().clone();
+    assert_eq!(
+        answers.len(),
+        3,
+        "the probes did not answer within 400 frames"
+    );
+    let (joint, cuboid, entity) = (answers[0], answers[1], answers[2]);
+    eprintln!(
+        "under the skinned cube's joint {:.4} m pressed, under the analytic box {:.4} m, under the skinned entity's own place {:.4} m",
+        joint.depression_m, cuboid.depression_m, entity.depression_m
+    );
+    assert!(
+        (joint.depression_m - 0.1).abs() < 0.01,
+        "{} m pressed under the joint, where the cube's bottom is 0.1 m below the top",
+        joint.depression_m
+    );
+    assert!(
+        (joint.depression_m - cuboid.depression_m).abs() < 0.002,
+        "the skinned cube pressed {} m, the same box as a shape {} m",
+        joint.depression_m,
+        cuboid.depression_m
+    );
+    assert!(
+        entity.depression_m.abs() < 1e-3,
+        "{} m pressed under the skinned entity's own transform",
+        entity.depression_m
+    );
+}
+
 fn bevy_render() -> image::RgbImage {
     let shot = Arc::new(Mutex::new(None));
     let mut app = headless_app(

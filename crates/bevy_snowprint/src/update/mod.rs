@@ -16,6 +16,7 @@ pub(crate) mod exchange;
 
 use std::collections::HashMap;
 
+use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::renderer::{
@@ -72,6 +73,8 @@ struct ExtractedSurface {
 struct ExtractedSnow {
     surfaces: Vec<ExtractedSurface>,
     deformers: Vec<(Entity, snowprint::Shape, Pose)>,
+    /// Skinned mesh deformers' joint matrices this frame (`joint global * inverse bind`).
+    skins: Vec<(snowprint::MeshId, Vec<snowprint::glam::Mat4>)>,
     dt: f32,
 }
 
@@ -87,9 +90,38 @@ pub(crate) struct RenderSnow {
     keys: Vec<u64>,
     /// Bevy meshes registered as deformers, or why they could not be (said once).
     meshes: HashMap<AssetId<Mesh>, Result<snowprint::MeshId, String>>,
+    /// Skinned mesh deformers, one registration an entity (each is skinned into its own
+    /// vertices).
+    skinned: HashMap<Entity, Result<snowprint::MeshId, String>>,
 }
 
 impl RenderSnow {
+    /// The library's skinned mesh of a skinned deformer entity, registered the first time.
+    fn skinned_mesh(
+        &mut self,
+        entity: Entity,
+        id: AssetId<Mesh>,
+        meshes: &Assets<Mesh>,
+        inverse_bindposes: &[Mat4],
+    ) -> Option<snowprint::MeshId> {
+        if let Some(known) = self.skinned.get(&entity) {
+            return known.as_ref().ok().copied();
+        }
+        let mesh = meshes.get(id)?;
+        let registered =
+            crate::components::library_skinned_mesh(mesh, inverse_bindposes).and_then(|m| {
+                self.world
+                    .add_skinned_mesh(&format!("{entity}"), &m)
+                    .map_err(|e| e.to_string())
+            });
+        if let Err(e) = &registered {
+            warn!("the skinned snow deformer {entity} {e}");
+        }
+        let answer = registered.as_ref().ok().copied();
+        self.skinned.insert(entity, registered);
+        answer
+    }
+
     /// The library's mesh of a Bevy mesh, registered the first time it is asked for; `None` (and
     /// one warning) for a mesh that is not a closed triangle list, `None` without a word while
     /// the asset is still loading.
@@ -135,6 +167,7 @@ fn start(
                 pending: None,
                 keys: Vec::new(),
                 meshes: HashMap::new(),
+                skinned: HashMap::new(),
             });
             shared.lock().status = SnowStatus::Running;
         }
@@ -172,7 +205,16 @@ fn extract(
             Option<&SnowSurfaceBuffers>,
         )>,
     >,
-    deformers: Extract<Query<(Entity, &SnowDeformer, &GlobalTransform)>>,
+    deformers: Extract<
+        Query<(
+            Entity,
+            &SnowDeformer,
+            &GlobalTransform,
+            Option<&SkinnedMesh>,
+        )>,
+    >,
+    joints: Extract<Query<&GlobalTransform>>,
+    bindposes: Extract<Res<Assets<SkinnedMeshInverseBindposes>>>,
     meshes: Extract<Res<Assets<Mesh>>>,
     time: Extract<Res<Time>>,
     snow: Option<ResMut<RenderSnow>>,
@@ -186,8 +228,40 @@ fn extract(
         });
     }
     extracted.deformers.clear();
+    extracted.skins.clear();
     let mut snow = snow;
-    for (entity, deformer, transform) in &deformers {
+    for (entity, deformer, transform, skinned) in &deformers {
+        if let (crate::DeformerShape::Mesh(handle), Some(skinned)) = (&deformer.shape, skinned) {
+            let Some(snow) = snow.as_deref_mut() else {
+                continue;
+            };
+            let Some(inverse) = bindposes.get(&skinned.inverse_bindposes) else {
+                continue;
+            };
+            let matrices: Option<Vec<snowprint::glam::Mat4>> = skinned
+                .joints
+                .iter()
+                .zip(inverse.iter())
+                .map(|(&joint, inverse)| {
+                    let global = joints.get(joint).ok()?.to_matrix() * *inverse;
+                    Some(snowprint::glam::Mat4::from_cols_array(
+                        &global.to_cols_array(),
+                    ))
+                })
+                .collect();
+            let (Some(matrices), Some(id)) = (
+                matrices,
+                snow.skinned_mesh(entity, handle.id(), &meshes, inverse),
+            ) else {
+                continue;
+            };
+            extracted.skins.push((id, matrices));
+            // The joints' matrices carry the mesh into the world: the deformer stands at the origin.
+            extracted
+                .deformers
+                .push((entity, snowprint::Shape::Mesh(id), Pose::at([0.0; 3])));
+            continue;
+        }
         let shape = match (&deformer.shape, deformer.shape.analytic()) {
             (_, Some(shape)) => shape,
             (crate::DeformerShape::Mesh(handle), None) => {
@@ -234,6 +308,17 @@ fn record(
         }
     }
     let encoder = ctx.command_encoder();
+    if !extracted.skins.is_empty() {
+        let poses: Vec<(snowprint::MeshId, &[snowprint::glam::Mat4])> = extracted
+            .skins
+            .iter()
+            .map(|(id, m)| (*id, m.as_slice()))
+            .collect();
+        // Skinned before the update that captures them, in the same encoder.
+        if let Err(e) = snow.world.encode_skin_meshes(encoder, &poses) {
+            error!("the snow's skinned deformers were not skinned: {e}");
+        }
+    }
     match snow.world.encode_step(encoder, extracted.dt, &deformers) {
         Ok(pending) => snow.pending = Some(pending),
         Err(e) => {
