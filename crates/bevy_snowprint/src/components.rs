@@ -185,40 +185,6 @@ pub(crate) fn pose_of(transform: &GlobalTransform) -> snowprint::Pose {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A surface turned a quarter turn counter-clockwise seen from above has a yaw of +90
-    /// degrees, the library's convention (`Quat::from_rotation_y`).
-    #[test]
-    fn yaw_follows_the_rotation_about_y() {
-        let surface = SnowSurface::new(Vec2::new(4.0, 2.0), 0.3);
-        for degrees in [0.0_f32, 30.0, 90.0, -120.0] {
-            let t = GlobalTransform::from(
-                Transform::from_xyz(1.0, 2.0, 3.0)
-                    .with_rotation(Quat::from_rotation_y(degrees.to_radians())),
-            );
-            let desc = surface.desc("s", &t);
-            assert!(
-                (desc.yaw_degrees - degrees).abs() < 1e-3,
-                "{degrees}: {}",
-                desc.yaw_degrees
-            );
-            assert_eq!(desc.center.to_array(), [1.0, 2.0, 3.0]);
-        }
-    }
-
-    /// The resolution is the library's: 4 cm texels on an 8 m x 6 m surface.
-    #[test]
-    fn resolution_is_the_librarys() {
-        assert_eq!(
-            SnowSurface::new(Vec2::new(8.0, 6.0), 0.3).resolution(),
-            UVec2::new(200, 150)
-        );
-    }
-}
-
 /// A Bevy skinned mesh (joint indices and weights, one inverse bind pose a joint) as the
 /// library's skinned mesh: one flat node a joint, its matrices given each frame by the caller
 /// (`joint global * inverse bind`, Bevy's own skinning), so no animation of the library's.
@@ -267,4 +233,38 @@ pub(crate) fn library_skinned_mesh(
             .collect(),
         animations: Vec::new(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A surface turned a quarter turn counter-clockwise seen from above has a yaw of +90
+    /// degrees, the library's convention (`Quat::from_rotation_y`).
+    #[test]
+    fn yaw_follows_the_rotation_about_y() {
+        let surface = SnowSurface::new(Vec2::new(4.0, 2.0), 0.3);
+        for degrees in [0.0_f32, 30.0, 90.0, -120.0] {
+            let t = GlobalTransform::from(
+                Transform::from_xyz(1.0, 2.0, 3.0)
+                    .with_rotation(Quat::from_rotation_y(degrees.to_radians())),
+            );
+            let desc = surface.desc("s", &t);
+            assert!(
+                (desc.yaw_degrees - degrees).abs() < 1e-3,
+                "{degrees}: {}",
+                desc.yaw_degrees
+            );
+            assert_eq!(desc.center.to_array(), [1.0, 2.0, 3.0]);
+        }
+    }
+
+    /// The resolution is the library's: 4 cm texels on an 8 m x 6 m surface.
+    #[test]
+    fn resolution_is_the_librarys() {
+        assert_eq!(
+            SnowSurface::new(Vec2::new(8.0, 6.0), 0.3).resolution(),
+            UVec2::new(200, 150)
+        );
+    }
 }

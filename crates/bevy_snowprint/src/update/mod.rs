@@ -3,7 +3,7 @@
 //! surface's heights copied where its material reads them.
 //!
 //! Per frame:
-//! 1. `ExtractSchedule`: [`extract`] copies the surfaces and deformers (their `GlobalTransform`s)
+//! 1. `ExtractSchedule`: [`extract_surfaces`] and [`extract_deformers`] copy the surfaces and deformers (their `GlobalTransform`s)
 //!    and the frame's time step out of the main world.
 //! 2. `RenderGraph`, before Bevy's `camera_driver`: [`record`] adds and removes surfaces, sends
 //!    the probes asked, records `SnowWorld::encode_step` into the render context's encoder, then
@@ -45,7 +45,7 @@ pub(crate) fn build(app: &mut App, shared: SharedExchange, config: WorldConfig) 
         .insert_resource(SnowSettings(config))
         .init_resource::<ExtractedSnow>()
         .add_systems(RenderStartup, start)
-        .add_systems(ExtractSchedule, extract)
+        .add_systems(ExtractSchedule, (extract_surfaces, extract_deformers))
         .add_systems(
             RenderGraph,
             (
@@ -195,7 +195,7 @@ pub(crate) fn unavailable(e: &snowprint::SnowError) -> String {
 
 // Bevy's extract queries are tuples of what they read; naming them adds nothing.
 #[allow(clippy::type_complexity)]
-fn extract(
+fn extract_surfaces(
     mut extracted: ResMut<ExtractedSnow>,
     surfaces: Extract<
         Query<(
@@ -205,6 +205,24 @@ fn extract(
             Option<&SnowSurfaceBuffers>,
         )>,
     >,
+    time: Extract<Res<Time>>,
+) {
+    extracted.surfaces.clear();
+    for (entity, surface, transform, buffers) in &surfaces {
+        extracted.surfaces.push(ExtractedSurface {
+            entity,
+            desc: surface.desc(&format!("{entity}"), transform),
+            buffers: buffers.cloned(),
+        });
+    }
+    extracted.dt = time.delta_secs();
+}
+
+/// The deformers' shapes and poses; meshes registered with the snow world the first time, and
+/// skinned meshes' joint matrices.
+#[allow(clippy::type_complexity)]
+fn extract_deformers(
+    mut extracted: ResMut<ExtractedSnow>,
     deformers: Extract<
         Query<(
             Entity,
@@ -216,17 +234,8 @@ fn extract(
     joints: Extract<Query<&GlobalTransform>>,
     bindposes: Extract<Res<Assets<SkinnedMeshInverseBindposes>>>,
     meshes: Extract<Res<Assets<Mesh>>>,
-    time: Extract<Res<Time>>,
     snow: Option<ResMut<RenderSnow>>,
 ) {
-    extracted.surfaces.clear();
-    for (entity, surface, transform, buffers) in &surfaces {
-        extracted.surfaces.push(ExtractedSurface {
-            entity,
-            desc: surface.desc(&format!("{entity}"), transform),
-            buffers: buffers.cloned(),
-        });
-    }
     extracted.deformers.clear();
     extracted.skins.clear();
     let mut snow = snow;
@@ -279,7 +288,6 @@ fn extract(
             .deformers
             .push((entity, shape, pose_of(transform)));
     }
-    extracted.dt = time.delta_secs();
 }
 
 /// Record the snow's update into the render graph's encoder, ahead of the cameras.
