@@ -96,6 +96,23 @@ pub(crate) struct RenderSnow {
 }
 
 impl RenderSnow {
+    /// Remove the skinned meshes of deformers not seen this frame.
+    fn forget_skinned_except(&mut self, seen: &[Entity]) {
+        let gone: Vec<Entity> = self
+            .skinned
+            .keys()
+            .filter(|e| !seen.contains(e))
+            .copied()
+            .collect();
+        for entity in gone {
+            if let Some(Ok(id)) = self.skinned.remove(&entity)
+                && let Err(e) = self.world.remove_mesh(id)
+            {
+                warn!("the skinned snow deformer {entity} could not be removed: {e}");
+            }
+        }
+    }
+
     /// The library's skinned mesh of a skinned deformer entity, registered the first time.
     fn skinned_mesh(
         &mut self,
@@ -239,8 +256,10 @@ fn extract_deformers(
     extracted.deformers.clear();
     extracted.skins.clear();
     let mut snow = snow;
+    let mut skinned_seen = Vec::new();
     for (entity, deformer, transform, skinned) in &deformers {
         if let (crate::DeformerShape::Mesh(handle), Some(skinned)) = (&deformer.shape, skinned) {
+            skinned_seen.push(entity);
             let Some(snow) = snow.as_deref_mut() else {
                 continue;
             };
@@ -287,6 +306,10 @@ fn extract_deformers(
         extracted
             .deformers
             .push((entity, shape, pose_of(transform)));
+    }
+    // Skinned deformers gone (their entity or component): their meshes leave the snow world.
+    if let Some(snow) = snow.as_deref_mut() {
+        snow.forget_skinned_except(&skinned_seen);
     }
 }
 
