@@ -3,10 +3,12 @@
 //! surface's heights copied where its material reads them.
 //!
 //! Per frame:
-//! 1. `ExtractSchedule`: [`extract_surfaces`] and [`extract_deformers`] copy the surfaces and deformers (their `GlobalTransform`s)
-//!    and the frame's time step out of the main world.
+//! 1. `ExtractSchedule`: [`extract_surfaces`] and [`extract_deformers`] copy the surfaces, the
+//!    deformers (their `GlobalTransform`s, skinned meshes' joint matrices) and the frame's time
+//!    step out of the main world, registering meshes with the snow world the first time.
 //! 2. `RenderGraph`, before Bevy's `camera_driver`: [`record`] adds and removes surfaces, sends
-//!    the probes asked, records `SnowWorld::encode_step` into the render context's encoder, then
+//!    the probes asked, records the skinning of skinned deformers and `SnowWorld::encode_step`
+//!    into the render context's encoder, hands the update's footsteps to the main world, then
 //!    (`copy.rs`) each surface's `SurfaceUniform` and heights into its material's buffers.
 //! 3. `RenderGraph`, after Bevy submitted: [`finish`] tells the world the frame was submitted and
 //!    hands the probes' newest answers to the main world.
