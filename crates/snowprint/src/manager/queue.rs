@@ -219,18 +219,21 @@ pub fn push(
     isolation: &Isolation<'_>,
 ) -> Push {
     let scan_from = queue.len().saturating_sub(SCAN);
-    // Whether `d` may leave this tick (be dropped as held by an entry of another frame).
-    let alone = isolation.pushed_alone();
-    let may_drop = |q: &Imprint| q.frame == frame || alone;
+    // Whether `d` may leave this tick (be dropped as held by an entry of another frame): asked
+    // only of a push that could be dropped, and at most once (it compares `d` with the tick's
+    // every deformer).
+    let alone_once = std::cell::OnceCell::new();
+    let alone = || *alone_once.get_or_init(|| isolation.pushed_alone());
+    let may_drop = |q: &Imprint| q.frame == frame || alone();
     // The common case first, by exact comparison: a deformer resting where a queued sweep of the
     // same shape ends or starts (a planted foot), or the same entry again.
     let resting = start(&d) == d.pose;
     if queue
         .range(scan_from..)
         .rev()
-        .any(|q| may_drop(q) && covers_exactly(&q.deformer, &d, resting))
+        .any(|q| covers_exactly(&q.deformer, &d, resting) && may_drop(q))
         || (skip_applied
-            && alone
+            && alone()
             && applied
                 .iter()
                 .rev()
@@ -245,7 +248,7 @@ pub fn push(
         if q.deformer.shape != d.shape {
             continue;
         }
-        if may_drop(q) && contains(&q.deformer, &d) {
+        if contains(&q.deformer, &d) && may_drop(q) {
             return Push::Redundant;
         }
         if contains(&d, &q.deformer) && (q.frame == frame || isolation.queued_alone(queue, i)) {
@@ -255,7 +258,7 @@ pub fn push(
             return Push::Absorbed;
         }
     }
-    if skip_applied && alone && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) {
+    if skip_applied && applied.iter().rev().take(SCAN).any(|q| contains(q, &d)) && alone() {
         return Push::Redundant;
     }
     queue.push_back(Imprint { frame, deformer: d });
