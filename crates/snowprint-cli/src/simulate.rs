@@ -57,13 +57,6 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             camera.line
         );
     }
-    if managed && let Some(g) = scene.grounds.iter().flatten().next() {
-        return Err(format!(
-            "{}:{}: a surface on ground that is not flat runs only without the surface manager for now; remove [budget], --report, --save and --load, or the ground key",
-            scene.path.display(),
-            g.line
-        ));
-    }
     let outputs = Outputs::prepare(&scene, &args.dump, args.report.as_deref())?;
     if let Some(save) = &args.save {
         crate::output::check_file_target(save, "--save")?;
