@@ -110,7 +110,11 @@ fn walker(f: u32) -> Vec<ManagedDeformer> {
         let y = ground_height(k, x, z) + DEPTH - SINK + RADIUS;
         Pose::at([k as f32 * 5.0 + x, y, z])
     };
-    let prev = if f.is_multiple_of(20) { at(f) } else { at(f - 1) };
+    let prev = if f.is_multiple_of(20) {
+        at(f)
+    } else {
+        at(f - 1)
+    };
     vec![ManagedDeformer::player(Deformer::moving(
         Shape::Sphere { radius: RADIUS },
         prev,
