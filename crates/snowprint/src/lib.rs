@@ -88,8 +88,8 @@ pub use spray::{
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
 pub use world::{
-    CaptureConfig, CaptureMode, FrameStats, MemoryReport, MeshAnimation, PassMode, PendingFrame,
-    SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
+    CaptureConfig, CaptureMode, CapturePath, FrameStats, MemoryReport, MeshAnimation, PassMode,
+    PendingFrame, SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
 
 /// What a [`SkinnedMesh`] holds besides its triangles: joints and influences, the node hierarchy,
