@@ -287,31 +287,13 @@ fn saves_keep_the_ground_and_refuse_a_wrong_one() {
     let mut short = sections.clone();
     let g = short.iter_mut().find(|s| &s.0 == b"GRND").unwrap();
     g.1[4..8].copy_from_slice(&74u32.to_le_bytes());
-    let err = SaveFile::parse(&assemble(2, &short)).unwrap_err();
+    let err = SaveFile::parse(&common::assemble_save(2, &short)).unwrap_err();
     assert!(
         err.contains("GRND") && err.contains("74 x 75") && !err.contains('\n'),
         "{err}"
     );
-    let err = SaveFile::parse(&assemble(1, &sections)).unwrap_err();
+    let err = SaveFile::parse(&common::assemble_save(1, &sections)).unwrap_err();
     assert!(err.contains("GRND") && err.contains("version 2"), "{err}");
-}
-
-/// Bytes of a save with these sections, every length and checksum right (stored raw).
-fn assemble(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
-    let mut out = b"SNOWSAVE".to_vec();
-    out.extend_from_slice(&version.to_le_bytes());
-    out.extend_from_slice(&(sections.len() as u32).to_le_bytes());
-    let crc = crc32fast::hash(&out);
-    out.extend_from_slice(&crc.to_le_bytes());
-    for (tag, data) in sections {
-        out.extend_from_slice(tag);
-        out.extend_from_slice(&0u32.to_le_bytes());
-        out.extend_from_slice(&(data.len() as u64).to_le_bytes());
-        out.extend_from_slice(&(data.len() as u64).to_le_bytes());
-        out.extend_from_slice(&crc32fast::hash(data).to_le_bytes());
-        out.extend_from_slice(data);
-    }
-    out
 }
 
 #[test]
