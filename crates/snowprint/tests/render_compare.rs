@@ -93,7 +93,7 @@ fn heightfield_pass_matches_its_cpu_reference() {
         snow_depth: depth,
         texel_x: texel.x,
         texel_z: texel.y,
-        _pad2: 0.0,
+        ground: snowprint::low_level::ground::NO_GROUND,
         light: [light.x, light.y, light.z, 0.0],
     };
     let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -118,6 +118,11 @@ fn heightfield_pass_matches_its_cpu_reference() {
         })
     };
     let (shape, lit) = (texture(), texture());
+    let ground = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("ground"),
+        contents: &[0u8; 16],
+        usage: wgpu::BufferUsages::STORAGE,
+    });
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("heightfield.wgsl"),
         source: wgpu::ShaderSource::Wgsl(snowprint::wgsl::HEIGHTFIELD.source.into()),
@@ -151,6 +156,11 @@ fn heightfield_pass_matches_its_cpu_reference() {
             wgpu::BindGroupEntry {
                 binding: 3,
                 resource: wgpu::BindingResource::TextureView(&lit.create_view(&Default::default())),
+            },
+            // No ground field (flat ground): never read.
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: ground.as_entire_binding(),
             },
         ],
     });
@@ -272,8 +282,12 @@ struct Case {
 
 var<private> field: u32;
 const DEPTH: f32 = 0.3;
+const GROUND_SLOPE: f32 = 0.5;
 
 fn analytic_height(xz: vec2<f32>) -> f32 {
+    if field == 2u {
+        return DEPTH;
+    }
     if field == 0u {
         return 0.15 + 0.04 * xz.x;
     }
@@ -295,6 +309,14 @@ fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
 fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
     return 1.0;
 }
+// Field 2: untouched snow on ground that is a plane rising along x (GROUND_SLOPE metres a metre).
+fn snow_ground_base(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    if field != 2u {
+        return 0.0;
+    }
+    let xz = uv * 2.0 * s.half_size - s.half_size;
+    return GROUND_SLOPE * xz.x;
+}
 
 @compute @workgroup_size(64)
 fn search(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -308,6 +330,15 @@ fn search(@builtin(global_invocation_id) id: vec3<u32>) {
     s.snow_depth = DEPTH;
     s.texel = 0.04;
     s.search = vec4<f32>(0.5, 4.0, 12.0, 5.0);
+    // Flat ground, but for field 2: its plane spans -1 to 1 m over the 4 m of x.
+    s.terrain = 0xffffffffu;
+    s.terrain_low = 0.0;
+    s.terrain_top = DEPTH;
+    if field == 2u {
+        s.terrain = 0u;
+        s.terrain_low = -2.0 * GROUND_SLOPE;
+        s.terrain_top = 2.0 * GROUND_SLOPE + DEPTH;
+    }
     let o = c.origin.xyz;
     let d = c.dir.xyz;
     let exit = snow_slab_exit(s, o, d);
@@ -327,6 +358,49 @@ fn blend(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
+/// A ray through untouched snow 0.3 m deep on ground that is the plane `y = 0.5 x` (27 degrees):
+/// the snow top is `0.5 x + 0.3`, so the ray `o + t d` meets it (within the inside test's slack
+/// `SNOW_EPSILON`) at `t = (0.5 o.x + 0.3 + 1e-4 - o.y) / (d.y - 0.5 d.x)`, computed by hand. The
+/// slab's floor is the plane's lowest point (-1 m), its top the highest snow top (1.3 m). Relief
+/// mapping lands within its last bracket of it, POM (a secant on a plane is exact) within 1e-4.
+fn on_a_sloped_ground(i: usize, ray: &cpu::SlabRay, g: &[f32], half: Vec2, depth: f32) {
+    let (o, d) = (ray.origin, ray.dir);
+    let t = (0.5 * o.x + depth + 1e-4 - o.y) / (d.y - 0.5 * d.x);
+    let p = o + d * t;
+    let inside = p.x.abs() <= half.x && p.z.abs() <= half.y;
+    // The slab's exit: the floor at -1 m or a side.
+    let floor = (o.y + 1.0) / -d.y;
+    let side = |o: f32, d: f32, h: f32| {
+        if d == 0.0 {
+            f32::MAX
+        } else {
+            (h * d.signum() - o) / d
+        }
+    };
+    let t_max = floor
+        .min(side(o.x, d.x, half.x))
+        .min(side(o.z, d.z, half.y));
+    assert!(
+        (g[4] - t_max).abs() < 1e-4,
+        "case {i}: exit {} vs {t_max}",
+        g[4]
+    );
+    if !inside {
+        return;
+    }
+    let bracket = t_max / g[6] / 32.0 + 1e-4;
+    assert!(
+        g[1] == 1.0 && (g[0] - t).abs() <= bracket,
+        "case {i}: relief on the slope {} vs {t} by hand",
+        g[0]
+    );
+    assert!(
+        g[3] == 1.0 && (g[2] - t).abs() <= 1e-4,
+        "case {i}: POM on the slope {} vs {t} by hand",
+        g[2]
+    );
+}
+
 #[test]
 fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
     let gpu = common::gpu();
@@ -335,13 +409,16 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
     let depth = 0.3f32;
     // Rays entering the top over the plane and over the dent, in many directions.
     let mut cases: Vec<[f32; 8]> = Vec::new();
-    for field in 0..2 {
+    for field in 0..3 {
         for i in 0..48 {
             let a = std::f32::consts::TAU * i as f32 / 48.0;
             let down = 0.25 + 1.5 * ((i * 7) % 11) as f32 / 11.0;
             let dir = Vec3::new(a.cos(), -down, a.sin()).normalize();
             let origin = if field == 0 {
                 Vec3::new(-1.0 + 0.03 * i as f32, depth, 0.2)
+            } else if field == 2 {
+                // On the top face of the sloped slab (y = 1.3).
+                Vec3::new(-1.0 + 0.03 * i as f32, 1.0 + depth, 0.2)
             } else {
                 Vec3::new(0.25 + 0.002 * i as f32, depth, -0.15)
             };
@@ -478,6 +555,11 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
             origin: Vec3::new(c[0], c[1], c[2]),
             dir: Vec3::new(c[4], c[5], c[6]),
         };
+        let g = &results[8 * i..8 * i + 8];
+        if c[3] == 2.0 {
+            on_a_sloped_ground(i, &ray, g, half, depth);
+            continue;
+        }
         let plane = c[3] == 0.0;
         let height = |p: Vec2| {
             if plane {
@@ -493,7 +575,6 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
         };
         let (t_max, ground) = cpu::slab_exit(&ray, half, depth);
         let taps = cpu::linear_taps(ray.dir, t_max, 0.04, 0.5, 4.0, 12.0);
-        let g = &results[8 * i..8 * i + 8];
         assert!(
             (g[4] - t_max).abs() < 1e-4 && (g[5] == 1.0) == ground,
             "case {i}: exit {g:?} vs {t_max} {ground}"

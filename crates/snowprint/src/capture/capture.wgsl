@@ -13,7 +13,7 @@
 // `tile_list` (count cleared to 0): each tile the first time it is flagged, as (record, tile), so
 // the update can be dispatched over the flagged tiles alone.
 
-// import constants
+// import constants, ground_texel
 
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
@@ -60,7 +60,7 @@ fn ground_at(frag: vec2<f32>) -> vec2<f32> {
         return vec2<f32>(0.0);
     }
     let cell = vec2<u32>(frag - view.origin);
-    return ground[view.ground + cell.y * u32(view.texels.x) + cell.x];
+    return ground_texel(view.ground, u32(view.texels.x), cell.x, cell.y);
 }
 
 // Flag every tile holding a texel within one of this one (the blur's reach).

@@ -1,0 +1,259 @@
+//! Image tests of snow on ground that is not flat: a 30-degree plane and a patch of sine hills,
+//! each with a short trail of prints pressed across it (one sphere a frame, each 0.12 m deep from
+//! the local snow top), rendered at 256x144 in the relief, POM and tessellated tiers and compared
+//! with NVIDIA FLIP against the goldens in `tests/golden/` (`terrain_relief.png`,
+//! `terrain_pom.png`, `terrain_tessellated.png`; bounds in `tolerances.toml`). The same scene with
+//! its ground switched off (the surfaces left flat, the same spheres pressed) fails all three, so
+//! the check sees the ground; untouched snow on the ground is drawn by the deformable material
+//! (the basic one draws a flat top).
+//!
+//! `SNOWPRINT_BLESS=1 cargo test --release --test render_terrain` writes new goldens (refused when
+//! `CI` is set).
+
+mod common;
+mod golden_support;
+
+use glam::{Mat4, Quat, Vec3};
+use golden_support::{check, score, tolerance};
+use snowprint::render::{
+    Environment, Instance, MeshMaterial, RenderConfig, RenderFrame, RenderOutput, Renderer, Tier,
+};
+use snowprint::{
+    Camera, Deformer, Ground, GroundMaterial, HeightGrid, Mesh, Pose, Shape, SlopeRule, SnowWorld,
+    SurfaceDesc, SurfaceId, WorldConfig,
+};
+
+const WIDTH: u32 = 256;
+const HEIGHT: u32 = 144;
+const DEPTH: f32 = 0.25;
+const RADIUS: f32 = 0.12;
+/// How deep each print is pressed below the local snow top, metres.
+const PRESS: f32 = 0.12;
+
+/// The 30-degree plane under the first surface (local metres, rising along x).
+fn plane(x: f32, _z: f32) -> f32 {
+    x * 30f32.to_radians().tan()
+}
+
+/// The sine hills under the second (at most 32 degrees: all the snow stays on).
+fn hills(x: f32, z: f32) -> f32 {
+    0.1 * (std::f32::consts::TAU * x / 1.0).sin() * (std::f32::consts::TAU * z / 1.6).cos()
+}
+
+struct Patch {
+    desc: SurfaceDesc,
+    ground: fn(f32, f32) -> f32,
+    /// The trail's prints, local (x, z).
+    prints: Vec<[f32; 2]>,
+}
+
+fn patches() -> [Patch; 2] {
+    [
+        Patch {
+            desc: SurfaceDesc::new("slope", [-1.35, 0.0, 0.0], [2.4, 1.6], DEPTH),
+            ground: plane,
+            // Up the slope, left and right.
+            prints: (0..5)
+                .map(|i| {
+                    [
+                        -0.9 + 0.45 * i as f32,
+                        if i % 2 == 0 { 0.15 } else { -0.15 },
+                    ]
+                })
+                .collect(),
+        },
+        Patch {
+            desc: SurfaceDesc::new("hills", [1.35, 0.0, 0.0], [2.0, 2.0], DEPTH),
+            ground: hills,
+            // Across the hills, diagonally.
+            prints: (0..5)
+                .map(|i| [-0.7 + 0.35 * i as f32, -0.5 + 0.25 * i as f32])
+                .collect(),
+        },
+    ]
+}
+
+/// A grid with one sample per texel centre of `desc` of the heights `f(x, z)`, local metres.
+fn grid_of(desc: &SurfaceDesc, f: fn(f32, f32) -> f32) -> HeightGrid {
+    let l = desc.layout();
+    let (w, h) = (l.width, l.height);
+    let heights = (0..h)
+        .flat_map(|r| (0..w).map(move |c| (c, r)))
+        .map(|(c, r)| {
+            let x = (c as f32 + 0.5) / w as f32 * desc.size.x - 0.5 * desc.size.x;
+            let z = (r as f32 + 0.5) / h as f32 * desc.size.y - 0.5 * desc.size.y;
+            f(x, z)
+        })
+        .collect();
+    HeightGrid {
+        columns: w,
+        rows: h,
+        heights,
+    }
+}
+
+struct Scene {
+    world: SnowWorld,
+    renderer: Renderer,
+    surfaces: Vec<SurfaceId>,
+    instances: Vec<Instance>,
+}
+
+/// The two patches on their ground (or, `on_ground` false, on flat ground), with their trails
+/// pressed (`pressed`) or untouched.
+fn scene(on_ground: bool, pressed: bool) -> Scene {
+    let gpu = common::gpu();
+    let mut world = SnowWorld::new(
+        gpu,
+        WorldConfig {
+            pool_bytes: 4 << 20,
+            ..Default::default()
+        },
+    )
+    .expect("world");
+    let mut surfaces = Vec::new();
+    for p in patches() {
+        let id = world.add_surface(p.desc.clone()).expect("surface");
+        if on_ground {
+            let grid = Ground::Grid(grid_of(&p.desc, p.ground));
+            world
+                .set_ground(id, &grid, SlopeRule::default())
+                .expect("ground");
+        }
+        surfaces.push(id);
+    }
+    if pressed {
+        for p in patches() {
+            for [x, z] in &p.prints {
+                // The sphere's bottom PRESS below the local snow top (ground + depth).
+                let y = (p.ground)(*x, *z) + DEPTH - PRESS + RADIUS;
+                let c = p.desc.center + Vec3::new(*x, y, *z);
+                let d = Deformer::new(Shape::Sphere { radius: RADIUS }, Pose::at(c.into()));
+                world.step(1.0 / 30.0, &[d]).expect("step");
+            }
+        }
+    }
+    let mut config = RenderConfig::new(WIDTH, HEIGHT, Tier::Relief);
+    config.shadow_map_size = 1024;
+    let mut renderer = Renderer::new(gpu, config).expect("renderer");
+    let block = renderer
+        .add_mesh(&Mesh::cuboid(Vec3::splat(0.5)))
+        .expect("mesh");
+    // A dark yard far under the patches, so that what shows under their edges is not sky.
+    let instances = vec![
+        Instance::new(
+            block,
+            Mat4::from_scale_rotation_translation(
+                Vec3::new(8.0, 0.2, 5.0),
+                Quat::IDENTITY,
+                Vec3::new(0.0, -1.0, 0.0),
+            ),
+            [0.2, 0.19, 0.18],
+        )
+        .with_material(MeshMaterial::Concrete),
+    ];
+    Scene {
+        world,
+        renderer,
+        surfaces,
+        instances,
+    }
+}
+
+fn render(scene: &mut Scene, tier: Tier) -> RenderOutput {
+    scene.renderer.set_tier(tier);
+    let surfaces: Vec<_> = scene
+        .surfaces
+        .iter()
+        .map(|&id| (id, GroundMaterial::Concrete))
+        .collect();
+    let frame = RenderFrame {
+        camera: Camera {
+            eye: Vec3::new(0.0, 2.3, 3.0),
+            target: Vec3::new(0.0, 0.1, 0.0),
+            fov_y_degrees: 50.0,
+        },
+        time: 1.0,
+        surfaces: &surfaces,
+        instances: &scene.instances,
+        lights: &[],
+        environment: Environment::moonlit_night(),
+        snowfall: false,
+    };
+    scene.renderer.render(&scene.world, &frame).expect("render")
+}
+
+const TIERS: [(Tier, &str); 3] = [
+    (Tier::Relief, "terrain_relief"),
+    (Tier::Pom, "terrain_pom"),
+    (Tier::Tessellated, "terrain_tessellated"),
+];
+
+/// Where `SNOWPRINT_TERRAIN_STILLS` names a folder, write the render there too (to look at).
+fn keep(name: &str, out: &RenderOutput) {
+    if let Some(dir) = std::env::var_os("SNOWPRINT_TERRAIN_STILLS") {
+        golden_support::save_png(&std::path::Path::new(&dir).join(format!("{name}.png")), out);
+    }
+}
+
+/// The trails on the slope and the hills, in every tier.
+#[test]
+fn prints_on_a_slope_and_on_hills_match_their_goldens() {
+    let mut scene = scene(true, true);
+    for (tier, name) in TIERS {
+        let out = render(&mut scene, tier);
+        keep(name, &out);
+        assert!(out.basic_material_surfaces.is_empty(), "{name}");
+        check(name, &out);
+    }
+}
+
+/// The same spheres pressed into the same surfaces left flat score past both bounds of every
+/// golden: the goldens see the ground.
+#[test]
+fn the_scene_drawn_flat_fails_the_terrain_goldens() {
+    if golden_support::bless() {
+        return;
+    }
+    let mut scene = scene(false, true);
+    for (tier, name) in TIERS {
+        let out = render(&mut scene, tier);
+        keep(&format!("{name}_flat"), &out);
+        let (_, mean, p99) = score(name, &out);
+        eprintln!("{name}, drawn flat: FLIP mean {mean:.4}, p99 {p99:.4}");
+        let tol = tolerance(name);
+        assert!(
+            mean > tol.mean && p99 > tol.p99,
+            "{name}: the flat scene scores mean {mean:.4} / p99 {p99:.4}, within the bounds {} / {}",
+            tol.mean,
+            tol.p99
+        );
+    }
+}
+
+/// Untouched snow on ground that is not flat: nothing pressed it, yet it is drawn by the deformable
+/// material (the basic one draws a flat top) and shows its ground's shape: it fails the goldens of
+/// the pressed trails less than the flat scene does, yet it is no flat slab (the flat untouched
+/// scene draws both surfaces with the basic material).
+#[test]
+fn untouched_snow_on_the_ground_is_drawn_on_its_ground() {
+    if golden_support::bless() {
+        return;
+    }
+    let mut on_ground = scene(true, false);
+    let mut flat = scene(false, false);
+    for (tier, name) in TIERS {
+        let a = render(&mut on_ground, tier);
+        let b = render(&mut flat, tier);
+        keep(&format!("{name}_untouched"), &a);
+        assert!(a.basic_material_surfaces.is_empty(), "{name}");
+        assert_eq!(b.basic_material_surfaces.len(), 2, "{name}");
+        let (_, mean_ground, _) = score(name, &a);
+        let (_, mean_flat, _) = score(name, &b);
+        eprintln!("{name}, untouched: on its ground {mean_ground:.4}, flat {mean_flat:.4}");
+        assert!(
+            mean_ground < mean_flat,
+            "{name}: untouched on its ground {mean_ground:.4}, flat {mean_flat:.4}"
+        );
+    }
+}
