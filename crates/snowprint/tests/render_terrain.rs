@@ -196,7 +196,8 @@ fn keep(name: &str, out: &RenderOutput) {
     }
 }
 
-/// The trails on the slope and the hills, in every tier.
+/// The trails on the slope and the hills, in every tier. With `SNOWPRINT_TERRAIN_STILLS` set,
+/// 960x540 stills of every tier are written there too.
 #[test]
 fn prints_on_a_slope_and_on_hills_match_their_goldens() {
     let mut scene = scene(true, true);
@@ -205,6 +206,12 @@ fn prints_on_a_slope_and_on_hills_match_their_goldens() {
         keep(name, &out);
         assert!(out.basic_material_surfaces.is_empty(), "{name}");
         check(name, &out);
+    }
+    if std::env::var_os("SNOWPRINT_TERRAIN_STILLS").is_some() {
+        scene.renderer.resize(960, 540, 1).expect("resize");
+        for (tier, name) in TIERS {
+            keep(&format!("{name}_960"), &render(&mut scene, tier));
+        }
     }
 }
 
@@ -254,6 +261,146 @@ fn untouched_snow_on_the_ground_is_drawn_on_its_ground() {
         assert!(
             mean_ground < mean_flat,
             "{name}: untouched on its ground {mean_ground:.4}, flat {mean_flat:.4}"
+        );
+    }
+}
+
+/// `scenes/pitched_roof.toml` (two 30-degree planes of a glTF roof, a ball dragged up one side
+/// and over the ridge, another across a side) after its 4 s, on its roof or (`on_ground` false)
+/// on flat ground, with the house under it: walls, the roof's faces and its gables.
+fn roof_scene(on_ground: bool) -> Scene {
+    let gpu = common::gpu();
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pitched_roof.toml");
+    let file = snowprint::scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut world = SnowWorld::new(gpu, WorldConfig::default()).expect("world");
+    let id = world.add_surface(file.surfaces[0].clone()).expect("roof");
+    let ground = file.grounds[0].as_ref().expect("the roof mesh");
+    if on_ground {
+        world
+            .set_ground(id, &ground.ground, ground.slope)
+            .expect("ground");
+    }
+    let dt = 1.0 / 30.0;
+    let mut prev: Vec<Option<Pose>> = vec![None; file.deformers.len()];
+    for f in 1..=120 {
+        let t = f as f32 * dt;
+        let ds: Vec<Deformer> = file
+            .deformers
+            .iter()
+            .zip(&mut prev)
+            .map(|(d, p)| {
+                let snowprint::scene::SceneShape::Sphere { radius } = d.shape else {
+                    panic!("the roof's deformers are spheres")
+                };
+                let pose = d.pose_at(t);
+                match p.replace(pose) {
+                    Some(before) => Deformer::moving(Shape::Sphere { radius }, before, pose),
+                    None => Deformer::new(Shape::Sphere { radius }, pose),
+                }
+            })
+            .collect();
+        world.step(dt, &ds).expect("step");
+    }
+    let mut config = RenderConfig::new(WIDTH, HEIGHT, Tier::Relief);
+    config.shadow_map_size = 1024;
+    let mut renderer = Renderer::new(gpu, config).expect("renderer");
+    let Ground::Mesh(roof) = &ground.ground else {
+        panic!("the roof is a mesh")
+    };
+    // The roof's faces, and the gables closing it at x = -4 and 4 (both windings).
+    let mut positions: Vec<Vec3> = roof.triangles.iter().flatten().copied().collect();
+    for x in [-4.0, 4.0] {
+        let (a, b, c) = (
+            Vec3::new(x, 10.0, -3.0),
+            Vec3::new(x, 10.0 + 3.0 * 30f32.to_radians().tan(), 0.0),
+            Vec3::new(x, 10.0, 3.0),
+        );
+        positions.extend([a, b, c, a, c, b]);
+    }
+    let indices = (0..positions.len() as u32).collect();
+    let roof = renderer
+        .add_mesh(&Mesh { positions, indices })
+        .expect("roof mesh");
+    let block = renderer
+        .add_mesh(&Mesh::cuboid(Vec3::splat(0.5)))
+        .expect("block");
+    let instances = vec![
+        Instance::new(roof, Mat4::IDENTITY, [0.35, 0.16, 0.1]).with_material(MeshMaterial::Brick),
+        Instance::new(
+            block,
+            Mat4::from_scale_rotation_translation(
+                Vec3::new(8.0, 3.0, 6.0),
+                Quat::IDENTITY,
+                Vec3::new(0.0, 8.5, 0.0),
+            ),
+            [0.3, 0.28, 0.26],
+        )
+        .with_material(MeshMaterial::Brick),
+    ];
+    Scene {
+        world,
+        renderer,
+        surfaces: vec![id],
+        instances,
+    }
+}
+
+fn render_roof(scene: &mut Scene, tier: Tier) -> RenderOutput {
+    scene.renderer.set_tier(tier);
+    let surfaces = [(scene.surfaces[0], GroundMaterial::RoofTiles)];
+    let frame = RenderFrame {
+        camera: Camera {
+            eye: Vec3::new(-8.5, 14.5, -8.0),
+            target: Vec3::new(-0.8, 10.6, -0.6),
+            fov_y_degrees: 45.0,
+        },
+        time: 1.0,
+        surfaces: &surfaces,
+        instances: &scene.instances,
+        lights: &[],
+        environment: Environment::moonlit_night(),
+        snowfall: false,
+    };
+    scene.renderer.render(&scene.world, &frame).expect("render")
+}
+
+const ROOF_TIERS: [(Tier, &str); 2] = [
+    (Tier::Relief, "roof_relief"),
+    (Tier::Tessellated, "roof_tessellated"),
+];
+
+/// The pitched roof's trenches, drawn on the roof in both tiers; the roof drawn flat (its snow a
+/// slab at the eaves' height, inside the house) fails both goldens. With
+/// `SNOWPRINT_TERRAIN_STILLS` set, 960x540 stills of both tiers are written there too.
+#[test]
+fn the_pitched_roof_scene_matches_its_goldens_and_fails_them_flat() {
+    let mut scene = roof_scene(true);
+    for (tier, name) in ROOF_TIERS {
+        let out = render_roof(&mut scene, tier);
+        keep(name, &out);
+        assert!(out.basic_material_surfaces.is_empty(), "{name}");
+        check(name, &out);
+    }
+    if std::env::var_os("SNOWPRINT_TERRAIN_STILLS").is_some() {
+        scene.renderer.resize(960, 540, 1).expect("resize");
+        for (tier, name) in ROOF_TIERS {
+            keep(&format!("{name}_960"), &render_roof(&mut scene, tier));
+        }
+    }
+    if golden_support::bless() {
+        return;
+    }
+    let mut flat = roof_scene(false);
+    for (tier, name) in ROOF_TIERS {
+        let out = render_roof(&mut flat, tier);
+        keep(&format!("{name}_flat"), &out);
+        let (_, mean, p99) = score(name, &out);
+        eprintln!("{name}, drawn flat: FLIP mean {mean:.4}, p99 {p99:.4}");
+        let tol = tolerance(name);
+        assert!(
+            mean > tol.mean && p99 > tol.p99,
+            "{name}: the flat roof scores mean {mean:.4} / p99 {p99:.4}, within the bounds"
         );
     }
 }
