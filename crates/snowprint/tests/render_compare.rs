@@ -1,7 +1,8 @@
 //! The snow material's GPU maths against their CPU references (`snowprint::reference::material`), on the
 //! same inputs: the heightfield pass (Sobel normals, horizon AO, moon visibility) on a synthetic
-//! heightmap, and the relief search, POM search and RNM of `snow.wgsl` run in a compute harness on
-//! analytic heightfields.
+//! heightmap (and on ground that is a plane, the moon turned by its slope), and the relief search,
+//! POM search and RNM of `snow.wgsl` run in a compute harness on analytic heightfields (and on
+//! snow over a sloped ground plane, the hit computed by hand).
 
 mod common;
 
@@ -59,6 +60,20 @@ fn synthetic(width: u32, height: u32) -> Vec<f32> {
 
 #[test]
 fn heightfield_pass_matches_its_cpu_reference() {
+    heightfield_case(None);
+}
+
+/// On ground that is a plane (rising 0.3 m a metre along x, falling 0.2 along z) the pass turns the
+/// moon by the rotation that takes the plane's normal to up before marching over the prints: the
+/// CPU reference marches with the moon turned by `Quat::from_rotation_arc` (computed here, not by
+/// the shader's formula). Texels on the border, where the pass's differences are one-sided, are
+/// left out.
+#[test]
+fn heightfield_pass_turns_the_moon_by_the_slope_of_the_ground() {
+    heightfield_case(Some(Vec2::new(0.3, -0.2)));
+}
+
+fn heightfield_case(slope: Option<Vec2>) {
     let gpu = common::gpu();
     let dev = &gpu.device;
     let (w, h) = (64u32, 48u32);
@@ -93,7 +108,8 @@ fn heightfield_pass_matches_its_cpu_reference() {
         snow_depth: depth,
         texel_x: texel.x,
         texel_z: texel.y,
-        ground: snowprint::low_level::ground::NO_GROUND,
+        // The field starts 3 texels into the ground buffer, as a world's second surface might.
+        ground: slope.map_or(snowprint::low_level::ground::NO_GROUND, |_| 3),
         light: [light.x, light.y, light.z, 0.0],
     };
     let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -118,9 +134,19 @@ fn heightfield_pass_matches_its_cpu_reference() {
         })
     };
     let (shape, lit) = (texture(), texture());
+    // `[base, bare]` per texel: the plane at the texel centres (none bare), after 3 texels of
+    // another field; a zero texel on flat ground (never read).
+    let mut columns = vec![[9.0f32, 0.0]; 3];
+    if let Some(g) = slope {
+        for r in 0..h {
+            for c in 0..w {
+                columns.push([g.x * c as f32 * texel.x + g.y * r as f32 * texel.y, 0.0]);
+            }
+        }
+    }
     let ground = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("ground"),
-        contents: &[0u8; 16],
+        contents: bytemuck::cast_slice(&columns),
         usage: wgpu::BufferUsages::STORAGE,
     });
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -157,7 +183,6 @@ fn heightfield_pass_matches_its_cpu_reference() {
                 binding: 3,
                 resource: wgpu::BindingResource::TextureView(&lit.create_view(&Default::default())),
             },
-            // No ground field (flat ground): never read.
             wgpu::BindGroupEntry {
                 binding: 4,
                 resource: ground.as_entire_binding(),
@@ -218,32 +243,48 @@ fn heightfield_pass_matches_its_cpu_reference() {
         (units[(r as u32 * w + c as u32) as usize] & 0xffff) as f32 / 65535.0
     };
     let mut worst = [0.0f32; 5];
+    // The moon as the prints on the plane see it, and how many texels would be lit otherwise had
+    // the pass not turned it (the case must see the turn).
+    let turned = slope.map_or(light, |g| {
+        glam::Quat::from_rotation_arc(Vec3::new(-g.x, 1.0, -g.y).normalize(), Vec3::Y) * light
+    });
+    let mut unturned_differs = 0;
+    let inner = |c: i32, r: i32| c > 0 && r > 0 && c < w as i32 - 1 && r < h as i32 - 1;
     for r in 0..h as i32 {
         for c in 0..w as i32 {
+            if slope.is_some() && !inner(c, r) {
+                continue;
+            }
             let gpu_texel = texel_at(&shape_bytes, c as u32, r as u32);
             let n = cpu::sobel_normal(d, c, r, depth, texel);
             let ao = cpu::horizon_ao(|dx, dz| {
                 let (oc, orow) = ((dx / texel.x).round() as i32, (dz / texel.y).round() as i32);
                 depth * (1.0 - d(c + oc, r + orow))
             });
-            let vis = cpu::light_visibility(
-                |x, z| {
-                    let (fx, fz) = (x / texel.x, z / texel.y);
-                    let (ix, iz) = (fx.floor(), fz.floor());
-                    let (wx, wz) = (fx - ix, fz - iz);
-                    let (x0, z0) = (c + ix as i32, r + iz as i32);
-                    let a = d(x0, z0) * (1.0 - wx) + d(x0 + 1, z0) * wx;
-                    let b = d(x0, z0 + 1) * (1.0 - wx) + d(x0 + 1, z0 + 1) * wx;
-                    depth * (1.0 - (a * (1.0 - wz) + b * wz))
-                },
-                0.0,
-                0.0,
-                light,
-                depth,
-                texel.x.max(texel.y),
-            );
+            let march = |l: Vec3| {
+                cpu::light_visibility(
+                    |x, z| {
+                        let (fx, fz) = (x / texel.x, z / texel.y);
+                        let (ix, iz) = (fx.floor(), fz.floor());
+                        let (wx, wz) = (fx - ix, fz - iz);
+                        let (x0, z0) = (c + ix as i32, r + iz as i32);
+                        let a = d(x0, z0) * (1.0 - wx) + d(x0 + 1, z0) * wx;
+                        let b = d(x0, z0 + 1) * (1.0 - wx) + d(x0 + 1, z0 + 1) * wx;
+                        depth * (1.0 - (a * (1.0 - wz) + b * wz))
+                    },
+                    0.0,
+                    0.0,
+                    l,
+                    depth,
+                    texel.x.max(texel.y),
+                )
+            };
+            let vis = march(turned);
             let gpu_light = texel_at(&lit_bytes, c as u32, r as u32);
             let gpu_vis = gpu_light[0];
+            if (march(light) - gpu_vis).abs() > 0.05 {
+                unturned_differs += 1;
+            }
             let displaced = cpu::displaced_fraction(
                 units[(r as u32 * w + c as u32) as usize] >> 16,
                 snowprint::Precision::Bits16,
@@ -266,6 +307,13 @@ fn heightfield_pass_matches_its_cpu_reference() {
         worst.iter().all(|&e| e < 2e-3),
         "worst |GPU - CPU| (depression, normal, AO, light, displaced): {worst:?}"
     );
+    if slope.is_some() {
+        eprintln!("{unturned_differs} texels would be lit otherwise without the turn");
+        assert!(
+            unturned_differs > 50,
+            "only {unturned_differs} texels see the moon turned by the slope"
+        );
+    }
 }
 
 /// A compute harness around snow.wgsl: analytic heightfields as the contract, every search and
@@ -363,7 +411,8 @@ fn blend(@builtin(global_invocation_id) id: vec3<u32>) {
 /// `SNOW_EPSILON`) at `t = (0.5 o.x + 0.3 + 1e-4 - o.y) / (d.y - 0.5 d.x)`, computed by hand. The
 /// slab's floor is the plane's lowest point (-1 m), its top the highest snow top (1.3 m). Relief
 /// mapping lands within its last bracket of it, POM (a secant on a plane is exact) within 1e-4.
-fn on_a_sloped_ground(i: usize, ray: &cpu::SlabRay, g: &[f32], half: Vec2, depth: f32) {
+/// Returns whether the ray met the snow inside the slab (and was checked).
+fn on_a_sloped_ground(i: usize, ray: &cpu::SlabRay, g: &[f32], half: Vec2, depth: f32) -> bool {
     let (o, d) = (ray.origin, ray.dir);
     let t = (0.5 * o.x + depth + 1e-4 - o.y) / (d.y - 0.5 * d.x);
     let p = o + d * t;
@@ -386,7 +435,7 @@ fn on_a_sloped_ground(i: usize, ray: &cpu::SlabRay, g: &[f32], half: Vec2, depth
         g[4]
     );
     if !inside {
-        return;
+        return false;
     }
     let bracket = t_max / g[6] / 32.0 + 1e-4;
     assert!(
@@ -399,6 +448,7 @@ fn on_a_sloped_ground(i: usize, ray: &cpu::SlabRay, g: &[f32], half: Vec2, depth
         "case {i}: POM on the slope {} vs {t} by hand",
         g[2]
     );
+    true
 }
 
 #[test]
@@ -550,6 +600,7 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
     let results: Vec<f32> = bytemuck::cast_slice(&read_buffer(&results_rb)).to_vec();
     let blended: Vec<f32> = bytemuck::cast_slice(&read_buffer(&blended_rb)).to_vec();
 
+    let mut sloped_hits = 0;
     for (i, c) in cases.iter().enumerate() {
         let ray = cpu::SlabRay {
             origin: Vec3::new(c[0], c[1], c[2]),
@@ -557,7 +608,7 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
         };
         let g = &results[8 * i..8 * i + 8];
         if c[3] == 2.0 {
-            on_a_sloped_ground(i, &ray, g, half, depth);
+            sloped_hits += usize::from(on_a_sloped_ground(i, &ray, g, half, depth));
             continue;
         }
         let plane = c[3] == 0.0;
@@ -600,6 +651,11 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
             None => assert_eq!(g[3], 0.0, "case {i}: pom found a hit the CPU did not"),
         }
     }
+    eprintln!("sloped ground: {sloped_hits} of 48 rays met the snow and were checked by hand");
+    assert!(
+        sloped_hits >= 24,
+        "only {sloped_hits} rays met the sloped snow"
+    );
     for (k, (a, b)) in normals.iter().zip(normals.iter().rev()).enumerate() {
         let want = cpu::rnm(*a, *b);
         let got = Vec3::new(blended[4 * k], blended[4 * k + 1], blended[4 * k + 2]);

@@ -135,7 +135,7 @@ pub struct SurfaceUniform {
     /// below the room for rims.
     pub terrain_top: f32,
     /// Padding.
-    pub _terrain_pad: f32,
+    pub terrain_pad: f32,
 }
 
 /// Room for rims above the snow top that the relief and POM tiers raise their slab by, metres:
@@ -231,7 +231,7 @@ impl SurfaceUniform {
             terrain: surface.ground,
             terrain_low: surface.ground_range.0,
             terrain_top: surface.ground_range.1 + desc.snow_depth,
-            _terrain_pad: 0.0,
+            terrain_pad: 0.0,
         }
     }
 
@@ -506,7 +506,11 @@ mod tests {
             albedo,
             disturbed,
             grain,
-            translucency
+            translucency,
+            terrain,
+            terrain_low,
+            terrain_top,
+            terrain_pad
         );
         for (source, name) in [
             (&engine, "snowprint_Surface"),
