@@ -404,3 +404,217 @@ fn the_pitched_roof_scene_matches_its_goldens_and_fails_them_flat() {
         );
     }
 }
+
+/// The tessellated tier's vertex stage (`tess_local` of `tess_surface.wgsl`, run in a compute
+/// harness over the renderer's own bindings) lifts each vertex of the top to the snow over the
+/// ground: the bilinear base of the surface's ground field (`GroundField::columns`, as the world
+/// built it) plus the snow depth less the bilinear depression of the heightfield, computed here
+/// on the CPU, within 0.1 mm; a skirt's base vertex to the ground's base alone.
+#[test]
+fn tessellated_vertices_stand_on_the_ground_plus_the_snow() {
+    let gpu = common::gpu();
+    let dev = &gpu.device;
+    let mut world = SnowWorld::new(gpu, WorldConfig::default()).expect("world");
+    let p = &patches()[1];
+    let id = world.add_surface(p.desc.clone()).expect("surface");
+    world
+        .set_ground(
+            id,
+            &Ground::Grid(grid_of(&p.desc, p.ground)),
+            SlopeRule::default(),
+        )
+        .expect("ground");
+    let field = world.ground(id).unwrap().unwrap().clone();
+    let l = p.desc.layout();
+    let (w, h) = (l.width, l.height);
+    // A depression of k/8 (exact in half floats) in a pattern over the texels.
+    let dep = |c: u32, r: u32| ((c * 3 + r * 5) % 8) as f32 / 8.0;
+    let view = world.frame_view();
+    let mut uniform = snowprint::SurfaceUniform::for_surface(&view, id).expect("uniform");
+    uniform.pattern[3] = 0.0; // no macro waves
+    let half_bits = |x: f32| -> u16 {
+        if x == 0.0 {
+            return 0;
+        }
+        let b = x.to_bits();
+        ((((b >> 23) & 0xff) as u16 - 127 + 15) << 10) | ((b >> 13) & 0x3ff) as u16
+    };
+    let texels: Vec<u16> = (0..h)
+        .flat_map(|r| (0..w).map(move |c| (c, r)))
+        .flat_map(|(c, r)| [half_bits(dep(c, r)), 0, 0, 0])
+        .collect();
+    let texture = |data: &[u16]| {
+        dev.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(data),
+        )
+        .create_view(&Default::default())
+    };
+    use wgpu::util::DeviceExt;
+    let (shape, bank) = (texture(&texels), texture(&vec![0u16; texels.len()]));
+    let buffer = |bytes: &[u8], usage| {
+        dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytes,
+            usage,
+        })
+    };
+    let mut state = vec![0u32; snowprint::wgsl::consts::STATE_WORDS as usize];
+    state[snowprint::wgsl::consts::STATE_TOUCHED as usize] = 1;
+    // Points over the surface, edges included: tops (kind 0) and skirt bases (kind 2).
+    let half = p.desc.size * 0.5;
+    let points: Vec<[f32; 4]> = (0..=20)
+        .flat_map(|i| (0..=20).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let x = -half.x + 2.0 * half.x * i as f32 / 20.0;
+            let z = -half.y + 2.0 * half.y * j as f32 / 20.0;
+            [x, 0.0, z, if (i + j) % 5 == 0 { 2.0 } else { 0.0 }]
+        })
+        .collect();
+    let u = wgpu::BufferUsages::STORAGE;
+    let (uni, ground, state, input) = (
+        buffer(bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM),
+        view.ground_buffer,
+        buffer(bytemuck::cast_slice(&state), u),
+        buffer(bytemuck::cast_slice(&points), u),
+    );
+    let output = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: (points.len() * 16) as u64,
+        usage: u | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let source = format!(
+        "{}\n{}",
+        snowprint::wgsl::TESS_SURFACE.source,
+        r#"
+@group(2) @binding(0) var<storage, read> probe_in: array<vec4<f32>>;
+@group(2) @binding(1) var<storage, read_write> probe_out: array<vec4<f32>>;
+@compute @workgroup_size(64)
+fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= arrayLength(&probe_in) {
+        return;
+    }
+    var v: TessVertex;
+    v.position = probe_in[id.x];
+    v.outward = vec4<f32>(0.0);
+    probe_out[id.x] = vec4<f32>(tess_local(v), 0.0);
+}
+"#
+    );
+    let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("tess_local harness"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: None,
+        layout: None,
+        module: &module,
+        entry_point: Some("probe"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let group = |g: u32, resources: &[wgpu::BindingResource<'_>], bindings: &[u32]| {
+        dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(g),
+            entries: &resources
+                .iter()
+                .zip(bindings)
+                .map(|(r, &binding)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: r.clone(),
+                })
+                .collect::<Vec<_>>(),
+        })
+    };
+    let g0 = group(0, &[], &[]);
+    let g1 = group(
+        1,
+        &[
+            uni.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&shape),
+            wgpu::BindingResource::TextureView(&bank),
+            ground.as_entire_binding(),
+            state.as_entire_binding(),
+        ],
+        &[0, 1, 3, 4, 5],
+    );
+    let g2 = group(
+        2,
+        &[input.as_entire_binding(), output.as_entire_binding()],
+        &[0, 1],
+    );
+    let readback = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: output.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = dev.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        for (i, g) in [&g0, &g1, &g2].into_iter().enumerate() {
+            pass.set_bind_group(i as u32, g, &[]);
+        }
+        pass.dispatch_workgroups((points.len() as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&output, 0, &readback, 0, output.size());
+    gpu.queue.submit([enc.finish()]);
+    readback.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    gpu.wait_idle().expect("gpu");
+    let got: Vec<[f32; 4]> =
+        bytemuck::cast_slice(&readback.slice(..).get_mapped_range().expect("mapped")).to_vec();
+
+    // Bilinear between texel centres, clamped at the edges.
+    let bilinear = |f: &dyn Fn(u32, u32) -> f32, x: f32, z: f32| {
+        let (fx, fz) = (
+            (x + half.x) / (2.0 * half.x) * w as f32 - 0.5,
+            (z + half.y) / (2.0 * half.y) * h as f32 - 0.5,
+        );
+        let (ix, iz) = (fx.floor(), fz.floor());
+        let (tx, tz) = (fx - ix, fz - iz);
+        let at = |c: f32, r: f32| {
+            f(
+                (c as i32).clamp(0, w as i32 - 1) as u32,
+                (r as i32).clamp(0, h as i32 - 1) as u32,
+            )
+        };
+        let a = at(ix, iz) * (1.0 - tx) + at(ix + 1.0, iz) * tx;
+        let b = at(ix, iz + 1.0) * (1.0 - tx) + at(ix + 1.0, iz + 1.0) * tx;
+        a * (1.0 - tz) + b * tz
+    };
+    let base = |c: u32, r: u32| field.columns[(r * w + c) as usize][0];
+    let mut worst = 0.0f32;
+    for (p, g) in points.iter().zip(&got) {
+        let ground = bilinear(&base, p[0], p[2]);
+        let want = if p[3] < 1.5 {
+            ground + DEPTH * (1.0 - bilinear(&dep, p[0], p[2]))
+        } else {
+            ground
+        };
+        assert!(g[0] == p[0] && g[2] == p[2], "{p:?} moved to {g:?}");
+        worst = worst.max((g[1] - want).abs());
+    }
+    eprintln!(
+        "tess_local against the CPU: worst {worst:.2e} m over {} points",
+        points.len()
+    );
+    assert!(worst < 1e-4, "worst |GPU - CPU| height {worst} m");
+}
