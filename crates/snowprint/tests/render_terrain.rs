@@ -5,7 +5,12 @@
 //! `terrain_pom.png`, `terrain_tessellated.png`; bounds in `tolerances.toml`). The same scene with
 //! its ground switched off (the surfaces left flat, the same spheres pressed) fails all three, so
 //! the check sees the ground; untouched snow on the ground is drawn by the deformable material
-//! (the basic one draws a flat top).
+//! (the basic one draws a flat top). `scenes/pitched_roof.toml`'s trenches in the relief and
+//! tessellated tiers against `roof_{relief,tessellated}.png`, failed by the roof drawn flat. The
+//! tessellated tier's vertex stage against the ground field plus the heightfield on the CPU.
+//!
+//! `SNOWPRINT_TERRAIN_STILLS=DIR` also writes every render, and 960x540 stills of both scenes, to
+//! `DIR` (the stills of `docs/RENDERING.md`, "Snow on its ground").
 //!
 //! `SNOWPRINT_BLESS=1 cargo test --release --test render_terrain` writes new goldens (refused when
 //! `CI` is set).
