@@ -2,6 +2,7 @@
 //! call ([`SnowWorld::frame_view`]) instead of per-surface accessor calls scattered through the
 //! passes. Built from the world's public accessors only, so another renderer can do the same.
 
+use crate::capture::NO_GROUND;
 use crate::error::{Result, SnowError};
 use crate::pool::{PoolFormat, Precision};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
@@ -22,10 +23,16 @@ pub struct SurfaceView<'a> {
     pub normals: Option<u32>,
     /// Precision of its heights in the pool.
     pub precision: Precision,
+    /// Its ground: first texel in [`FrameView::ground_buffer`] or [`crate::low_level::ground::NO_GROUND`]
+    /// on flat ground.
+    pub ground: u32,
+    /// Lowest base of its snow columns and highest ground, local metres ((0, 0) on flat ground):
+    /// the snow lies between the first and the second plus the snow depth.
+    pub ground_range: (f32, f32),
 }
 
-/// Everything of a world a frame reads: the pool buffer, its format, and every live surface
-/// with its layout and offsets in the pool.
+/// Everything of a world a frame reads: the pool buffer, its format, every live surface with its
+/// layout and offsets in the pool, and the ground fields of the surfaces not on flat ground.
 #[derive(Debug)]
 pub struct FrameView<'a> {
     /// The pool buffer (`array<u32>` in WGSL).
@@ -34,6 +41,9 @@ pub struct FrameView<'a> {
     pub pool_format: PoolFormat,
     /// Every live surface, in the world's order (by slot index).
     pub surfaces: Vec<SurfaceView<'a>>,
+    /// Every surface's ground field, packed (`array<vec2<f32>>`: `[base, bare]` per texel; read
+    /// through `ground_texel` in `ground/texel.wgsl`); surfaces on flat ground have none.
+    pub ground_buffer: &'a wgpu::Buffer,
 }
 
 impl<'a> FrameView<'a> {
@@ -61,6 +71,8 @@ impl SnowWorld {
             .filter_map(|(id, desc)| {
                 let layout = self.layout(id).ok()?;
                 let (heights, normals) = self.gpu_offsets(id).ok()?;
+                let placement = self.ground_placement(id).ok()?;
+                let (ground, low, high) = placement.unwrap_or((NO_GROUND, 0.0, 0.0));
                 Some(SurfaceView {
                     id,
                     desc,
@@ -68,6 +80,8 @@ impl SnowWorld {
                     heights,
                     normals,
                     precision: pool_format.precision,
+                    ground,
+                    ground_range: (low, high),
                 })
             })
             .collect();
@@ -77,6 +91,7 @@ impl SnowWorld {
             pool_buffer: self.pool_buffer(),
             pool_format,
             surfaces,
+            ground_buffer: self.ground_buffer(),
         }
     }
 }

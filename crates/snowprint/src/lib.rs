@@ -154,6 +154,7 @@ pub mod low_level {
     }
     /// The ground mesh rasterisation pass and its uniform.
     pub mod ground {
+        pub use crate::capture::NO_GROUND;
         pub use crate::ground::raster::{GroundRaster, RasterView, decode_height};
         pub use crate::ground::sample_grid;
     }

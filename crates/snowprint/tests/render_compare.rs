@@ -1,7 +1,8 @@
 //! The snow material's GPU maths against their CPU references (`snowprint::reference::material`), on the
 //! same inputs: the heightfield pass (Sobel normals, horizon AO, moon visibility) on a synthetic
-//! heightmap, and the relief search, POM search and RNM of `snow.wgsl` run in a compute harness on
-//! analytic heightfields.
+//! heightmap (and on ground that is a plane, the moon turned by its slope), and the relief search,
+//! POM search and RNM of `snow.wgsl` run in a compute harness on analytic heightfields (and on
+//! snow over a sloped ground plane, the hit computed by hand).
 
 mod common;
 
@@ -59,6 +60,20 @@ fn synthetic(width: u32, height: u32) -> Vec<f32> {
 
 #[test]
 fn heightfield_pass_matches_its_cpu_reference() {
+    heightfield_case(None);
+}
+
+/// On ground that is a plane (rising 0.3 m a metre along x, falling 0.2 along z) the pass turns the
+/// moon by the rotation that takes the plane's normal to up before marching over the prints: the
+/// CPU reference marches with the moon turned by `Quat::from_rotation_arc` (computed here, not by
+/// the shader's formula). Texels on the border, where the pass's differences are one-sided, are
+/// left out.
+#[test]
+fn heightfield_pass_turns_the_moon_by_the_slope_of_the_ground() {
+    heightfield_case(Some(Vec2::new(0.3, -0.2)));
+}
+
+fn heightfield_case(slope: Option<Vec2>) {
     let gpu = common::gpu();
     let dev = &gpu.device;
     let (w, h) = (64u32, 48u32);
@@ -93,7 +108,8 @@ fn heightfield_pass_matches_its_cpu_reference() {
         snow_depth: depth,
         texel_x: texel.x,
         texel_z: texel.y,
-        _pad2: 0.0,
+        // The field starts 3 texels into the ground buffer, as a world's second surface might.
+        ground: slope.map_or(snowprint::low_level::ground::NO_GROUND, |_| 3),
         light: [light.x, light.y, light.z, 0.0],
     };
     let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -118,6 +134,21 @@ fn heightfield_pass_matches_its_cpu_reference() {
         })
     };
     let (shape, lit) = (texture(), texture());
+    // `[base, bare]` per texel: the plane at the texel centres (none bare), after 3 texels of
+    // another field; a zero texel on flat ground (never read).
+    let mut columns = vec![[9.0f32, 0.0]; 3];
+    if let Some(g) = slope {
+        for r in 0..h {
+            for c in 0..w {
+                columns.push([g.x * c as f32 * texel.x + g.y * r as f32 * texel.y, 0.0]);
+            }
+        }
+    }
+    let ground = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("ground"),
+        contents: bytemuck::cast_slice(&columns),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
     let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("heightfield.wgsl"),
         source: wgpu::ShaderSource::Wgsl(snowprint::wgsl::HEIGHTFIELD.source.into()),
@@ -151,6 +182,10 @@ fn heightfield_pass_matches_its_cpu_reference() {
             wgpu::BindGroupEntry {
                 binding: 3,
                 resource: wgpu::BindingResource::TextureView(&lit.create_view(&Default::default())),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: ground.as_entire_binding(),
             },
         ],
     });
@@ -208,32 +243,48 @@ fn heightfield_pass_matches_its_cpu_reference() {
         (units[(r as u32 * w + c as u32) as usize] & 0xffff) as f32 / 65535.0
     };
     let mut worst = [0.0f32; 5];
+    // The moon as the prints on the plane see it, and how many texels would be lit otherwise had
+    // the pass not turned it (the case must see the turn).
+    let turned = slope.map_or(light, |g| {
+        glam::Quat::from_rotation_arc(Vec3::new(-g.x, 1.0, -g.y).normalize(), Vec3::Y) * light
+    });
+    let mut unturned_differs = 0;
+    let inner = |c: i32, r: i32| c > 0 && r > 0 && c < w as i32 - 1 && r < h as i32 - 1;
     for r in 0..h as i32 {
         for c in 0..w as i32 {
+            if slope.is_some() && !inner(c, r) {
+                continue;
+            }
             let gpu_texel = texel_at(&shape_bytes, c as u32, r as u32);
             let n = cpu::sobel_normal(d, c, r, depth, texel);
             let ao = cpu::horizon_ao(|dx, dz| {
                 let (oc, orow) = ((dx / texel.x).round() as i32, (dz / texel.y).round() as i32);
                 depth * (1.0 - d(c + oc, r + orow))
             });
-            let vis = cpu::light_visibility(
-                |x, z| {
-                    let (fx, fz) = (x / texel.x, z / texel.y);
-                    let (ix, iz) = (fx.floor(), fz.floor());
-                    let (wx, wz) = (fx - ix, fz - iz);
-                    let (x0, z0) = (c + ix as i32, r + iz as i32);
-                    let a = d(x0, z0) * (1.0 - wx) + d(x0 + 1, z0) * wx;
-                    let b = d(x0, z0 + 1) * (1.0 - wx) + d(x0 + 1, z0 + 1) * wx;
-                    depth * (1.0 - (a * (1.0 - wz) + b * wz))
-                },
-                0.0,
-                0.0,
-                light,
-                depth,
-                texel.x.max(texel.y),
-            );
+            let march = |l: Vec3| {
+                cpu::light_visibility(
+                    |x, z| {
+                        let (fx, fz) = (x / texel.x, z / texel.y);
+                        let (ix, iz) = (fx.floor(), fz.floor());
+                        let (wx, wz) = (fx - ix, fz - iz);
+                        let (x0, z0) = (c + ix as i32, r + iz as i32);
+                        let a = d(x0, z0) * (1.0 - wx) + d(x0 + 1, z0) * wx;
+                        let b = d(x0, z0 + 1) * (1.0 - wx) + d(x0 + 1, z0 + 1) * wx;
+                        depth * (1.0 - (a * (1.0 - wz) + b * wz))
+                    },
+                    0.0,
+                    0.0,
+                    l,
+                    depth,
+                    texel.x.max(texel.y),
+                )
+            };
+            let vis = march(turned);
             let gpu_light = texel_at(&lit_bytes, c as u32, r as u32);
             let gpu_vis = gpu_light[0];
+            if (march(light) - gpu_vis).abs() > 0.05 {
+                unturned_differs += 1;
+            }
             let displaced = cpu::displaced_fraction(
                 units[(r as u32 * w + c as u32) as usize] >> 16,
                 snowprint::Precision::Bits16,
@@ -256,6 +307,13 @@ fn heightfield_pass_matches_its_cpu_reference() {
         worst.iter().all(|&e| e < 2e-3),
         "worst |GPU - CPU| (depression, normal, AO, light, displaced): {worst:?}"
     );
+    if slope.is_some() {
+        eprintln!("{unturned_differs} texels would be lit otherwise without the turn");
+        assert!(
+            unturned_differs > 50,
+            "only {unturned_differs} texels see the moon turned by the slope"
+        );
+    }
 }
 
 /// A compute harness around snow.wgsl: analytic heightfields as the contract, every search and
@@ -272,8 +330,12 @@ struct Case {
 
 var<private> field: u32;
 const DEPTH: f32 = 0.3;
+const GROUND_SLOPE: f32 = 0.5;
 
 fn analytic_height(xz: vec2<f32>) -> f32 {
+    if field == 2u {
+        return DEPTH;
+    }
     if field == 0u {
         return 0.15 + 0.04 * xz.x;
     }
@@ -295,6 +357,14 @@ fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
 fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
     return 1.0;
 }
+// Field 2: untouched snow on ground that is a plane rising along x (GROUND_SLOPE metres a metre).
+fn snow_ground_base(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    if field != 2u {
+        return 0.0;
+    }
+    let xz = uv * 2.0 * s.half_size - s.half_size;
+    return GROUND_SLOPE * xz.x;
+}
 
 @compute @workgroup_size(64)
 fn search(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -308,6 +378,15 @@ fn search(@builtin(global_invocation_id) id: vec3<u32>) {
     s.snow_depth = DEPTH;
     s.texel = 0.04;
     s.search = vec4<f32>(0.5, 4.0, 12.0, 5.0);
+    // Flat ground, but for field 2: its plane spans -1 to 1 m over the 4 m of x.
+    s.terrain = 0xffffffffu;
+    s.terrain_low = 0.0;
+    s.terrain_top = DEPTH;
+    if field == 2u {
+        s.terrain = 0u;
+        s.terrain_low = -2.0 * GROUND_SLOPE;
+        s.terrain_top = 2.0 * GROUND_SLOPE + DEPTH;
+    }
     let o = c.origin.xyz;
     let d = c.dir.xyz;
     let exit = snow_slab_exit(s, o, d);
@@ -327,6 +406,51 @@ fn blend(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
+/// A ray through untouched snow 0.3 m deep on ground that is the plane `y = 0.5 x` (27 degrees):
+/// the snow top is `0.5 x + 0.3`, so the ray `o + t d` meets it (within the inside test's slack
+/// `SNOW_EPSILON`) at `t = (0.5 o.x + 0.3 + 1e-4 - o.y) / (d.y - 0.5 d.x)`, computed by hand. The
+/// slab's floor is the plane's lowest point (-1 m), its top the highest snow top (1.3 m). Relief
+/// mapping lands within its last bracket of it, POM (a secant on a plane is exact) within 1e-4.
+/// Returns whether the ray met the snow inside the slab (and was checked).
+fn on_a_sloped_ground(i: usize, ray: &cpu::SlabRay, g: &[f32], half: Vec2, depth: f32) -> bool {
+    let (o, d) = (ray.origin, ray.dir);
+    let t = (0.5 * o.x + depth + 1e-4 - o.y) / (d.y - 0.5 * d.x);
+    let p = o + d * t;
+    let inside = p.x.abs() <= half.x && p.z.abs() <= half.y;
+    // The slab's exit: the floor at -1 m or a side.
+    let floor = (o.y + 1.0) / -d.y;
+    let side = |o: f32, d: f32, h: f32| {
+        if d == 0.0 {
+            f32::MAX
+        } else {
+            (h * d.signum() - o) / d
+        }
+    };
+    let t_max = floor
+        .min(side(o.x, d.x, half.x))
+        .min(side(o.z, d.z, half.y));
+    assert!(
+        (g[4] - t_max).abs() < 1e-4,
+        "case {i}: exit {} vs {t_max}",
+        g[4]
+    );
+    if !inside {
+        return false;
+    }
+    let bracket = t_max / g[6] / 32.0 + 1e-4;
+    assert!(
+        g[1] == 1.0 && (g[0] - t).abs() <= bracket,
+        "case {i}: relief on the slope {} vs {t} by hand",
+        g[0]
+    );
+    assert!(
+        g[3] == 1.0 && (g[2] - t).abs() <= 1e-4,
+        "case {i}: POM on the slope {} vs {t} by hand",
+        g[2]
+    );
+    true
+}
+
 #[test]
 fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
     let gpu = common::gpu();
@@ -335,13 +459,16 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
     let depth = 0.3f32;
     // Rays entering the top over the plane and over the dent, in many directions.
     let mut cases: Vec<[f32; 8]> = Vec::new();
-    for field in 0..2 {
+    for field in 0..3 {
         for i in 0..48 {
             let a = std::f32::consts::TAU * i as f32 / 48.0;
             let down = 0.25 + 1.5 * ((i * 7) % 11) as f32 / 11.0;
             let dir = Vec3::new(a.cos(), -down, a.sin()).normalize();
             let origin = if field == 0 {
                 Vec3::new(-1.0 + 0.03 * i as f32, depth, 0.2)
+            } else if field == 2 {
+                // On the top face of the sloped slab (y = 1.3).
+                Vec3::new(-1.0 + 0.03 * i as f32, 1.0 + depth, 0.2)
             } else {
                 Vec3::new(0.25 + 0.002 * i as f32, depth, -0.15)
             };
@@ -473,11 +600,17 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
     let results: Vec<f32> = bytemuck::cast_slice(&read_buffer(&results_rb)).to_vec();
     let blended: Vec<f32> = bytemuck::cast_slice(&read_buffer(&blended_rb)).to_vec();
 
+    let mut sloped_hits = 0;
     for (i, c) in cases.iter().enumerate() {
         let ray = cpu::SlabRay {
             origin: Vec3::new(c[0], c[1], c[2]),
             dir: Vec3::new(c[4], c[5], c[6]),
         };
+        let g = &results[8 * i..8 * i + 8];
+        if c[3] == 2.0 {
+            sloped_hits += usize::from(on_a_sloped_ground(i, &ray, g, half, depth));
+            continue;
+        }
         let plane = c[3] == 0.0;
         let height = |p: Vec2| {
             if plane {
@@ -493,7 +626,6 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
         };
         let (t_max, ground) = cpu::slab_exit(&ray, half, depth);
         let taps = cpu::linear_taps(ray.dir, t_max, 0.04, 0.5, 4.0, 12.0);
-        let g = &results[8 * i..8 * i + 8];
         assert!(
             (g[4] - t_max).abs() < 1e-4 && (g[5] == 1.0) == ground,
             "case {i}: exit {g:?} vs {t_max} {ground}"
@@ -519,6 +651,11 @@ fn snow_wgsl_searches_and_rnm_match_their_cpu_references() {
             None => assert_eq!(g[3], 0.0, "case {i}: pom found a hit the CPU did not"),
         }
     }
+    eprintln!("sloped ground: {sloped_hits} of 48 rays met the snow and were checked by hand");
+    assert!(
+        sloped_hits >= 24,
+        "only {sloped_hits} rays met the sloped snow"
+    );
     for (k, (a, b)) in normals.iter().zip(normals.iter().rev()).enumerate() {
         let want = cpu::rnm(*a, *b);
         let got = Vec3::new(blended[4 * k], blended[4 * k + 1], blended[4 * k + 2]);

@@ -6,7 +6,7 @@
 // call the same functions on the same texel centres, so they write the same bits. The importer
 // declares `capture`, `tiles`, `tile_list` (read_write atomics) and `ground` (read).
 
-// import constants
+// import constants, ground_texel
 
 struct CaptureView {
     half_size: vec2<f32>,   // half the surface's sides, metres
@@ -40,7 +40,7 @@ fn ground_of(v: CaptureView, cell: vec2<u32>) -> vec2<f32> {
     if v.ground == NO_GROUND {
         return vec2<f32>(0.0);
     }
-    return ground[v.ground + cell.y * u32(v.texels.x) + cell.x];
+    return ground_texel(v.ground, u32(v.texels.x), cell.x, cell.y);
 }
 
 // Flag every tile holding a texel within one of `cell` (the blur's reach).

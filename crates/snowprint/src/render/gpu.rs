@@ -126,6 +126,16 @@ pub struct SurfaceUniform {
     pub grain: [f32; 4],
     /// Translucency (x: the sky tint of prints' walls and the diffuse wrap); yzw unused.
     pub translucency: [f32; 4],
+    /// First texel of the surface's ground field in [`crate::FrameView::ground_buffer`], or
+    /// [`crate::low_level::ground::NO_GROUND`] on flat ground.
+    pub terrain: u32,
+    /// Lowest base of the snow columns, local metres (0 on flat ground): the slab's floor.
+    pub terrain_low: f32,
+    /// Highest untouched snow top, local metres (the snow depth on flat ground): the slab's top
+    /// below the room for rims.
+    pub terrain_top: f32,
+    /// Padding.
+    pub terrain_pad: f32,
 }
 
 /// Room for rims above the snow top that the relief and POM tiers raise their slab by, metres:
@@ -218,6 +228,10 @@ impl SurfaceUniform {
                 1.0,
                 rim_room(&desc.material, desc.snow_depth),
             ],
+            terrain: surface.ground,
+            terrain_low: surface.ground_range.0,
+            terrain_top: surface.ground_range.1 + desc.snow_depth,
+            terrain_pad: 0.0,
         }
     }
 
@@ -259,8 +273,11 @@ pub struct ClassifyRecord {
     pub box_vertices: u32,
     /// Bits a channel of the pool's heightmaps.
     pub bits: u32,
+    /// 1 when the surface lies on ground that is not flat (always the deformable material: the
+    /// basic one draws a flat top), else 0.
+    pub terrain: u32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
@@ -281,8 +298,9 @@ pub struct HeightfieldParams {
     pub texel_x: f32,
     /// Texel side along z, metres.
     pub texel_z: f32,
-    /// Padding.
-    pub _pad2: f32,
+    /// First texel of the surface's ground field ([`crate::FrameView::ground_buffer`]), or
+    /// [`crate::low_level::ground::NO_GROUND`] on flat ground.
+    pub ground: u32,
     /// Unit direction towards the moon in the surface's local frame; w unused.
     pub light: [f32; 4],
 }
@@ -488,7 +506,11 @@ mod tests {
             albedo,
             disturbed,
             grain,
-            translucency
+            translucency,
+            terrain,
+            terrain_low,
+            terrain_top,
+            terrain_pad
         );
         for (source, name) in [
             (&engine, "snowprint_Surface"),

@@ -551,13 +551,19 @@ impl Renderer {
         self.frame.prepare(&self.queue, &uniform);
 
         let (device, queue) = (&self.device, &self.queue);
-        let pool = view.pool_buffer;
+        let (pool, ground) = (view.pool_buffer, view.ground_buffer);
         self.classify.prepare(device, queue, pool, &surfaces);
         let moon = frame.environment.moon_direction;
         self.heightfield
-            .prepare(device, queue, pool, &surfaces, moon);
-        self.snow
-            .prepare(device, queue, &self.config, &surfaces, &self.heightfield);
+            .prepare(device, queue, pool, ground, &surfaces, moon);
+        self.snow.prepare(
+            device,
+            queue,
+            &self.config,
+            &surfaces,
+            &self.heightfield,
+            ground,
+        );
         self.last_surfaces = surfaces.iter().map(|s| s.view.id).collect();
         let state = &self.classify.state.buffer;
         self.dice.prepare(
@@ -571,6 +577,7 @@ impl Renderer {
             self.geometry_version,
             &self.heightfield,
             state,
+            ground,
         )?;
         self.banks.prepare(
             device,
@@ -580,8 +587,14 @@ impl Renderer {
             &self.heightfield,
         );
         let uniforms = &self.snow.uniforms.buffer;
-        self.tess_surface
-            .prepare(device, &surfaces, uniforms, &self.heightfield, state);
+        self.tess_surface.prepare(
+            device,
+            &surfaces,
+            uniforms,
+            &self.heightfield,
+            state,
+            ground,
+        );
         self.meshes.prepare(device, queue, frame.instances);
         self.tonemap
             .prepare(device, &self.targets, format, self.config.supersample);

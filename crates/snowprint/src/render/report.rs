@@ -15,7 +15,7 @@ pub struct PassTime {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SnowMaterialKind {
-    /// The basic material: nothing has pressed the surface.
+    /// The basic material: nothing has pressed the surface, and it lies on flat ground.
     Basic,
     /// The deformable material.
     Deformable,

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
 
 use super::error::{RenderError, RenderResult};
-use super::gpu::{STATE_DEEPEST, STATE_TOUCHED, STATE_WORDS};
+use super::gpu::{STATE_DEEPEST, STATE_DEFORMABLE_DRAW, STATE_WORDS};
 use super::graph::PASSES;
 use super::readback::Timestamps;
 use super::report::{FrameReport, PassTime, SnowMaterialKind, SurfaceShading};
@@ -174,7 +174,9 @@ impl StatsReadback {
                     + (tessellate::ARGS_BASE + tessellate::ARGS_STRIDE * s as u64) as usize;
                 SurfaceShading {
                     surface: id,
-                    material: if word(base + STATE_TOUCHED as usize) == 0 {
+                    // The pipeline that draws it: the deformable one's instance count (a surface
+                    // on ground that is not flat takes it untouched).
+                    material: if word(base + STATE_DEFORMABLE_DRAW as usize + 1) == 0 {
                         SnowMaterialKind::Basic
                     } else {
                         SnowMaterialKind::Deformable

@@ -39,6 +39,10 @@ struct snowprint_Surface {
     disturbed: vec4<f32>,   // disturbed albedo, wet roughness
     grain: vec4<f32>,       // grain, sparkle, wetness, water depth (metres, 0: none)
     translucency: vec4<f32>, // translucency; y, z: the material's ground blend (0: the renderer's); w: room for rims above the top (m)
+    terrain: u32,           // first texel of the ground field (the renderer's), or 0xffffffff on flat ground
+    terrain_low: f32,       // lowest base of the snow columns (0 on flat ground)
+    terrain_top: f32,       // highest untouched snow top (the snow depth on flat ground)
+    terrain_pad: f32,
 }
 
 @group(0) @binding(0) var<storage, read> snowprint_pool: array<u32>;

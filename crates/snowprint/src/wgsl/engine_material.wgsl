@@ -1,6 +1,6 @@
 // engine_material.wgsl: the snow material (render/snow/snow.wgsl) with its heightfield contract
 // filled from the pool by engine.wgsl, for an engine that wants the material without deriving
-// heightfield textures (`wgsl::material_module`). Defines the three functions snow.wgsl calls:
+// heightfield textures (`wgsl::material_module`). Defines the four functions snow.wgsl calls:
 // `snow_depression` (one bilinear read of the pool), `snow_heightfield` (depression and the
 // normal by central differences; no ambient occlusion, so 1) and `snow_light_visibility` (no
 // shadow of the prints' walls, so 1). The snowprint renderer draws smoother normals and those two
@@ -16,7 +16,13 @@ fn snowprint_surface_of(s: SnowSurface) -> snowprint_Surface {
         s.ground, s.index, s.search, s.look, s.pattern,
         s.heights, s.row_words, s.bits, s.channel_max, s.width, s.height, s.texel_x, s.texel_z,
         s.albedo, s.disturbed, s.grain, s.translucency,
+        s.terrain, s.terrain_low, s.terrain_top, s.terrain_pad,
     );
+}
+
+// The engine module binds no ground field: the snow is drawn on flat ground.
+fn snow_ground_base(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    return 0.0;
 }
 
 fn snow_depression(s: SnowSurface, uv: vec2<f32>) -> f32 {

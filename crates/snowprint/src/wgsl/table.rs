@@ -35,6 +35,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("skin", "skin/skin.wgsl", true),
     // Ground meshes rasterised into surfaces' texels (`ground/`).
     ("ground_raster", "ground/raster.wgsl", true),
+    // Reading a surface's ground field (the capture and the renderer).
+    ("ground_texel", "ground/texel.wgsl", false),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe/probe.wgsl", true),
     // The renderer.

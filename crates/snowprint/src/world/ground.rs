@@ -16,6 +16,8 @@ pub(crate) struct SurfaceGround {
     pub field: GroundField,
     /// First texel in the ground buffer.
     pub offset: u32,
+    /// [`GroundField::range`], kept: the plan and the renderer read it every frame.
+    pub range: (f32, f32),
 }
 
 impl SurfaceGround {
@@ -23,7 +25,7 @@ impl SurfaceGround {
     pub fn plan(&self) -> PlanGround {
         PlanGround {
             offset: self.offset,
-            range: self.field.range(),
+            range: self.range,
         }
     }
 }
@@ -120,7 +122,11 @@ impl SnowWorld {
         self.surfaces[id.0 as usize]
             .as_mut()
             .expect("checked live above")
-            .ground = field.map(|field| super::ground::SurfaceGround { field, offset: 0 });
+            .ground = field.map(|field| SurfaceGround {
+            range: field.range(),
+            field,
+            offset: 0,
+        });
         self.upload_grounds();
         Ok(())
     }
@@ -128,6 +134,24 @@ impl SnowWorld {
     /// A surface's ground field (`None` on flat ground).
     pub fn ground(&self, id: SurfaceId) -> Result<Option<&GroundField>> {
         Ok(self.state(id)?.ground.as_ref().map(|g| &g.field))
+    }
+
+    /// Where a surface's ground lies for a renderer: `(first texel in [`Self::ground_buffer`],
+    /// lowest base, highest ground)`, local metres; `None` on flat ground.
+    pub fn ground_placement(&self, id: SurfaceId) -> Result<Option<(u32, f32, f32)>> {
+        Ok(self
+            .state(id)?
+            .ground
+            .as_ref()
+            .map(|g| (g.offset, g.range.0, g.range.1)))
+    }
+
+    /// Every surface's ground field, packed (`array<vec2<f32>>` in WGSL: `[base, bare]` per
+    /// texel, row after row from each surface's first texel), for renderers that draw the snow on
+    /// its ground. Read it through `ground_texel` (`ground/texel.wgsl`). Rewritten by
+    /// [`Self::set_ground`] only.
+    pub fn ground_buffer(&self) -> &wgpu::Buffer {
+        &self.grounds.buffer
     }
 
     /// Pack every live surface's field into the ground buffer, one after the other, and write it.

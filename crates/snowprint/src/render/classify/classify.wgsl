@@ -1,6 +1,7 @@
 // classify.wgsl: which snow material each surface needs this frame, decided on the GPU. A surface
 // whose heightmap is all zero (nothing ever pressed it, or the snow has filled every print back)
-// gets the basic material; any other the deformable one. The pass writes, per surface, the
+// gets the basic material; any other the deformable one, and so does every surface on ground that is
+// not flat (the basic material draws a flat top). The pass writes, per surface, the
 // indirect draw arguments of both snow pipelines (one of them with zero instances), the indirect
 // dispatch of its heightfield pass (zero workgroups when basic), and the flag the report reads.
 // Reads: the heightmap pool, the surface list. Writes: the surface state table.
@@ -14,7 +15,7 @@ struct ClassifyRecord {
     height: u32,
     box_vertices: u32,
     bits: u32,        // bits a channel (pool/texel.wgsl)
-    _pad0: u32,
+    terrain: u32,     // 1 on ground that is not flat
     _pad1: u32,
     _pad2: u32,
 }
@@ -43,19 +44,20 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
     if li == 0u {
         let d = atomicLoad(&deepest);
         let touched = select(0u, 1u, d > 0u);
+        let deformable = max(touched, rec.terrain);
         let base = wg.x * STATE_WORDS;
         // Basic material draw: vertex count, instance count, first vertex, first instance.
         state[base + 0u] = rec.box_vertices;
-        state[base + 1u] = 1u - touched;
+        state[base + 1u] = 1u - deformable;
         state[base + 2u] = 0u;
         state[base + 3u] = 0u;
         // Deformable material draw.
         state[base + 4u] = rec.box_vertices;
-        state[base + 5u] = touched;
+        state[base + 5u] = deformable;
         state[base + 6u] = 0u;
         state[base + 7u] = 0u;
         // Heightfield dispatch (8 x 8 workgroups).
-        state[base + 8u] = select(0u, (rec.width + 7u) / 8u, touched == 1u);
+        state[base + 8u] = select(0u, (rec.width + 7u) / 8u, deformable == 1u);
         state[base + 9u] = (rec.height + 7u) / 8u;
         state[base + 10u] = 1u;
         state[base + STATE_TOUCHED] = touched;

@@ -64,7 +64,8 @@ impl ClassifyPass {
                 height: s.view.layout.height,
                 box_vertices: BOX_VERTICES,
                 bits: s.view.precision.bits(),
-                _pad: [0; 3],
+                terrain: u32::from(s.view.ground != crate::capture::NO_GROUND),
+                _pad: [0; 2],
             })
             .collect();
         if n > 0 {

@@ -11,7 +11,7 @@
 // CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
 // displaced_fraction}.
 
-// import texel, constants
+// import texel, constants, ground_texel
 
 // Must match `HeightfieldParams` in src/render/gpu.rs.
 struct HeightfieldParams {
@@ -22,7 +22,7 @@ struct HeightfieldParams {
     snow_depth: f32,
     texel_x: f32,
     texel_z: f32,
-    _pad2: f32,
+    ground: u32,        // first texel of the ground field (ground_texel), or NO_GROUND
     light: vec4<f32>,   // xyz: unit direction towards the moon in the surface's local frame
 }
 
@@ -30,6 +30,8 @@ struct HeightfieldParams {
 @group(0) @binding(1) var<uniform> params: HeightfieldParams;
 @group(0) @binding(2) var out_texture: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(3) var out_light: texture_storage_2d<rgba16float, write>;
+// The world's ground fields; this surface's starts at `params.ground`.
+@group(0) @binding(4) var<storage, read> ground: array<vec2<f32>>;
 
 // Must match AO_RADII in cpu.rs (PENUMBRA_*, LIGHT_TAPS and AO_DIRECTIONS: constants.wgsl).
 const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
@@ -70,10 +72,40 @@ fn height_bilinear(c: i32, r: i32, dx: f32, dz: f32) -> f32 {
     return params.snow_depth * (1.0 - mix(a, b, wz));
 }
 
-// Must match `light_visibility` in cpu.rs.
-fn light_visibility(c: i32, r: i32) -> f32 {
+// Base of the snow column at a texel, clamped to the grid (on ground that is not flat).
+fn ground_base(c: i32, r: i32) -> f32 {
+    let x = u32(clamp(c, 0, i32(params.width) - 1));
+    let y = u32(clamp(r, 0, i32(params.height) - 1));
+    return ground_texel(params.ground, params.width, x, y).x;
+}
+
+// The moon as the prints at a texel see it: on flat ground the surface's own direction; on ground
+// that is not flat the direction turned by the rotation that takes the ground's normal there
+// (central differences of the base) to local up, so that the walls of a print on a slope shadow
+// its floor as they would on flat ground lit from the same angle to the slope.
+fn light_at(c: i32, r: i32) -> vec3<f32> {
     let l = params.light.xyz;
+    if params.ground == NO_GROUND {
+        return l;
+    }
+    let gx = (ground_base(c + 1, r) - ground_base(c - 1, r)) / (2.0 * params.texel_x);
+    let gz = (ground_base(c, r + 1) - ground_base(c, r - 1)) / (2.0 * params.texel_z);
+    let n = normalize(vec3<f32>(-gx, 1.0, -gz));
+    // Rotation taking n to +y: R v = v + k x v + k x (k x v) / (1 + n.y), k = n x y.
+    let k = cross(n, vec3<f32>(0.0, 1.0, 0.0));
+    let kv = cross(k, l);
+    return normalize(l + kv + cross(k, kv) / (1.0 + n.y));
+}
+
+// Must match `light_visibility` in cpu.rs (which takes the light `light_at` gives).
+fn light_visibility(c: i32, r: i32) -> f32 {
+    let l = light_at(c, r);
     if l.y <= 0.02 {
+        // Below the horizon of flat ground: no moon. Where a slope turns away from it, the
+        // lighting's N.L (and its wrap) darkens the snow; the prints' walls add nothing.
+        if params.ground != NO_GROUND {
+            return 1.0;
+        }
         return 0.0;
     }
     let h0 = height_bilinear(c, r, 0.0, 0.0);

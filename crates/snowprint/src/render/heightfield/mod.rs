@@ -110,6 +110,7 @@ impl HeightfieldPass {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         pool: &wgpu::Buffer,
+        ground: &wgpu::Buffer,
         surfaces: &[FrameSurface<'_>],
         moon_direction: Vec3,
     ) {
@@ -126,7 +127,7 @@ impl HeightfieldPass {
                 snow_depth: desc.snow_depth,
                 texel_x: desc.size.x / layout.width as f32,
                 texel_z: desc.size.y / layout.height as f32,
-                _pad2: 0.0,
+                ground: surface.view.ground,
                 light: {
                     let l = local_to_world
                         .inverse()
@@ -165,6 +166,7 @@ impl HeightfieldPass {
                         ),
                         wgpu::BindingResource::TextureView(&tex.shape),
                         wgpu::BindingResource::TextureView(&tex.light),
+                        ground.as_entire_binding(),
                     ],
                 )
             })

@@ -19,6 +19,10 @@ fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
     return 1.0;
 }
 
+fn snow_ground_base(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    return 0.0;
+}
+
 // Must match `MeshMaterial` in src/render/mod.rs.
 const MATERIAL_PLAIN: u32 = 0u;
 const MATERIAL_BRICK: u32 = 1u;

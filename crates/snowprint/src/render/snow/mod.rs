@@ -74,8 +74,8 @@ impl SnowPass {
         }
     }
 
-    /// Upload each surface's uniform (transform, grid, ground, search, look and its material's look) and bind it with
-    /// its heightfield textures.
+    /// Upload each surface's uniform (transform, grid, ground, search, look and its material's
+    /// look) and bind it with its heightfield textures and the world's ground fields.
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -83,6 +83,7 @@ impl SnowPass {
         cfg: &RenderConfig,
         surfaces: &[FrameSurface<'_>],
         heightfields: &HeightfieldPass,
+        ground: &wgpu::Buffer,
     ) {
         let search = cfg.search_settings();
         let look = cfg.look;
@@ -122,6 +123,7 @@ impl SnowPass {
                         wgpu::BindingResource::TextureView(&tex.shape),
                         wgpu::BindingResource::TextureView(&tex.light),
                         wgpu::BindingResource::TextureView(&tex.bank),
+                        ground.as_entire_binding(),
                     ],
                 ))
             })

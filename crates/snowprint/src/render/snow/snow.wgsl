@@ -20,12 +20,17 @@
 //   // How much of the moon reaches the snow at `uv` past the walls of the prints (1 = all), or
 //   // 1.0 if you have no such term. Called once per pixel.
 //   fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32
+//   // The base of the snow column at `uv` (local y, metres; the snow top is the base plus the
+//   // snow depth, less the depression): 0.0 on flat ground. Called by the search with
+//   // `snow_depression`. A renderer without ground fields returns 0.0 (wgsl/engine_material.wgsl).
+//   fn snow_ground_base(s: SnowSurface, uv: vec2<f32>) -> f32
 //
 // UVs run 0..1 across the surface: u along local +x, v along local +z (texel column 0 / row 0 at the
 // smallest x / z, as the heightmap pool stores them). The snowprint renderer fills all three from
 // textures that `heightfield.wgsl` derives from the pool each frame.
 //
-// Then, per pixel of the box drawn for a surface (top face at y = snow_top(s), the snow depth raised by any room for rims, sides down to y = 0,
+// Then, per pixel of the box drawn for a surface (top face at y = snow_top(s), the highest snow top raised by any room for rims, sides down to
+// y = s.terrain_low, 0 on flat ground,
 // in the surface's local frame; `tier` SNOW_TIER_RELIEF or SNOW_TIER_POM, `light_local` the unit
 // direction towards the light in the local frame, `pixel` the pixel's footprint in metres):
 //   let hit = snow_trace(s, local_position, local_view_direction, tier, light_local);
@@ -69,12 +74,19 @@ struct SnowSurface {
     disturbed: vec4<f32>,   // xyz: disturbed albedo at the bottom of prints, w: wet roughness
     grain: vec4<f32>,       // x: grain, y: sparkle, z: wetness, w: water depth below the top (m, 0: none)
     translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), y: depression where the material's ground starts to show (0: look.x's), z: where it shows fully, w: room for rims above the snow top (m, 0: none)
+    // The ground under the snow (ground/mod.rs): where its field lies, and the slab it spans.
+    terrain: u32,           // first texel of the ground field, or SNOW_NO_GROUND on flat ground
+    terrain_low: f32,       // lowest base of the snow columns, local y (0 on flat ground)
+    terrain_top: f32,       // highest untouched snow top, local y (the snow depth on flat ground)
+    terrain_pad: f32,
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
 const SNOW_GROUND_CONCRETE: u32 = 1u;
 const SNOW_TIER_RELIEF: u32 = 0u;
 const SNOW_TIER_POM: u32 = 1u;
+// `terrain` of a surface on flat ground. Must match NO_GROUND in wgsl/constants.wgsl.
+const SNOW_NO_GROUND: u32 = 0xffffffffu;
 // Slack of the inside test, metres. Must match `INSIDE_EPSILON` in cpu.rs.
 const SNOW_EPSILON: f32 = 1e-4;
 const SNOW_PI: f32 = 3.14159265;
@@ -189,16 +201,29 @@ fn snow_uv(s: SnowSurface, xz: vec2<f32>) -> vec2<f32> {
     return (xz + s.half_size) / (2.0 * s.half_size);
 }
 
-// Top of the slab the view ray is traced through: the snow top, raised by the room for rims
-// (`translucency.w`, metres) where the material throws them (their banks are in
-// `snow_depression`).
+// Top of the slab the view ray is traced through: the highest snow top (the snow depth on flat
+// ground), raised by the room for rims (`translucency.w`, metres) where the material throws them
+// (their banks are in `snow_depression`).
 fn snow_top(s: SnowSurface) -> f32 {
-    return s.snow_depth + s.translucency.w;
+    return s.terrain_top + s.translucency.w;
 }
 
-// Snow height above the ground at a local (x, z), metres.
+// The untouched snow top over a local (x, z), raised by the room for rims: `snow_top` of the
+// column there.
+fn snow_local_top(s: SnowSurface, xz: vec2<f32>) -> f32 {
+    return snow_ground_base(s, snow_uv(s, xz)) + s.snow_depth + s.translucency.w;
+}
+
+// Snow height at a local (x, z), metres: above the ground on flat ground, the column's base plus
+// what is left of the depth on ground that is not flat. (On flat ground the base is not read, so
+// the search is exactly the flat one.)
 fn snow_height(s: SnowSurface, xz: vec2<f32>) -> f32 {
-    return s.snow_depth * (1.0 - snow_depression(s, snow_uv(s, xz)));
+    let uv = snow_uv(s, xz);
+    let h = s.snow_depth * (1.0 - snow_depression(s, uv));
+    if s.terrain == SNOW_NO_GROUND {
+        return h;
+    }
+    return snow_ground_base(s, uv) + h;
 }
 
 fn snow_inside(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t: f32) -> bool {
@@ -206,13 +231,13 @@ fn snow_inside(s: SnowSurface, o: vec3<f32>, d: vec3<f32>, t: f32) -> bool {
     return p.y <= snow_height(s, p.xz) + SNOW_EPSILON;
 }
 
-// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, 0 <= y <= snow_top(s):
+// Where the ray leaves the slab |x| <= half.x, |z| <= half.y, terrain_low <= y <= snow_top(s):
 // (t, 1 when it reaches the ground first). Must match `slab_exit` in cpu.rs.
 fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     var t = 3.0e38;
     var ground = 0.0;
     if d.y < 0.0 {
-        t = o.y / -d.y;
+        t = (o.y - s.terrain_low) / -d.y;
         ground = 1.0;
     } else if d.y > 0.0 {
         t = (snow_top(s) - o.y) / d.y;
@@ -319,7 +344,7 @@ fn snow_self_shadow(s: SnowSurface, p: vec3<f32>, l: vec3<f32>, taps: u32) -> f3
         return 1.0;
     }
     let start = p + vec3<f32>(0.0, 0.5 * s.texel, 0.0);
-    let t_top = (snow_top(s) - start.y) / l.y;
+    let t_top = (snow_local_top(s, p.xz) - start.y) / l.y;
     if t_top <= 0.0 {
         return 1.0;
     }
@@ -344,7 +369,7 @@ fn snow_water_level(s: SnowSurface) -> f32 {
 // Trace the view ray entering the surface's box at local `o` with unit local direction `d`.
 fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_local: vec3<f32>) -> SnowHit {
     // The rasterized point can lie a hair outside the box: pull it in.
-    let o = clamp(o_in, vec3<f32>(-s.half_size.x, 0.0, -s.half_size.y), vec3<f32>(s.half_size.x, snow_top(s), s.half_size.y));
+    let o = clamp(o_in, vec3<f32>(-s.half_size.x, s.terrain_low, -s.half_size.y), vec3<f32>(s.half_size.x, snow_top(s), s.half_size.y));
     var hit: SnowHit;
     hit.shadow = 1.0;
     hit.side = 0u;
@@ -362,13 +387,29 @@ fn snow_trace(s: SnowSurface, o_in: vec3<f32>, d: vec3<f32>, tier: u32, light_lo
     hit.found = u32(r.y);
     hit.position = o + d * r.x;
     hit.water = 0u;
-    if r.x == 0.0 && o.y < s.snow_depth - 1e-3 {
+    // The base under the entry and under the hit (0 on flat ground, where it is not read).
+    var base_o = 0.0;
+    var base_hit = 0.0;
+    if s.terrain != SNOW_NO_GROUND {
+        base_o = snow_ground_base(s, snow_uv(s, o.xz));
+        base_hit = snow_ground_base(s, snow_uv(s, hit.position.xz));
+    }
+    if r.x == 0.0 && o.y < base_o + s.snow_depth - 1e-3 {
         hit.side = 1u;
+        // A side face below the column's base cuts through the ground, not the snow: nothing of
+        // the snow's to draw there.
+        if o.y < base_o {
+            hit.found = 0u;
+        }
     }
     // Water: a hit below the water table lies in a print deeper than it; the view ray met the
     // flat water surface first, where it crossed the level (in the air over the print, since the
-    // search found no material before the hit).
-    let level = snow_water_level(s);
+    // search found no material before the hit). On ground that is not flat the table lies over
+    // the column under the hit.
+    var level = snow_water_level(s);
+    if level >= 0.0 {
+        level += base_hit;
+    }
     if hit.found == 1u && hit.side == 0u && hit.position.y < level && d.y < 0.0 {
         hit.t = max((level - o.y) / d.y, 0.0);
         hit.position = o + d * hit.t;

@@ -1,13 +1,14 @@
 // surface.wgsl: the snow pass. Each surface is drawn as the box of its snow slab (top face at
 // y = snow_depth, raised by the room for rims where the material throws them, four sides down to
-// the ground) in its local frame; every fragment of the
+// the ground; on ground that is not flat, from the lowest base of its columns to the highest snow
+// top, and always with the deformable material) in its local frame; every fragment of the
 // deformable material traces its view ray through the heightfield (snow.wgsl) and writes the depth
 // of the point it hits, so characters standing in prints and bodies lying in trenches are hidden
 // and shown correctly.
-// Reads: frame uniforms, shadow map, the surface's heightfield texture (heightfield.wgsl).
-// Writes: scene colour (HDR) and depth.
+// Reads: frame uniforms, shadow map, the surface's heightfield texture (heightfield.wgsl), the
+// world's ground fields. Writes: scene colour (HDR) and depth.
 
-// import frame, snow
+// import frame, snow, ground_texel
 
 @group(1) @binding(0) var<uniform> surface: SnowSurface;
 @group(1) @binding(1) var heightfield: texture_2d<f32>;
@@ -15,6 +16,9 @@
 // Bank heights (metres, .x; banks.wgsl): the tessellated tier's banks, and the rims of materials
 // that throw them (`translucency.w` > 0) in the relief and POM tiers.
 @group(1) @binding(3) var bank_texture: texture_2d<f32>;
+// The world's ground fields, `[base, bare]` per texel (read through `ground_texel`); the surface's
+// field starts at `surface.terrain`, unread on flat ground.
+@group(1) @binding(4) var<storage, read> ground: array<vec2<f32>>;
 
 // Set when the device cannot filter Rgba16Float: bilinear filtering is then done by hand.
 override MANUAL_FILTER: bool = false;
@@ -30,8 +34,8 @@ fn box_vertex(i: u32, rim_room: f32) -> array<vec3<f32>, 2> {
     let a = corner * 2.0 - 1.0;
     let hx = surface.half_size.x;
     let hz = surface.half_size.y;
-    let top = surface.snow_depth + rim_room;
-    let y = corner.y * top;
+    let top = surface.terrain_top + rim_room;
+    let y = surface.terrain_low + corner.y * (top - surface.terrain_low);
     var p: vec3<f32>;
     var n: vec3<f32>;
     switch face {
@@ -137,6 +141,43 @@ fn sample_bilinear(uv: vec2<f32>) -> vec4<f32> {
     return textureSampleLevel(heightfield, linear_sampler, uv, 0.0);
 }
 
+fn ground_column(c: vec2<i32>) -> vec2<f32> {
+    let t = clamp(c, vec2<i32>(0), vec2<i32>(surface.grid) - 1);
+    return ground_texel(surface.terrain, surface.width, u32(t.x), u32(t.y));
+}
+
+// (base, bare) of the ground field at uv, bilinear between texel centres (as the heightmap);
+// (0, 0) on flat ground.
+fn ground_at_uv(uv: vec2<f32>) -> vec2<f32> {
+    if surface.terrain == SNOW_NO_GROUND {
+        return vec2<f32>(0.0);
+    }
+    let p = uv * surface.grid - 0.5;
+    let i = floor(p);
+    let f = p - i;
+    let c = vec2<i32>(i);
+    let a = mix(ground_column(c), ground_column(c + vec2<i32>(1, 0)), f.x);
+    let b = mix(ground_column(c + vec2<i32>(0, 1)), ground_column(c + vec2<i32>(1, 1)), f.x);
+    return mix(a, b, f.y);
+}
+
+// Slope of the columns' base at uv (metres per metre along local x and z): the untouched snow
+// top's, central differences a texel apart.
+fn ground_gradient(uv: vec2<f32>) -> vec2<f32> {
+    let du = vec2<f32>(1.0 / surface.grid.x, 0.0);
+    let dv = vec2<f32>(0.0, 1.0 / surface.grid.y);
+    let step = 2.0 * surface.half_size / surface.grid;
+    return vec2<f32>(
+        (ground_at_uv(uv + du).x - ground_at_uv(uv - du).x) / (2.0 * step.x),
+        (ground_at_uv(uv + dv).x - ground_at_uv(uv - dv).x) / (2.0 * step.y),
+    );
+}
+
+// The heightfield contract of snow.wgsl: the base of the snow column.
+fn snow_ground_base(s: SnowSurface, uv: vec2<f32>) -> f32 {
+    return ground_at_uv(uv).x;
+}
+
 // The heightfield contract of snow.wgsl, for the search: one bilinear tap of the smoothed
 // depression. (A smoothstep remap of the weights would remove the creases at texel boundaries,
 // but its flat spots at texel centres pull the rims of deep pits onto the texel grid.) Where the
@@ -231,13 +272,44 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
         let n = normalize(vec3<f32>(-g.x, 1.0, -g.y));
         hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
     }
-    let m = snow_deformable(surface, hit, hf, in.face, sky_tint(), pixel);
+    var at = hit;
+    if surface.terrain != SNOW_NO_GROUND {
+        let on = on_ground(hit, hf, uv);
+        at = on.hit;
+        hf = on.hf;
+    }
+    let m = snow_deformable(surface, at, hf, in.face, sky_tint(), pixel);
     let c = deformable_view(shade(m, hit.position, hit.shadow, pixel), m, hf.x, f32(hit.taps) / 48.0);
     var out: SnowOut;
     out.color = vec4<f32>(c, 1.0);
     let world = surface.local_to_world * vec4<f32>(hit.position, 1.0);
     let clip = frame.view_proj * world;
     out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
+    return out;
+}
+
+struct OnGround {
+    hit: SnowHit,
+    hf: vec4<f32>,
+}
+
+// The material is written for snow on flat ground; on ground that is not flat, give it the hit and
+// the heightfield as they are measured from the ground under the hit: the hit's height above the
+// ground scaled to a whole depth (a slope that holds a fraction k of the depth is pressed through
+// at a depression of k, so the ground shows there), the depression as a fraction of the snow the
+// column holds, and the heightfield's normal reoriented onto the ground's (RNM), so prints follow
+// the slope. The hit's true position stays the caller's for lighting and depth.
+fn on_ground(hit: SnowHit, hf_in: vec4<f32>, uv: vec2<f32>) -> OnGround {
+    let g = ground_at_uv(uv);
+    let d = surface.snow_depth;
+    let held = max(d - g.y, 1e-3 * d) / d;
+    var out: OnGround;
+    out.hit = hit;
+    out.hit.position.y = (hit.position.y - g.x - g.y) / held;
+    let base_n = snow_normal_from_gradient(ground_gradient(uv));
+    let hn = vec3<f32>(hf_in.y, hf_in.z, sqrt(max(1.0 - hf_in.y * hf_in.y - hf_in.z * hf_in.z, 0.0)));
+    let n = snow_rnm(base_n, hn);
+    out.hf = vec4<f32>(hf_in.x / held, n.x, n.y, hf_in.w);
     return out;
 }
 

@@ -344,11 +344,11 @@ pub struct DiceParams {
     pub eye: [f32; 4],
     /// Target edge pixels, max level, shortest segment (metres), detail floor.
     pub settings: [f32; 4],
-    /// Snow depth, reach above the snow top, unused, unused.
+    /// Snow depth, reach above the snow top, the ground field's lowest base and highest ground.
     pub extent: [f32; 4],
     /// Heightfield width and height, surface slot, base triangles.
     pub grid: [u32; 4],
-    /// Vertex capacity, index capacity, unused, unused.
+    /// Vertex capacity, index capacity, first texel of the ground field (or `NO_GROUND`), unused.
     pub capacity: [u32; 4],
     /// Half the surface's sides; zw unused.
     pub half_size: [f32; 4],

@@ -5,7 +5,8 @@
 //      and the moon's near shadow cascade (snow just out of view still shadows what is in it);
 //   2. a level per edge, a function of the edge alone (its endpoints in a canonical order, lower
 //      vertex id first): projected length in pixels over the target, scaled by the relief of the
-//      heightfield along the edge (finer where there are prints and banks), at most one segment
+//      heightfield along the edge (finer where there are prints and banks) and by how much the
+//      ground field bends along it (finer over hills, not on a plane), at most one segment
 //      per half texel and MAX level;
 //   3. an inner level N = max(edge levels, 3): a uniform lattice of level N inside, whose outermost
 //      ring is replaced by three strips stitched between each edge's own points and the inner
@@ -17,20 +18,21 @@
 // Vertices (two vec4 each: local position with the base height and a kind; the skirt's outward
 // normal) and indices are appended with atomic counters; `seal` then writes the surface's
 // indexed indirect draw. Displacement happens in the vertex stage (tess_surface.wgsl).
-// Reads: dice params, base triangles, the heightfield and bank textures, the surface state.
+// Reads: dice params, base triangles, the heightfield and bank textures, the surface state, the
+// ground fields.
 // Writes: diced vertices, indices, counters and the surface's draw arguments.
 // CPU reference of the topology: render::tessellate::cpu::dice_triangle.
 
-// import constants
+// import constants, ground_texel
 
 // Must match `DiceParams` in src/render/tessellate/mod.rs.
 struct DiceParams {
     local_to_clip: mat4x4<f32>,
     eye: vec4<f32>,          // xyz: the camera in the surface's local frame; w: pixels per radian
     settings: vec4<f32>,     // x: target edge length in pixels, y: max level, z: shortest segment (m), w: detail floor
-    extent: vec4<f32>,       // x: snow depth, y: how far above the snow top banks and waves reach, zw: unused
+    extent: vec4<f32>,       // x: snow depth, y: how far above the snow top banks and waves reach, z: lowest base of the ground field, w: its highest ground (both 0 on flat ground)
     grid: vec4<u32>,         // xy: heightfield size, z: surface slot, w: base triangles
-    capacity: vec4<u32>,     // x: vertex capacity, y: index capacity
+    capacity: vec4<u32>,     // x: vertex capacity, y: index capacity, z: first texel of the ground field (NO_GROUND on flat ground)
     half_size: vec4<f32>,    // xy: half the surface's sides
     local_to_shadow: mat4x4<f32>, // surface-local to the moon's near shadow cascade
 }
@@ -58,6 +60,8 @@ const KIND_SKIRT_BOTTOM: f32 = 2.0;
 @group(0) @binding(5) var<storage, read_write> vertices: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> indices: array<u32>;
 @group(0) @binding(7) var<storage, read_write> counters: array<atomic<u32>>;
+// The world's ground fields (`ground_texel`); this surface's starts at `dice.capacity.z`.
+@group(0) @binding(8) var<storage, read> ground: array<vec2<f32>>;
 
 var<workgroup> levels: array<u32, 3>;
 var<workgroup> inner_level: u32;
@@ -67,6 +71,27 @@ var<workgroup> keep: u32;
 
 fn touched() -> bool {
     return state[dice.grid.z * STATE_WORDS + STATE_TOUCHED] != 0u;
+}
+
+// Base of the snow column at a local (x, z), nearest texel (on ground that is not flat).
+fn ground_base(xz: vec2<f32>) -> f32 {
+    let size = vec2<i32>(dice.grid.xy);
+    let uv = (xz + dice.half_size.xy) / (2.0 * dice.half_size.xy);
+    let t = clamp(vec2<i32>(floor(uv * vec2<f32>(size))), vec2<i32>(0), size - 1);
+    return ground_texel(dice.capacity.z, dice.grid.x, u32(t.x), u32(t.y)).x;
+}
+
+// How far the ground bends away from the straight line between an edge's ends (a plane needs no
+// more than its ends; hills do), as a fraction of a quarter of the snow depth, at most 1.
+fn ground_bend(p0: vec3<f32>, p1: vec3<f32>) -> f32 {
+    let g0 = ground_base(p0.xz);
+    let g1 = ground_base(p1.xz);
+    var bend = 0.0;
+    for (var i = 1u; i < DETAIL_SAMPLES; i++) {
+        let f = f32(i) / f32(DETAIL_SAMPLES);
+        bend = max(bend, abs(ground_base(edge_point(p0, p1, i, DETAIL_SAMPLES).xz) - mix(g0, g1, f)));
+    }
+    return clamp(bend / (0.25 * dice.extent.x), 0.0, 1.0);
 }
 
 // Snow height (metres above the base) at a local (x, z), nearest texel: depression and banks.
@@ -88,7 +113,9 @@ fn edge_point(p0: vec3<f32>, p1: vec3<f32>, k: u32, level: u32) -> vec3<f32> {
 // Level of the edge p0 -> p1 (p0 the endpoint with the lower id): a function of the edge alone.
 fn edge_level(p0: vec3<f32>, p1: vec3<f32>) -> u32 {
     let len = distance(p0, p1);
-    let mid = 0.5 * (p0 + p1) + vec3<f32>(0.0, dice.extent.x, 0.0);
+    // On ground that is not flat the snow lies somewhere in the field's range: its middle stands
+    // for it (the level stays a function of the edge alone).
+    let mid = 0.5 * (p0 + p1) + vec3<f32>(0.0, dice.extent.x + 0.5 * (dice.extent.z + dice.extent.w), 0.0);
     let dist = max(distance(mid, dice.eye.xyz), 1e-3);
     // Projected length by the distance to the middle: robust for edges behind the camera.
     let pixels = len / dist * dice.eye.w;
@@ -103,6 +130,9 @@ fn edge_level(p0: vec3<f32>, p1: vec3<f32>) -> u32 {
             hi = max(hi, h);
         }
         detail = clamp((hi - lo) / (0.25 * dice.extent.x), 0.0, 1.0);
+    }
+    if dice.capacity.z != NO_GROUND {
+        detail = max(detail, ground_bend(p0, p1));
     }
     let want = pixels / dice.settings.x * mix(dice.settings.w, 1.0, detail);
     let finest = len / dice.settings.z;
@@ -225,11 +255,12 @@ fn is_border(t: BaseTriangle, e: u32) -> bool {
     return (t.ids.w & (1u << e)) != 0u;
 }
 
-// Whether the box of the triangle (from its base up to the highest snow) is outside both the view
+// Whether the box of the triangle (from its base up to the highest snow, widened by the ground
+// field's range) is outside both the view
 // and the near shadow cascade: then it neither shows nor shadows anything that shows.
 fn culled(t: BaseTriangle) -> bool {
-    let lo = min(min(t.a.xyz, t.b.xyz), t.c.xyz);
-    let hi = max(max(t.a.xyz, t.b.xyz), t.c.xyz) + vec3<f32>(0.0, dice.extent.x + dice.extent.y, 0.0);
+    let lo = min(min(t.a.xyz, t.b.xyz), t.c.xyz) + vec3<f32>(0.0, dice.extent.z, 0.0);
+    let hi = max(max(t.a.xyz, t.b.xyz), t.c.xyz) + vec3<f32>(0.0, dice.extent.x + dice.extent.y + dice.extent.w, 0.0);
     return outside(dice.local_to_clip, lo, hi) && outside(dice.local_to_shadow, lo, hi);
 }
 

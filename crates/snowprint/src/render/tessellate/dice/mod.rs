@@ -101,6 +101,7 @@ impl DicePass {
         geometry_version: u64,
         heightfields: &HeightfieldPass,
         state: &wgpu::Buffer,
+        ground: &wgpu::Buffer,
     ) -> RenderResult<()> {
         let n = surfaces.len();
         self.counters.ensure(device, counters_bytes(n));
@@ -141,15 +142,16 @@ impl DicePass {
                     0.5 * texel.min_element(),
                     cfg.dice.detail_floor,
                 ],
-                // Banks stay below the snow depth in practice; waves reach 5 cm at most.
+                // Banks stay below the snow depth in practice; waves reach 5 cm at most. The
+                // ground field's range widens the box (0, 0 on flat ground).
                 extent: [
                     desc.snow_depth,
                     desc.snow_depth + 0.05 * g.macro_waves,
-                    0.0,
-                    0.0,
+                    surface.view.ground_range.0,
+                    surface.view.ground_range.1,
                 ],
                 grid: [layout.width, layout.height, s as u32, base.triangles],
-                capacity: [vertex_capacity, index_capacity, 0, 0],
+                capacity: [vertex_capacity, index_capacity, surface.view.ground, 0],
                 half_size: [half.x, half.y, 0.0, 0.0],
                 local_to_shadow: (Mat4::from_cols_array_2d(&uniform.shadow_near) * local_to_world)
                     .to_cols_array_2d(),
@@ -180,6 +182,7 @@ impl DicePass {
                     self.vertices.buffer.as_entire_binding(),
                     self.indices.buffer.as_entire_binding(),
                     self.counters.buffer.as_entire_binding(),
+                    ground.as_entire_binding(),
                 ],
             );
             self.bind_groups.push(Some((group, base.triangles)));

@@ -81,8 +81,8 @@ impl TessSurface {
         }
     }
 
-    /// Bind each diced surface's uniform (in the snow pass's `surfaces` buffer), textures and
-    /// state.
+    /// Bind each diced surface's uniform (in the snow pass's `surfaces` buffer), textures, the
+    /// world's ground fields and the surface state.
     pub(crate) fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -90,6 +90,7 @@ impl TessSurface {
         uniforms: &wgpu::Buffer,
         heightfields: &HeightfieldPass,
         state: &wgpu::Buffer,
+        ground: &wgpu::Buffer,
     ) {
         let tv = wgpu::BindingResource::TextureView;
         self.bind_groups = surfaces
@@ -109,6 +110,7 @@ impl TessSurface {
                         tv(&tex.shape),
                         tv(&tex.light),
                         tv(&tex.bank),
+                        ground.as_entire_binding(),
                         state.as_entire_binding(),
                     ],
                 ))

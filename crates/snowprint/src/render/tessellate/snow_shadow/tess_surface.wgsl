@@ -6,18 +6,20 @@
 // has water (mud) and a print is deeper than its water depth, the top is the flat water surface at
 // the water table instead, so the water is real geometry (in the shadow map too) and the fragment
 // stage shades it as the relief tier's water: a mirror of the sky. Skirt vertices at the base stay
-// there. The fragment stage shades the real surface with the deformable material
+// there. On ground that is not flat every vertex, skirts included, is lifted by the base of the
+// snow column under it (the ground field, `ground_at_uv`): the snow, its prints and banks follow
+// the slope, and the skirts close the cut down to the ground. The fragment stage shades the real surface with the deformable material
 // (snow.wgsl) without any search: the heightmap's normal tilted by the banks' slope, RNM detail,
 // the heightmap's AO, and the moon's shadow from the shadow map, which holds this same displaced
 // geometry (vs_tess_shadow), so trails shadow themselves and characters' shadows bend into them.
-// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-3 of group 1 (the
-// bank texture and `bank_height` included) and its heightfield contract are reused.
+// Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-4 of group 1 (the
+// bank texture and `bank_height`, the ground fields and `ground_at_uv` included) and its heightfield contract are reused.
 // Reads: frame uniforms, shadow map, the surface's heightfield, light and bank textures, the
 // surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade.
 
 // import surface
 
-@group(1) @binding(4) var<storage, read> surface_state: array<u32>;
+@group(1) @binding(5) var<storage, read> surface_state: array<u32>;
 
 // Mean of snow_macro_height over a large area, taken out so the waves move the snow both ways.
 const MACRO_MEAN: f32 = 0.025;
@@ -73,6 +75,9 @@ fn tess_local(v: TessVertex) -> vec3<f32> {
     if v.position.w < 1.5 {
         p.y += tess_snow_height(p.xz);
     }
+    if surface.terrain != SNOW_NO_GROUND {
+        p.y += ground_at_uv(snow_uv(surface, p.xz)).x;
+    }
     return p;
 }
 
@@ -106,7 +111,9 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
     if in.outward.w > 0.5 {
         // A skirt: the cut through the snow at an open edge, as the relief tier's box sides.
         let face = normalize(vec3<f32>(in.outward.x, 0.0, in.outward.z));
-        m = snow_basic(surface, in.local, face, sky_tint(), pixel);
+        var cut = in.local;
+        cut.y -= ground_at_uv(snow_uv(surface, in.local.xz)).x;
+        m = snow_basic(surface, cut, face, sky_tint(), pixel);
     } else {
         let uv = snow_uv(surface, in.local.xz);
         // The snow top's slope: the base mesh's (a pitched roof), plus the heightmap's and the
@@ -116,6 +123,13 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
             hf = snow_heightfield(surface, uv);
             let ny = max(sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)), 1e-3);
             g += vec2<f32>(-hf.y, -hf.z) / ny + bank_gradient(uv);
+        }
+        if surface.terrain != SNOW_NO_GROUND {
+            // The ground's slope under the snow; the stages see the depression as a fraction of
+            // the snow the column holds (as the relief tier's `on_ground`).
+            g += ground_gradient(uv);
+            let d = surface.snow_depth;
+            hf.x /= max(d - ground_at_uv(uv).y, 1e-3 * d) / d;
         }
         let n = normalize(vec3<f32>(-g.x, 1.0, -g.y));
         hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
