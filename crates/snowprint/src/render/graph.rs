@@ -198,7 +198,8 @@ pub const PASSES: [PassInfo; 12] = [
     },
     PassInfo {
         name: "tonemap",
-        kind: PassKind::Render,
+        // A raster pass only for a caller's view that cannot be a storage texture.
+        kind: PassKind::Compute,
         reads: &[R::FrameUniforms, R::SceneColor, R::SceneDepth],
         writes: &[R::Output],
     },

@@ -583,8 +583,13 @@ impl Renderer {
         self.tess_surface
             .prepare(device, &surfaces, uniforms, &self.heightfield, state);
         self.meshes.prepare(device, queue, frame.instances);
-        self.tonemap
-            .prepare(device, &self.targets, format, self.config.supersample);
+        self.tonemap.prepare(
+            device,
+            &self.targets,
+            target,
+            format,
+            self.config.supersample,
+        );
 
         // The table sets the order: pass `slot` of PASSES is recorded `slot`-th.
         let flakes = uniform.options[3];

@@ -1,8 +1,12 @@
 //! The frame's render targets: the supersampled HDR colour and depth the passes draw into, and
 //! the offscreen output with its readback buffer.
 
-/// Format of the offscreen output ([`Renderer::render`](super::Renderer::render)).
-pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// Format of the offscreen output ([`Renderer::render`](super::Renderer::render)): RGBA8 whose
+/// bytes are sRGB encoded by the tonemap itself, stored as `Rgba8Unorm` so that its compute pass
+/// can write it as a storage texture (an sRGB format cannot be one). A caller's view of this
+/// format made with `STORAGE_BINDING` is written by the compute pass too; any other view by the
+/// raster fallback.
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub(super) const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -56,7 +60,7 @@ impl Targets {
             width,
             height,
             OUTPUT_FORMAT,
-            U::RENDER_ATTACHMENT | U::COPY_SRC,
+            U::STORAGE_BINDING | U::RENDER_ATTACHMENT | U::COPY_SRC,
         );
         let padded_row = (width * 4).div_ceil(256) * 256;
         let readback = device.create_buffer(&wgpu::BufferDescriptor {

@@ -1,0 +1,109 @@
+//! The renderer's passes moved to compute, against what they replace: the tonemap's compute pass
+//! against its raster fallback (bit for bit on the same `Rgba8Unorm` output; within one unit of
+//! the sRGB render target the raster pass wrote before, which the driver encodes itself).
+
+mod common;
+mod golden_scene;
+mod golden_support;
+
+use golden_scene::{lights, overview_camera, scene};
+use snowprint::render::{OUTPUT_FORMAT, Tier};
+
+/// Render the overview into a texture of the caller's (`render_to_view`) and read its bytes back.
+fn render_into(
+    scene: &mut golden_scene::Scene,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> Vec<u8> {
+    let gpu = common::gpu();
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let (w, h) = (golden_scene::WIDTH, golden_scene::HEIGHT);
+    let target = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("caller's view"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: usage | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = target.create_view(&Default::default());
+    let instances = scene.instances.clone();
+    let lights = lights();
+    let frame = golden_scene::frame(&scene.surfaces, overview_camera(), &instances, &lights);
+    scene
+        .renderer
+        .render_to_view(&scene.world, &frame, &view, format)
+        .expect("render to view");
+    let row = (w * 4).div_ceil(256) * 256;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("view readback"),
+        size: (row * h) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        target.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        target.size(),
+    );
+    queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |r| r.expect("map"));
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+    let data = slice.get_mapped_range().expect("mapped");
+    (0..h as usize)
+        .flat_map(|y| data[y * row as usize..][..w as usize * 4].to_vec())
+        .collect()
+}
+
+/// The compute tonemap writes what its raster fallback writes into the same `Rgba8Unorm` output,
+/// byte for byte: the maths are one module (`resolve.wgsl`), only the way the pixel is written
+/// differs. Against an sRGB render target (what the tonemap wrote before it moved to compute,
+/// and still writes into a window's sRGB surface), where the driver encodes the linear value
+/// itself, no byte differs by more than one unit.
+#[test]
+fn the_compute_tonemap_writes_what_the_raster_tonemap_writes() {
+    let mut scene = scene();
+    scene.renderer.set_tier(Tier::Relief);
+    use wgpu::TextureUsages as U;
+    let compute = render_into(&mut scene, OUTPUT_FORMAT, U::STORAGE_BINDING);
+    let offscreen = golden_scene::render(&mut scene, Tier::Relief).rgba8;
+    assert!(compute == offscreen, "render_to_view and render differ");
+    let raster = render_into(&mut scene, OUTPUT_FORMAT, U::RENDER_ATTACHMENT);
+    let differing = compute.iter().zip(&raster).filter(|(a, b)| a != b).count();
+    assert_eq!(
+        differing, 0,
+        "bytes differing between compute and raster on Rgba8Unorm"
+    );
+    let srgb = render_into(
+        &mut scene,
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+        U::RENDER_ATTACHMENT,
+    );
+    let mut off_by_one = 0;
+    for (a, b) in compute.iter().zip(&srgb) {
+        let d = (*a as i32 - *b as i32).abs();
+        assert!(d <= 1, "compute {a} against the sRGB target's {b}");
+        off_by_one += usize::from(d == 1);
+    }
+    eprintln!(
+        "compute against the sRGB render target: {off_by_one} of {} bytes differ by one unit",
+        compute.len()
+    );
+}
