@@ -1,13 +1,16 @@
 //! The renderer's passes moved to compute, against what they replace: the tonemap's compute pass
 //! against its raster fallback (bit for bit on the same `Rgba8Unorm` output; within one unit of
-//! the sRGB render target the raster pass wrote before, which the driver encodes itself).
+//! the sRGB render target the raster pass wrote before, which the driver encodes itself); the
+//! opaque meshes through the visibility buffer against the forward path, by NVIDIA FLIP within
+//! the bounds of the goldens (`tests/golden/tolerances.toml`), and against the goldens themselves.
 
 mod common;
 mod golden_scene;
 mod golden_support;
 
-use golden_scene::{lights, overview_camera, scene};
-use snowprint::render::{OUTPUT_FORMAT, Tier};
+use golden_scene::{lights, overview_camera, render_golden_view, scene, scene_with};
+use golden_support::{check, diff_dir, rgb, save_png, tolerance};
+use snowprint::render::{OUTPUT_FORMAT, OpaquePath, RenderOutput, Tier};
 
 /// Render the overview into a texture of the caller's (`render_to_view`) and read its bytes back.
 fn render_into(
@@ -106,4 +109,49 @@ fn the_compute_tonemap_writes_what_the_raster_tonemap_writes() {
         "compute against the sRGB render target: {off_by_one} of {} bytes differ by one unit",
         compute.len()
     );
+}
+
+/// FLIP of `test` against `reference`: mean and weighted 99th percentile.
+fn flip(reference: &RenderOutput, test: &RenderOutput) -> (f64, f64) {
+    let (w, h) = (reference.width, reference.height);
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(w, h, &rgb(&reference.rgba8)),
+        nv_flip::FlipImageRgb8::with_data(w, h, &rgb(&test.rgba8)),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let pool = nv_flip::FlipPool::from_image(&error);
+    (pool.mean() as f64, pool.get_weighted_percentile(0.99))
+}
+
+/// The opaque meshes through the visibility buffer (depth and (instance, triangle) rasterised, the
+/// shading in compute) against the forward path, in every golden view of the scene: bricks, the
+/// ball, the bodies and their shadows, the lantern. The bound is each golden's own
+/// (`tolerances.toml`, the one in force on this driver), and the visibility renders pass the
+/// goldens themselves too. The pixels the two paths light differently are counted.
+#[test]
+fn the_visibility_buffer_draws_what_the_forward_path_draws() {
+    let mut forward = scene();
+    let mut visibility = scene_with(|c| c.opaque = OpaquePath::Visibility);
+    for name in ["relief", "relief_grazing", "tessellated"] {
+        let a = render_golden_view(&mut forward, name);
+        let b = render_golden_view(&mut visibility, name);
+        let (mean, p99) = flip(&a, &b);
+        let differing = a.rgba8.iter().zip(&b.rgba8).filter(|(x, y)| x != y).count();
+        let tol = tolerance(name);
+        eprintln!(
+            "{name}: visibility against forward FLIP mean {mean:.5} (max {}), p99 {p99:.5} (max {}), {differing} of {} bytes differ",
+            tol.mean,
+            tol.p99,
+            a.rgba8.len()
+        );
+        if mean > tol.mean || p99 > tol.p99 || std::env::var_os("SNOWPRINT_SAVE").is_some() {
+            save_png(&diff_dir().join(format!("{name}-forward.png")), &a);
+            save_png(&diff_dir().join(format!("{name}-visibility.png")), &b);
+        }
+        assert!(
+            mean <= tol.mean && p99 <= tol.p99,
+            "{name}: the visibility path scores FLIP mean {mean} p99 {p99} against the forward path"
+        );
+        check(name, &b);
+    }
 }

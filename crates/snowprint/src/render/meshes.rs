@@ -5,7 +5,7 @@ use glam::{Mat3, Vec3};
 
 use super::error::{RenderError, RenderResult};
 use super::geometry;
-use super::gpu::InstanceRaw;
+use super::gpu::{InstanceRaw, MeshVertexRaw};
 use super::inputs::{Instance, RenderMeshId};
 use crate::gpu::resources::Growable;
 use crate::mesh::Mesh;
@@ -13,8 +13,11 @@ use crate::mesh::Mesh;
 pub(super) struct GpuMesh {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
-    index_count: u32,
+    pub index_count: u32,
     pub radius: f32,
+    /// The vertices and indices uploaded, kept for the visibility path's one buffer of every
+    /// mesh (`opaque::geometry`).
+    pub source: (Vec<MeshVertexRaw>, Vec<u32>),
 }
 
 /// Draws of one mesh: its index and a range of instances.
@@ -27,6 +30,10 @@ pub(super) struct MeshSet {
     /// This frame's draws: every instance, then the shadow casters.
     draws: Vec<Run>,
     shadow_draws: Vec<Run>,
+    /// The mesh of each instance of `draws`, in the instance buffer's order.
+    pub instance_meshes: Vec<u32>,
+    /// Counts the changes to `meshes` (the visibility path rebuilds its buffers on a change).
+    pub version: u64,
 }
 
 impl MeshSet {
@@ -36,11 +43,16 @@ impl MeshSet {
             instances: Growable::new(
                 device,
                 "mesh instances",
-                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                // Storage too: the visibility path reads the instances in its own passes.
+                wgpu::BufferUsages::VERTEX
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 144 * 64,
             ),
             draws: Vec::new(),
             shadow_draws: Vec::new(),
+            instance_meshes: Vec::new(),
+            version: 0,
         }
     }
 
@@ -48,6 +60,7 @@ impl MeshSet {
     pub(super) fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
         let gpu = upload(device, mesh)?;
         self.meshes.push(gpu);
+        self.version += 1;
         Ok(RenderMeshId(self.meshes.len() as u32 - 1))
     }
 
@@ -62,6 +75,7 @@ impl MeshSet {
             return Err(RenderError::StaleMesh { index: id.0 });
         }
         self.meshes[id.0 as usize] = upload(device, mesh)?;
+        self.version += 1;
         Ok(())
     }
 
@@ -110,6 +124,7 @@ impl MeshSet {
             out
         };
         self.draws = runs(&order, 0);
+        self.instance_meshes = order.iter().map(|&i| frame[i].mesh.0).collect();
         self.shadow_draws = runs(&casters, order.len() as u32);
         if !instances.is_empty() {
             self.instances
@@ -126,6 +141,19 @@ impl MeshSet {
             &self.draws
         }
         .is_empty()
+    }
+
+    /// The instance buffer (all of the frame's instances first, in `instance_meshes`' order).
+    pub(super) fn instance_buffer(&self) -> &wgpu::Buffer {
+        &self.instances.buffer
+    }
+
+    /// Draw every instance without vertex or index buffers: `index_count` vertices an instance,
+    /// which the pipeline pulls from storage (the visibility path).
+    pub(super) fn draw_pulled(&self, p: &mut wgpu::RenderPass<'_>) {
+        for (mesh, range) in &self.draws {
+            p.draw(0..self.meshes[*mesh as usize].index_count, range.clone());
+        }
     }
 
     /// Draw the frame's instances (`shadow`: the shadow casters) with the pass's pipeline and
@@ -163,5 +191,6 @@ fn upload(device: &wgpu::Device, mesh: &Mesh) -> RenderResult<GpuMesh> {
         }),
         index_count: indices.len() as u32,
         radius: mesh.bounding_radius(),
+        source: (vertices, indices),
     })
 }

@@ -103,7 +103,7 @@ use tessellate::banks::BanksPass;
 use tessellate::dice::DicePass;
 use tessellate::snow_shadow::TessSurface;
 
-pub use config::{DebugView, RenderConfig, SearchSettings, SnowLook, Tier};
+pub use config::{DebugView, OpaquePath, RenderConfig, SearchSettings, SnowLook, Tier};
 pub use error::{RenderError, RenderResult};
 pub use graph::{PASSES, PassInfo, PassKind, Resource};
 pub use inputs::{Environment, Instance, MeshMaterial, PointLight, RenderFrame, RenderMeshId};
@@ -206,14 +206,20 @@ impl Renderer {
                 &frame.shadow_layout,
                 filterable,
             ),
-            opaque: opaque::OpaquePass::new(&device, &mesh_module, &frame.layout),
+            opaque: opaque::OpaquePass::new(&device, &mesh_module, &frame.layout, config.opaque),
             snow: snow::SnowPass::new(&device, &frame.layout, filterable),
             sky: sky::SkyPass::new(&device, &frame.layout),
             snowfall: snowfall::SnowfallPass::new(&device, &frame.layout),
             spray: spray::SprayPass::new(&device, &frame.layout),
             tonemap: tonemap::TonemapPass::new(&device, &frame.layout),
             meshes: meshes::MeshSet::new(&device),
-            targets: Targets::new(&device, config.width, config.height, config.supersample),
+            targets: Targets::new(
+                &device,
+                config.width,
+                config.height,
+                config.supersample,
+                config.opaque == OpaquePath::Visibility,
+            ),
             timestamps: gpu
                 .caps
                 .timestamps
@@ -310,7 +316,13 @@ impl Renderer {
         };
         config.validate(&self.device)?;
         self.config = config;
-        self.targets = Targets::new(&self.device, width, height, supersample);
+        self.targets = Targets::new(
+            &self.device,
+            width,
+            height,
+            supersample,
+            config.opaque == OpaquePath::Visibility,
+        );
         Ok(())
     }
 
@@ -583,6 +595,8 @@ impl Renderer {
         self.tess_surface
             .prepare(device, &surfaces, uniforms, &self.heightfield, state);
         self.meshes.prepare(device, queue, frame.instances);
+        self.opaque
+            .prepare(device, queue, &self.meshes, &self.targets);
         self.tonemap.prepare(
             device,
             &self.targets,
@@ -635,6 +649,7 @@ impl Renderer {
             pass::OPAQUE => self
                 .opaque
                 .encode(encoder, ts, slot, targets, frame, &self.meshes),
+            pass::OPAQUE_SHADE => self.opaque.encode_shade(encoder, ts, slot, frame),
             pass::SNOW => self.snow.encode(
                 encoder,
                 ts,

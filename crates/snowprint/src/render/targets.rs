@@ -9,12 +9,16 @@
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The visibility buffer: instance and triangle.
+pub(super) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 pub(super) const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) struct Targets {
     pub size: (u32, u32),
     pub color_view: wgpu::TextureView,
     pub depth_view: wgpu::TextureView,
+    /// The visibility buffer (only on `OpaquePath::Visibility`).
+    pub visibility_view: Option<wgpu::TextureView>,
     pub output: wgpu::Texture,
     pub output_view: wgpu::TextureView,
     pub readback: wgpu::Buffer,
@@ -22,7 +26,15 @@ pub(super) struct Targets {
 }
 
 impl Targets {
-    pub(super) fn new(device: &wgpu::Device, width: u32, height: u32, supersample: u32) -> Self {
+    /// The targets of a `width` x `height` output drawn `supersample` times larger, with a
+    /// visibility buffer when `visibility`.
+    pub(super) fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        supersample: u32,
+        visibility: bool,
+    ) -> Self {
         let texture = |label, w, h, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -46,8 +58,19 @@ impl Targets {
             iw,
             ih,
             HDR_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+            // Storage: the visibility buffer's shading writes it from compute.
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING,
         );
+        let visibility_view = visibility.then(|| {
+            texture(
+                "visibility",
+                iw,
+                ih,
+                VISIBILITY_FORMAT,
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+            )
+            .create_view(&Default::default())
+        });
         let depth = texture(
             "scene depth",
             iw,
@@ -73,6 +96,7 @@ impl Targets {
             size: (width, height),
             color_view: color.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
+            visibility_view,
             output_view: output.create_view(&Default::default()),
             output,
             readback,
