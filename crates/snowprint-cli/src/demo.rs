@@ -13,7 +13,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use snowprint::render::{DebugView, RenderConfig, RenderFrame, Renderer, SurfaceShading, Tier};
+use snowprint::render::{
+    DebugView, OpaquePath, RenderConfig, RenderFrame, Renderer, SurfaceShading, Tier,
+};
 use snowprint::{GpuContext, GpuOptions, SnowWorld, WorldConfig};
 
 use snowprint_demo::scene::{DemoScene, build_scene};
@@ -62,6 +64,10 @@ pub struct Args {
     /// tessellated (real displaced geometry diced on the GPU, banks, the snow in the shadow map).
     #[arg(long, default_value = "relief")]
     pub tier: Tier,
+    /// How opaque meshes are drawn: forward (shaded per fragment) or visibility (a visibility
+    /// buffer of depth and triangle ids, shaded in a compute pass).
+    #[arg(long, default_value = "forward")]
+    pub opaque: OpaquePath,
     /// Samples per pixel along each axis, 1 to 4 (default: 2 on a GPU, 1 on a software adapter).
     #[arg(long, allow_negative_numbers = true)]
     pub supersample: Option<u32>,
@@ -240,6 +246,7 @@ impl Settings {
         let mut config = RenderConfig::new(self.width, self.height, args.tier);
         config.supersample = self.supersample;
         config.debug_view = args.debug_view;
+        config.opaque = args.opaque;
         if self.software {
             config.snowflakes = 3000;
         } else {
@@ -320,6 +327,7 @@ struct Measured {
     last_surfaces: Vec<SurfaceShading>,
     last_overflow: u32,
     instances_count: usize,
+    culled_last: usize,
     mp4: bool,
 }
 
@@ -368,6 +376,7 @@ impl Demo<'_> {
             last_surfaces: Vec::new(),
             last_overflow: 0,
             instances_count: 0,
+            culled_last: 0,
             mp4: false,
         };
         for (k, &t) in clip.times.iter().enumerate() {
@@ -414,6 +423,7 @@ impl Demo<'_> {
             }
             m.last_surfaces = out.surfaces.clone();
             m.last_overflow = out.dice_overflow;
+            m.culled_last = out.culled_instances;
             let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
                 .ok_or("the renderer returned a frame of the wrong size")?;
             if args.compare_tiers && k + 1 == clip.times.len() {
@@ -548,12 +558,14 @@ impl Demo<'_> {
             "supersample": settings.supersample,
             "frames": settings.frames,
             "tier": args.tier,
+            "opaque": args.opaque,
             "camera": args.camera,
             "debug_view": args.debug_view,
             "scene": self.scene.name(),
             "clip_seconds": [clip.t0, clip.t1],
             "simulation_hz": settings.sim_hz,
             "instances_last_frame": m.instances_count,
+            "instances_culled_last_frame": m.culled_last,
             "search": renderer.config().search_settings(),
             "passes": renderer.passes(),
             "gpu_pass_times_ms": gpu_times,
@@ -587,6 +599,7 @@ mod tests {
             size: Some((64, 36)),
             camera: "closeup".into(),
             tier: Tier::Pom,
+            opaque: OpaquePath::Forward,
             supersample: Some(1),
             debug_view: DebugView::Shaded,
             no_snowfall: false,

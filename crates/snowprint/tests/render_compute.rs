@@ -155,3 +155,27 @@ fn the_visibility_buffer_draws_what_the_forward_path_draws() {
         check(name, &b);
     }
 }
+
+/// Instances outside the view's frustum are culled from the opaque pass and change no pixel: the
+/// overview with a second ball behind the camera and one far to the side draws the overview's
+/// bytes, and reports both culled.
+#[test]
+fn instances_out_of_view_are_culled_and_change_nothing() {
+    let mut scene = scene();
+    let plain = golden_scene::render(&mut scene, Tier::Relief);
+    assert_eq!(
+        plain.culled_instances, 0,
+        "every instance of the overview is in view"
+    );
+    let ball = scene.instances[1];
+    let moved = |to: glam::Vec3| snowprint::render::Instance {
+        transform: glam::Mat4::from_translation(to),
+        casts_shadow: false,
+        ..ball
+    };
+    scene.instances.push(moved(glam::Vec3::new(0.6, 5.0, 8.0)));
+    scene.instances.push(moved(glam::Vec3::new(40.0, 2.0, 0.0)));
+    let out = golden_scene::render(&mut scene, Tier::Relief);
+    assert_eq!(out.culled_instances, 2);
+    assert!(out.rgba8 == plain.rgba8, "culled instances changed pixels");
+}

@@ -3,6 +3,7 @@
 
 use glam::{Mat3, Vec3};
 
+use super::cull;
 use super::error::{RenderError, RenderResult};
 use super::geometry;
 use super::gpu::{InstanceRaw, MeshVertexRaw};
@@ -32,6 +33,8 @@ pub(super) struct MeshSet {
     shadow_draws: Vec<Run>,
     /// The mesh of each instance of `draws`, in the instance buffer's order.
     pub instance_meshes: Vec<u32>,
+    /// Instances of the frame outside the view, not drawn by the opaque pass.
+    pub culled: usize,
     /// Counts the changes to `meshes` (the visibility path rebuilds its buffers on a change).
     pub version: u64,
 }
@@ -52,6 +55,7 @@ impl MeshSet {
             draws: Vec::new(),
             shadow_draws: Vec::new(),
             instance_meshes: Vec::new(),
+            culled: 0,
             version: 0,
         }
     }
@@ -79,16 +83,29 @@ impl MeshSet {
         Ok(())
     }
 
-    /// Upload the frame's instances: all of them grouped by mesh, then the shadow casters grouped
-    /// by mesh.
+    /// Upload the frame's instances: those the view may see (`cull::visible` against
+    /// `view_proj`) grouped by mesh, then every shadow caster grouped by mesh (a caster out of
+    /// view can shadow what is in it).
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         frame: &[Instance],
+        view_proj: glam::Mat4,
     ) {
+        let radii = frame
+            .iter()
+            .map(|i| (i.transform, self.meshes[i.mesh.0 as usize].radius));
+        let visible = cull::visible(view_proj, radii);
         let mut order: Vec<usize> = (0..frame.len()).collect();
         order.sort_by_key(|&i| frame[i].mesh.0);
+        let casters: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&i| frame[i].casts_shadow)
+            .collect();
+        order.retain(|&i| visible[i]);
+        self.culled = frame.len() - order.len();
         let raw = |inst: &Instance| {
             let normal = Mat3::from_mat4(inst.transform).inverse().transpose();
             let c = |v: Vec3| [v.x, v.y, v.z, 0.0];
@@ -105,11 +122,6 @@ impl MeshSet {
             }
         };
         let mut instances: Vec<InstanceRaw> = order.iter().map(|&i| raw(&frame[i])).collect();
-        let casters: Vec<usize> = order
-            .iter()
-            .copied()
-            .filter(|&i| frame[i].casts_shadow)
-            .collect();
         instances.extend(casters.iter().map(|&i| raw(&frame[i])));
         let runs = |ids: &[usize], first: u32| {
             let mut out: Vec<Run> = Vec::new();

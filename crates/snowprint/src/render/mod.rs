@@ -64,6 +64,7 @@ mod cascades;
 mod classify;
 mod config;
 pub(crate) mod cpu;
+mod cull;
 mod error;
 mod frame;
 pub(crate) mod geometry;
@@ -410,6 +411,7 @@ impl Renderer {
             dice_overflow: report.dice_overflow,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
             cpu_encode_ms,
+            culled_instances: self.meshes.culled,
         })
     }
 
@@ -594,7 +596,9 @@ impl Renderer {
         let uniforms = &self.snow.uniforms.buffer;
         self.tess_surface
             .prepare(device, &surfaces, uniforms, &self.heightfield, state);
-        self.meshes.prepare(device, queue, frame.instances);
+        let view_proj = glam::Mat4::from_cols_array_2d(&uniform.view_proj);
+        self.meshes
+            .prepare(device, queue, frame.instances, view_proj);
         self.opaque
             .prepare(device, queue, &self.meshes, &self.targets);
         self.tonemap.prepare(

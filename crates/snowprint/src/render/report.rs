@@ -84,4 +84,7 @@ pub struct RenderOutput {
     /// CPU time to build the frame and submit it (every pass's tables written and its commands
     /// recorded), milliseconds: what a frame costs the CPU when nothing is read back.
     pub cpu_encode_ms: f64,
+    /// Instances of the frame outside the view's frustum, not drawn by the opaque pass (shadow
+    /// casters among them still cast).
+    pub culled_instances: usize,
 }
