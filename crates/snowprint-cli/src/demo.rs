@@ -328,6 +328,7 @@ struct Measured {
     last_overflow: u32,
     instances_count: usize,
     culled_last: usize,
+    shadow_last: snowprint::render::ShadowStats,
     mp4: bool,
 }
 
@@ -377,6 +378,7 @@ impl Demo<'_> {
             last_overflow: 0,
             instances_count: 0,
             culled_last: 0,
+            shadow_last: Default::default(),
             mp4: false,
         };
         for (k, &t) in clip.times.iter().enumerate() {
@@ -424,6 +426,7 @@ impl Demo<'_> {
             m.last_surfaces = out.surfaces.clone();
             m.last_overflow = out.dice_overflow;
             m.culled_last = out.culled_instances;
+            m.shadow_last = out.shadow;
             let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
                 .ok_or("the renderer returned a frame of the wrong size")?;
             if args.compare_tiers && k + 1 == clip.times.len() {
@@ -566,6 +569,7 @@ impl Demo<'_> {
             "simulation_hz": settings.sim_hz,
             "instances_last_frame": m.instances_count,
             "instances_culled_last_frame": m.culled_last,
+            "shadow_last_frame": m.shadow_last,
             "search": renderer.config().search_settings(),
             "passes": renderer.passes(),
             "gpu_pass_times_ms": gpu_times,

@@ -179,3 +179,33 @@ fn instances_out_of_view_are_culled_and_change_nothing() {
     assert_eq!(out.culled_instances, 2);
     assert!(out.rgba8 == plain.rgba8, "culled instances changed pixels");
 }
+
+/// Shadow casters are drawn only into the cascades whose box they reach: in the overview every
+/// instance (three, all casting) lies within the near cascade's 12 m square around the view's
+/// focus; a fourth caster 40 m to the side is out of view and out of the near cascade but in the
+/// far one, which is fitted around every caster. The goldens (checked elsewhere with the same
+/// culling) keep every shadow the scene casts.
+#[test]
+fn casters_are_culled_per_cascade() {
+    let mut scene = scene();
+    let out = golden_scene::render(&mut scene, Tier::Relief);
+    assert_eq!(out.shadow.casters, [3, 3]);
+    let far_away = snowprint::render::Instance {
+        transform: glam::Mat4::from_translation(glam::Vec3::new(40.0, 2.0, 0.0)),
+        ..scene.instances[1]
+    };
+    scene.instances.push(far_away);
+    let out = golden_scene::render(&mut scene, Tier::Relief);
+    assert_eq!(out.culled_instances, 1);
+    assert_eq!(out.shadow.casters, [3, 4]);
+    // 12 m over the 1024 texels of the scene's shadow map; the view's pixel at the focus (4.8 m
+    // ahead, 52 degrees over 144 rows) is 2 * 4.8 * tan(26 degrees) / 144 = 0.0325 m.
+    assert!((out.shadow.texel_m[0] - 12.0 / 1024.0).abs() < 1e-6);
+    let pixel = 2.0 * 4.8 * 26f32.to_radians().tan() / 144.0;
+    assert!(
+        (out.shadow.view_pixel_m - pixel).abs() < 1e-6,
+        "{:?}",
+        out.shadow
+    );
+    eprintln!("{:?}", out.shadow);
+}

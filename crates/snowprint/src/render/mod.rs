@@ -108,7 +108,9 @@ pub use config::{DebugView, OpaquePath, RenderConfig, SearchSettings, SnowLook, 
 pub use error::{RenderError, RenderResult};
 pub use graph::{PASSES, PassInfo, PassKind, Resource};
 pub use inputs::{Environment, Instance, MeshMaterial, PointLight, RenderFrame, RenderMeshId};
-pub use report::{FrameReport, PassTime, RenderOutput, SnowMaterialKind, SurfaceShading};
+pub use report::{
+    FrameReport, PassTime, RenderOutput, ShadowStats, SnowMaterialKind, SurfaceShading,
+};
 pub use targets::OUTPUT_FORMAT;
 pub use tessellate::{
     BankSettings, DiceSettings, DicedKind, DicedMesh, DicedVertex, SurfaceFields, SurfaceGeometry,
@@ -161,6 +163,8 @@ pub struct Renderer {
     timestamps: Option<Timestamps>,
     stats: StatsReadback,
     latest: Option<FrameReport>,
+    /// The latest frame's shadow cascades.
+    shadow_stats: ShadowStats,
 }
 
 impl std::fmt::Debug for Renderer {
@@ -233,6 +237,7 @@ impl Renderer {
             default_geometry: SurfaceGeometry::default(),
             last_surfaces: Vec::new(),
             latest: None,
+            shadow_stats: ShadowStats::default(),
             queue: gpu.queue.clone(),
             device,
             config,
@@ -412,6 +417,7 @@ impl Renderer {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
             cpu_encode_ms,
             culled_instances: self.meshes.culled,
+            shadow: self.shadow_stats,
         })
     }
 
@@ -597,8 +603,18 @@ impl Renderer {
         self.tess_surface
             .prepare(device, &surfaces, uniforms, &self.heightfield, state);
         let view_proj = glam::Mat4::from_cols_array_2d(&uniform.view_proj);
-        self.meshes
-            .prepare(device, queue, frame.instances, view_proj);
+        self.meshes.prepare(
+            device,
+            queue,
+            frame.instances,
+            view_proj,
+            [shadow.near, shadow.far],
+        );
+        self.shadow_stats = ShadowStats {
+            casters: self.meshes.cascade_casters,
+            texel_m: [shadow.near_texel, shadow.far_texel],
+            view_pixel_m: cascades::view_pixel(frame, self.config.height * self.config.supersample),
+        };
         self.opaque
             .prepare(device, queue, &self.meshes, &self.targets);
         self.tonemap.prepare(

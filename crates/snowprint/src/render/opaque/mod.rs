@@ -10,7 +10,7 @@ mod visibility;
 
 use super::config::OpaquePath;
 use super::graph::PASSES;
-use super::meshes::MeshSet;
+use super::meshes::{DrawSet, MeshSet};
 use super::readback::{Timestamps, compute_pass, render_writes};
 use super::targets::Targets;
 use super::{gpu, pipeline};
@@ -110,10 +110,10 @@ impl OpaquePass {
             Some(clear_depth),
             render_writes(ts, slot),
         );
-        if meshes.has_draws(false) {
+        if meshes.has_draws(DrawSet::Opaque) {
             p.set_pipeline(&self.pipeline);
             p.set_bind_group(0, frame, &[]);
-            meshes.draw(&mut p, false);
+            meshes.draw(&mut p, DrawSet::Opaque);
         }
     }
 }

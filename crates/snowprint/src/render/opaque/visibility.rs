@@ -4,7 +4,7 @@
 //! forward path's shading function.
 
 use super::super::graph::PASSES;
-use super::super::meshes::MeshSet;
+use super::super::meshes::{DrawSet, MeshSet};
 use super::super::pipeline;
 use super::super::readback::{Timestamps, compute_pass, render_writes};
 use super::super::targets::{HDR_FORMAT, Targets, VISIBILITY_FORMAT};
@@ -148,7 +148,7 @@ impl VisibilityPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let (true, Some((groups, _))) = (meshes.has_draws(false), &self.current) {
+        if let (true, Some((groups, _))) = (meshes.has_draws(DrawSet::Opaque), &self.current) {
             p.set_pipeline(&self.raster);
             p.set_bind_group(0, frame, &[]);
             p.set_bind_group(1, &groups[0], &[]);
