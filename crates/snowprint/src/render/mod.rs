@@ -8,12 +8,13 @@
 //! | `classify` (compute) | heightmap pool, surface table | surface state: material flag, indirect args |
 //! | `heightfield` (compute, indirect) | pool, surface state | per deformed surface: depression, normal, AO texture |
 //! | `shadow` | instances | the moon's shadow map |
-//! | `opaque` | instances, shadow map | scene colour (HDR), depth |
+//! | `opaque` | instances in view, shadow map | scene colour (HDR), depth; or depth and the visibility buffer ([`OpaquePath::Visibility`]) |
+//! | `opaque_shade` (compute) | visibility buffer, instances, shadow map | scene colour (empty on the forward path) |
 //! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth |
 //! | `sky` | depth | scene colour |
 //! | `snowfall` | depth | scene colour |
 //! | `spray` | the world's spray ring, depth | scene colour |
-//! | `tonemap` | scene colour, depth | the output |
+//! | `tonemap` (compute; raster for a view that cannot be a storage texture) | scene colour, depth | the output |
 //!
 //! Each snow surface is drawn as the box of its snow slab. A surface whose heightmap is all zero
 //! gets the talk's **basic** material (untouched snow, no heightmap reads); any other the
