@@ -189,9 +189,10 @@ pub enum OpaquePath {
     /// Rasterised and shaded per fragment (`opaque/mesh.wgsl`): the goldens' path.
     #[default]
     Forward,
-    /// Rasterised into a visibility buffer (depth and each pixel's instance and triangle, an
-    /// `Rg32Uint` target), then shaded by a compute pass that finds each pixel's triangle again
-    /// and shades it with the forward path's own function (`opaque/shade.wgsl`).
+    /// Rasterised into a visibility buffer (depth, and each pixel's instance, triangle and depth
+    /// in an `Rgba32Uint` target), then, after the snow, shaded by a compute pass that finds the
+    /// triangle again where the snow left it visible and shades it with the forward path's own
+    /// function (`opaque/shade.wgsl`).
     Visibility,
 }
 

@@ -27,8 +27,8 @@ pub enum Resource {
     DicedMesh,
     /// The moon's shadow map.
     ShadowMap,
-    /// The visibility buffer: per pixel of the scene, the opaque instance and triangle seen
-    /// (`OpaquePath::Visibility`).
+    /// The visibility buffer: per pixel of the scene, the opaque instance and triangle seen and
+    /// the depth they wrote (`OpaquePath::Visibility`).
     Visibility,
     /// The scene's HDR colour (supersampled).
     SceneColor,
@@ -93,10 +93,10 @@ pub mod pass {
     pub const SNOW_SHADOW: usize = 5;
     /// Opaque meshes: shaded (forward), or into the visibility buffer.
     pub const OPAQUE: usize = 6;
-    /// The visibility buffer shaded (empty on the forward path).
-    pub const OPAQUE_SHADE: usize = 7;
     /// Snow surfaces.
-    pub const SNOW: usize = 8;
+    pub const SNOW: usize = 7;
+    /// The visibility buffer shaded where the snow left it visible (empty on the forward path).
+    pub const OPAQUE_SHADE: usize = 8;
     /// Sky.
     pub const SKY: usize = 9;
     /// Falling snow.
@@ -170,12 +170,6 @@ pub const PASSES: [PassInfo; 13] = [
         writes: &[R::SceneColor, R::SceneDepth, R::Visibility],
     },
     PassInfo {
-        name: "opaque_shade",
-        kind: PassKind::Compute,
-        reads: &[R::Instances, R::FrameUniforms, R::ShadowMap, R::Visibility],
-        writes: &[R::SceneColor],
-    },
-    PassInfo {
         name: "snow",
         kind: PassKind::Render,
         reads: &[
@@ -189,6 +183,12 @@ pub const PASSES: [PassInfo; 13] = [
             R::SceneDepth,
         ],
         writes: &[R::SceneColor, R::SceneDepth],
+    },
+    PassInfo {
+        name: "opaque_shade",
+        kind: PassKind::Compute,
+        reads: &[R::Instances, R::FrameUniforms, R::ShadowMap, R::Visibility],
+        writes: &[R::SceneColor],
     },
     PassInfo {
         name: "sky",

@@ -1,15 +1,18 @@
-// shade.wgsl: the visibility buffer's shading, one thread a pixel of the scene. The pixel's
-// triangle is fetched again (`geometry.wgsl`), cut by the pixel's view ray (and its neighbours'
+// shade.wgsl: the visibility buffer's shading, one thread a pixel of the scene, after the snow
+// pass: a pixel is shaded only where the scene's depth is still the depth its triangle wrote (the
+// snow drew over the rest, and the sky fills what nothing covers). The pixel's triangle is
+// fetched again (`geometry.wgsl`), cut by the pixel's view ray (and its neighbours'
 // rays, for the footprint the forward pass takes from `fwidth`), its normal interpolated by the
 // hit's barycentrics (perspective-correct, as a rasteriser's), and the point shaded by
-// `shading.wgsl`, the forward pass's own function. Pixels with no triangle get the forward pass's
-// clear colour.
-// Reads: frame uniforms, shadow map, meshes, instances, visibility. Writes: scene colour.
+// `shading.wgsl`, the forward pass's own function.
+// Reads: frame uniforms, shadow map, meshes, instances, visibility, scene depth. Writes: scene
+// colour.
 
 // import mesh_shading, mesh_geometry
 
 @group(2) @binding(0) var visibility: texture_2d<u32>;
 @group(2) @binding(1) var scene_color: texture_storage_2d<rgba16float, write>;
+@group(2) @binding(2) var scene_depth: texture_depth_2d;
 
 // The view ray through a point of the scene's pixel grid (`pixel`: pixels from the top left
 // corner): origin and direction (not unit).
@@ -44,9 +47,8 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= size.x || id.y >= size.y {
         return;
     }
-    let ids = textureLoad(visibility, id.xy, 0).xy;
-    if ids.x == NO_TRIANGLE {
-        textureStore(scene_color, id.xy, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+    let ids = textureLoad(visibility, id.xy, 0).xyz;
+    if ids.x == NO_TRIANGLE || textureLoad(scene_depth, id.xy, 0) != bitcast<f32>(ids.z) {
         return;
     }
     let inst = instances[ids.x];

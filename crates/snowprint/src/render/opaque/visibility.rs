@@ -1,7 +1,8 @@
 //! The visibility path of the `opaque` pass (`OpaquePath::Visibility`): `visibility.wgsl`
-//! rasterises the meshes into depth and an `Rg32Uint` target of (instance, triangle), then the
-//! `opaque_shade` compute pass (`shade.wgsl`) shades every pixel of the scene from it with the
-//! forward path's shading function.
+//! rasterises the meshes into depth and an `Rgba32Uint` target of (instance, triangle, depth),
+//! then, after the snow pass, the `opaque_shade` compute pass (`shade.wgsl`) shades the pixels
+//! where an opaque triangle is still what the scene shows, with the forward path's shading
+//! function.
 
 use super::super::graph::PASSES;
 use super::super::meshes::{DrawSet, MeshSet};
@@ -104,6 +105,7 @@ impl VisibilityPass {
             &[
                 wgpu::BindingResource::TextureView(visibility),
                 wgpu::BindingResource::TextureView(&targets.color_view),
+                wgpu::BindingResource::TextureView(&targets.depth_view),
             ],
         );
         let t = targets.color_view.texture();
@@ -156,7 +158,7 @@ impl VisibilityPass {
         }
     }
 
-    /// Shade every pixel of the scene from the visibility buffer.
+    /// Shade the pixels of the scene whose opaque triangle the snow left visible.
     pub(super) fn encode_shade(
         &self,
         encoder: &mut wgpu::CommandEncoder,

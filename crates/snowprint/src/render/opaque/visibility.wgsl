@@ -1,5 +1,5 @@
 // visibility.wgsl: the opaque meshes into a visibility buffer: depth, and per pixel the instance
-// and triangle seen (an `Rg32Uint` target), nothing shaded. Vertices are pulled from storage
+// and triangle seen and the depth written (an `Rgba32Uint` target), nothing shaded. Vertices are pulled from storage
 // (`geometry.wgsl`), so the triangle is the vertex's index over three; the clip position is the
 // forward pass's (`vs_mesh`), so both cover the same pixels at the same depths.
 // Reads: frame uniforms, meshes, instances. Writes: visibility, scene depth.
@@ -23,6 +23,8 @@ fn vs_visibility(@builtin(vertex_index) vertex: u32, @builtin(instance_index) in
 }
 
 @fragment
-fn fs_visibility(in: VisibilityVarying) -> @location(0) vec2<u32> {
-    return in.ids;
+fn fs_visibility(in: VisibilityVarying) -> @location(0) vec4<u32> {
+    // The depth as the depth target stores it (`Depth32Float`, no bias): the shading, after the
+    // snow, shades the pixel only if the snow left this depth in place.
+    return vec4<u32>(in.ids, bitcast<u32>(in.clip.z), 0u);
 }
