@@ -9,8 +9,8 @@
 //! | `heightfield` (compute, indirect) | pool, surface state | per deformed surface: depression, normal, AO texture |
 //! | `shadow` | instances | the moon's shadow map |
 //! | `opaque` | instances in view, shadow map | scene colour (HDR), depth; or depth and the visibility buffer ([`OpaquePath::Visibility`]) |
-//! | `opaque_shade` (compute) | visibility buffer, instances, shadow map | scene colour (empty on the forward path) |
 //! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth |
+//! | `opaque_shade` (compute) | visibility buffer, instances, shadow map, depth | scene colour where the snow left the opaque visible (empty on the forward path) |
 //! | `sky` | depth | scene colour |
 //! | `snowfall` | depth | scene colour |
 //! | `spray` | the world's spray ring, depth | scene colour |
