@@ -58,8 +58,13 @@ impl Targets {
             iw,
             ih,
             HDR_FORMAT,
-            // Storage: the visibility buffer's shading writes it from compute.
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING,
+            // Storage only for the visibility buffer's shading, which writes it from compute
+            // (storage use can cost a render target its compression on some GPUs).
+            if visibility {
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING
+            } else {
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING
+            },
         );
         let visibility_view = visibility.then(|| {
             texture(
