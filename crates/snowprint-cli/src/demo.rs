@@ -102,6 +102,11 @@ pub struct Args {
     /// Leave out the kicked-up snow (the world's spray particles, on by default).
     #[arg(long)]
     pub no_spray: bool,
+    /// Side of each of the moon's two shadow cascades, texels (default: 4096 on a GPU, 2048 on a
+    /// software adapter). The report's `shadow_last_frame.view_pixel_m` against `texel_m` says
+    /// how dense the view needs the near one.
+    #[arg(long)]
+    pub shadow_map_size: Option<u32>,
 }
 
 /// Statistics of one pass over the frames.
@@ -251,6 +256,9 @@ impl Settings {
             config.snowflakes = 3000;
         } else {
             config.shadow_map_size = 4096;
+        }
+        if let Some(size) = args.shadow_map_size {
+            config.shadow_map_size = size;
         }
         config
     }
@@ -613,6 +621,7 @@ mod tests {
             scene: "rooftops".into(),
             compare_tiers: false,
             no_spray: false,
+            shadow_map_size: None,
         }
     }
 
