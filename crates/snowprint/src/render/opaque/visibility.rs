@@ -8,7 +8,7 @@ use super::super::graph::PASSES;
 use super::super::meshes::{DrawSet, MeshSet};
 use super::super::pipeline;
 use super::super::readback::{Timestamps, compute_pass, render_writes};
-use super::super::targets::{HDR_FORMAT, Targets, VISIBILITY_FORMAT};
+use super::super::targets::{Targets, VISIBILITY_FORMAT};
 use super::geometry::MeshGeometry;
 use crate::gpu::resources::bind_group;
 
@@ -60,7 +60,6 @@ impl VisibilityPass {
             "shade",
             &[frame_layout, &shade_layout, &targets_layout],
         );
-        debug_assert_eq!(HDR_FORMAT, wgpu::TextureFormat::Rgba16Float);
         Self {
             raster,
             shade,
@@ -174,5 +173,37 @@ impl VisibilityPass {
             p.set_bind_group(2, &groups[2], &[]);
             p.dispatch_workgroups(w.div_ceil(WORKGROUP), h.div_ceil(WORKGROUP), 1);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::targets::{HDR_FORMAT, OUTPUT_FORMAT};
+    use crate::wgsl::{BindingKind, ShaderModule};
+
+    fn storage_format(module: &ShaderModule, name: &str) -> wgpu::TextureFormat {
+        match module
+            .bindings
+            .iter()
+            .find(|b| b.name == name)
+            .map(|b| b.kind)
+        {
+            Some(BindingKind::StorageTexture { format, .. }) => format,
+            other => panic!("{}: {name} is {other:?}", module.name),
+        }
+    }
+
+    /// The compute passes' storage textures are declared in WGSL with the formats of the targets
+    /// they are bound to.
+    #[test]
+    fn storage_targets_match_their_wgsl() {
+        assert_eq!(
+            storage_format(&crate::wgsl::MESH_SHADE, "scene_color"),
+            HDR_FORMAT
+        );
+        assert_eq!(
+            storage_format(&crate::wgsl::TONEMAP_COMPUTE, "output"),
+            OUTPUT_FORMAT
+        );
     }
 }
