@@ -109,8 +109,8 @@ pub mod pass {
 
 /// The passes of a frame, in the order they run. The tessellated tier's passes (`dice`,
 /// `snow_shadow`) are encoded empty in the other tiers, `banks` too but for surfaces whose
-/// material throws rims, and `spray` for a world without spray, so every tier reports the same
-/// list.
+/// material throws rims, `spray` for a world without spray, and `opaque_shade` on the forward
+/// path, so every tier and path reports the same list.
 pub const PASSES: [PassInfo; 13] = [
     PassInfo {
         name: "classify",
