@@ -13,7 +13,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use snowprint::render::{DebugView, RenderConfig, RenderFrame, Renderer, SurfaceShading, Tier};
+use snowprint::render::{
+    DebugView, OpaquePath, RenderConfig, RenderFrame, Renderer, SurfaceShading, Tier,
+};
 use snowprint::{GpuContext, GpuOptions, SnowWorld, WorldConfig};
 
 use snowprint_demo::scene::{DemoScene, build_scene};
@@ -62,6 +64,10 @@ pub struct Args {
     /// tessellated (real displaced geometry diced on the GPU, banks, the snow in the shadow map).
     #[arg(long, default_value = "relief")]
     pub tier: Tier,
+    /// How opaque meshes are drawn: forward (shaded per fragment) or visibility (a visibility
+    /// buffer of depth and triangle ids, shaded in a compute pass).
+    #[arg(long, default_value = "forward")]
+    pub opaque: OpaquePath,
     /// Samples per pixel along each axis, 1 to 4 (default: 2 on a GPU, 1 on a software adapter).
     #[arg(long, allow_negative_numbers = true)]
     pub supersample: Option<u32>,
@@ -98,6 +104,11 @@ pub struct Args {
     /// Leave out the kicked-up snow (the world's spray particles, on by default).
     #[arg(long)]
     pub no_spray: bool,
+    /// Side of each of the moon's two shadow cascades, texels (default: 4096 on a GPU, 2048 on a
+    /// software adapter). The report's `shadow_last_frame.view_pixel_m` against `texel_m` says
+    /// how dense the view needs the near one.
+    #[arg(long)]
+    pub shadow_map_size: Option<u32>,
 }
 
 /// Statistics of one pass over the frames.
@@ -242,10 +253,14 @@ impl Settings {
         let mut config = RenderConfig::new(self.width, self.height, args.tier);
         config.supersample = self.supersample;
         config.debug_view = args.debug_view;
+        config.opaque = args.opaque;
         if self.software {
             config.snowflakes = 3000;
         } else {
             config.shadow_map_size = 4096;
+        }
+        if let Some(size) = args.shadow_map_size {
+            config.shadow_map_size = size;
         }
         config
     }
@@ -322,6 +337,8 @@ struct Measured {
     last_surfaces: Vec<SurfaceShading>,
     last_overflow: u32,
     instances_count: usize,
+    culled_last: usize,
+    shadow_last: snowprint::render::ShadowStats,
     mp4: bool,
 }
 
@@ -370,6 +387,8 @@ impl Demo<'_> {
             last_surfaces: Vec::new(),
             last_overflow: 0,
             instances_count: 0,
+            culled_last: 0,
+            shadow_last: Default::default(),
             mp4: false,
         };
         for (k, &t) in clip.times.iter().enumerate() {
@@ -416,6 +435,8 @@ impl Demo<'_> {
             }
             m.last_surfaces = out.surfaces.clone();
             m.last_overflow = out.dice_overflow;
+            m.culled_last = out.culled_instances;
+            m.shadow_last = out.shadow;
             let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
                 .ok_or("the renderer returned a frame of the wrong size")?;
             if args.compare_tiers && k + 1 == clip.times.len() {
@@ -550,12 +571,15 @@ impl Demo<'_> {
             "supersample": settings.supersample,
             "frames": settings.frames,
             "tier": args.tier,
+            "opaque": args.opaque,
             "camera": args.camera,
             "debug_view": args.debug_view,
             "scene": self.scene.name(),
             "clip_seconds": [clip.t0, clip.t1],
             "simulation_hz": settings.sim_hz,
             "instances_last_frame": m.instances_count,
+            "instances_culled_last_frame": m.culled_last,
+            "shadow_last_frame": m.shadow_last,
             "search": renderer.config().search_settings(),
             "passes": renderer.passes(),
             "gpu_pass_times_ms": gpu_times,
@@ -589,6 +613,7 @@ mod tests {
             size: Some((64, 36)),
             camera: "closeup".into(),
             tier: Tier::Pom,
+            opaque: OpaquePath::Forward,
             supersample: Some(1),
             debug_view: DebugView::Shaded,
             no_snowfall: false,
@@ -598,6 +623,7 @@ mod tests {
             scene: "rooftops".into(),
             compare_tiers: false,
             no_spray: false,
+            shadow_map_size: None,
         }
     }
 

@@ -10,6 +10,16 @@ use crate::surface::SurfaceDesc;
 /// Side of the near shadow cascade, metres.
 const NEAR_CASCADE: f32 = 12.0;
 
+/// Where the near cascade is centred: this far along the view, as a fraction of its side.
+const NEAR_FOCUS: f32 = 0.4;
+
+/// Side of a scene pixel (`rows` pixels high) at the near cascade's focus, metres: the shadow
+/// texel the view would need there for one texel a pixel.
+pub(super) fn view_pixel(frame: &RenderFrame<'_>, rows: u32) -> f32 {
+    let distance = NEAR_CASCADE * NEAR_FOCUS;
+    2.0 * distance * (frame.camera.fov_y_degrees.to_radians() * 0.5).tan() / rows as f32
+}
+
 /// The moon's two shadow projections and their texels in metres.
 pub(super) struct ShadowCascades {
     pub near: Mat4,
@@ -87,7 +97,7 @@ pub(super) fn shadow_cascades<'a>(
     // make its shadow edges crawl.
     let cam = &frame.camera;
     let forward = (cam.target - cam.eye).normalize_or(Vec3::NEG_Z);
-    let focus = view.transform_point3(cam.eye + forward * (NEAR_CASCADE * 0.4));
+    let focus = view.transform_point3(cam.eye + forward * (NEAR_CASCADE * NEAR_FOCUS));
     let near_texel = NEAR_CASCADE / shadow_size as f32;
     let snap = |v: f32| (v / near_texel).round() * near_texel;
     let (cx, cy) = (snap(focus.x), snap(focus.y));

@@ -180,6 +180,45 @@ impl SnowLook {
     }
 }
 
+/// How the opaque meshes reach the scene's colour.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum OpaquePath {
+    /// Rasterised and shaded per fragment (`opaque/mesh.wgsl`): the goldens' path.
+    #[default]
+    Forward,
+    /// Rasterised into a visibility buffer (depth, and each pixel's instance, triangle and depth
+    /// in an `Rgba32Uint` target), then, after the snow, shaded by a compute pass that finds the
+    /// triangle again where the snow left it visible and shades it with the forward path's own
+    /// function (`opaque/shade.wgsl`).
+    Visibility,
+}
+
+impl OpaquePath {
+    /// Lower-case name (`forward`, `visibility`).
+    pub fn name(self) -> &'static str {
+        match self {
+            OpaquePath::Forward => "forward",
+            OpaquePath::Visibility => "visibility",
+        }
+    }
+}
+
+impl std::str::FromStr for OpaquePath {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "forward" => Ok(OpaquePath::Forward),
+            "visibility" | "vis" => Ok(OpaquePath::Visibility),
+            _ => Err(format!(
+                "unknown opaque path {s:?}; use forward or visibility"
+            )),
+        }
+    }
+}
+
 /// Settings of a [`Renderer`](super::Renderer).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderConfig {
@@ -204,6 +243,8 @@ pub struct RenderConfig {
     pub look: SnowLook,
     /// The tessellated tier's dicing.
     pub dice: DiceSettings,
+    /// How opaque meshes are drawn: forward (the default) or through a visibility buffer.
+    pub opaque: OpaquePath,
 }
 
 impl RenderConfig {
@@ -220,6 +261,7 @@ impl RenderConfig {
             search: None,
             look: SnowLook::default(),
             dice: DiceSettings::default(),
+            opaque: OpaquePath::Forward,
         }
     }
 

@@ -432,6 +432,34 @@ mod tests {
         }
     }
 
+    /// The visibility path reads the instance buffer as storage: `InstanceData` of
+    /// `opaque/geometry.wgsl` must lay out `InstanceRaw` as the vertex stage's attributes do.
+    #[test]
+    fn instances_as_storage_match_wgsl() {
+        let (size, members) = layout(&crate::wgsl::MESH_SHADE.wgsl(), "InstanceData");
+        assert_eq!(size as usize, std::mem::size_of::<InstanceRaw>());
+        let offsets = [
+            ("model", std::mem::offset_of!(InstanceRaw, model)),
+            ("normal_0", std::mem::offset_of!(InstanceRaw, normal)),
+            ("normal_1", std::mem::offset_of!(InstanceRaw, normal) + 16),
+            ("normal_2", std::mem::offset_of!(InstanceRaw, normal) + 32),
+            (
+                "albedo_material",
+                std::mem::offset_of!(InstanceRaw, albedo_material),
+            ),
+            ("params", std::mem::offset_of!(InstanceRaw, params)),
+        ];
+        for (name, offset) in offsets {
+            let m = members
+                .iter()
+                .find(|m| m.0 == name)
+                .unwrap_or_else(|| panic!("no member {name}"));
+            assert_eq!(m.1 as usize, offset, "{name}");
+        }
+        // Six floats a vertex, as `geometry.wgsl` indexes `mesh_vertices`.
+        assert_eq!(std::mem::size_of::<MeshVertexRaw>(), 24);
+    }
+
     #[test]
     fn surface_uniform_matches_wgsl() {
         let (size, members) = layout(&crate::wgsl::SURFACE.wgsl(), "SnowSurface");

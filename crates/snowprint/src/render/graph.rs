@@ -27,6 +27,9 @@ pub enum Resource {
     DicedMesh,
     /// The moon's shadow map.
     ShadowMap,
+    /// The visibility buffer: per pixel of the scene, the opaque instance and triangle seen and
+    /// the depth they wrote (`OpaquePath::Visibility`).
+    Visibility,
     /// The scene's HDR colour (supersampled).
     SceneColor,
     /// The scene's depth (supersampled).
@@ -88,25 +91,27 @@ pub mod pass {
     pub const SHADOW: usize = 4;
     /// The moon's shadow map: the displaced snow (tessellated tier; empty otherwise).
     pub const SNOW_SHADOW: usize = 5;
-    /// Opaque meshes.
+    /// Opaque meshes: shaded (forward), or into the visibility buffer.
     pub const OPAQUE: usize = 6;
     /// Snow surfaces.
     pub const SNOW: usize = 7;
+    /// The visibility buffer shaded where the snow left it visible (empty on the forward path).
+    pub const OPAQUE_SHADE: usize = 8;
     /// Sky.
-    pub const SKY: usize = 8;
+    pub const SKY: usize = 9;
     /// Falling snow.
-    pub const SNOWFALL: usize = 9;
+    pub const SNOWFALL: usize = 10;
     /// Kicked-up snow (the world's spray; empty without it).
-    pub const SPRAY: usize = 10;
+    pub const SPRAY: usize = 11;
     /// Resolve and tonemap.
-    pub const TONEMAP: usize = 11;
+    pub const TONEMAP: usize = 12;
 }
 
 /// The passes of a frame, in the order they run. The tessellated tier's passes (`dice`,
 /// `snow_shadow`) are encoded empty in the other tiers, `banks` too but for surfaces whose
-/// material throws rims, and `spray` for a world without spray, so every tier reports the same
-/// list.
-pub const PASSES: [PassInfo; 12] = [
+/// material throws rims, `spray` for a world without spray, and `opaque_shade` on the forward
+/// path, so every tier and path reports the same list.
+pub const PASSES: [PassInfo; 13] = [
     PassInfo {
         name: "classify",
         kind: PassKind::Compute,
@@ -161,7 +166,8 @@ pub const PASSES: [PassInfo; 12] = [
         name: "opaque",
         kind: PassKind::Render,
         reads: &[R::Instances, R::FrameUniforms, R::ShadowMap],
-        writes: &[R::SceneColor, R::SceneDepth],
+        // The forward path writes colour and depth; the visibility path depth and visibility.
+        writes: &[R::SceneColor, R::SceneDepth, R::Visibility],
     },
     PassInfo {
         name: "snow",
@@ -177,6 +183,12 @@ pub const PASSES: [PassInfo; 12] = [
             R::SceneDepth,
         ],
         writes: &[R::SceneColor, R::SceneDepth],
+    },
+    PassInfo {
+        name: "opaque_shade",
+        kind: PassKind::Compute,
+        reads: &[R::Instances, R::FrameUniforms, R::ShadowMap, R::Visibility],
+        writes: &[R::SceneColor],
     },
     PassInfo {
         name: "sky",
@@ -198,7 +210,8 @@ pub const PASSES: [PassInfo; 12] = [
     },
     PassInfo {
         name: "tonemap",
-        kind: PassKind::Render,
+        // A raster pass only for a caller's view that cannot be a storage texture.
+        kind: PassKind::Compute,
         reads: &[R::FrameUniforms, R::SceneColor, R::SceneDepth],
         writes: &[R::Output],
     },

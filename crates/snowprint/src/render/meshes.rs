@@ -3,9 +3,10 @@
 
 use glam::{Mat3, Vec3};
 
+use super::cull;
 use super::error::{RenderError, RenderResult};
 use super::geometry;
-use super::gpu::InstanceRaw;
+use super::gpu::{InstanceRaw, MeshVertexRaw};
 use super::inputs::{Instance, RenderMeshId};
 use crate::gpu::resources::Growable;
 use crate::mesh::Mesh;
@@ -13,8 +14,18 @@ use crate::mesh::Mesh;
 pub(super) struct GpuMesh {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
-    index_count: u32,
+    pub index_count: u32,
     pub radius: f32,
+    /// The vertices and indices uploaded, kept for the visibility path's one buffer of every
+    /// mesh (`opaque::geometry`).
+    pub source: (Vec<MeshVertexRaw>, Vec<u32>),
+}
+
+/// Which of the frame's draws: the opaque pass's, or a shadow cascade's casters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum DrawSet {
+    Opaque,
+    Cascade(usize),
 }
 
 /// Draws of one mesh: its index and a range of instances.
@@ -26,7 +37,16 @@ pub(super) struct MeshSet {
     instances: Growable,
     /// This frame's draws: every instance, then the shadow casters.
     draws: Vec<Run>,
-    shadow_draws: Vec<Run>,
+    /// Per cascade of the moon's shadow map, the casters that reach it.
+    shadow_draws: [Vec<Run>; 2],
+    /// The mesh of each instance of `draws`, in the instance buffer's order.
+    pub instance_meshes: Vec<u32>,
+    /// Instances of the frame outside the view, not drawn by the opaque pass.
+    pub culled: usize,
+    /// Shadow casters drawn into each cascade this frame.
+    pub cascade_casters: [usize; 2],
+    /// Counts the changes to `meshes` (the visibility path rebuilds its buffers on a change).
+    pub version: u64,
 }
 
 impl MeshSet {
@@ -36,11 +56,18 @@ impl MeshSet {
             instances: Growable::new(
                 device,
                 "mesh instances",
-                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                // Storage too: the visibility path reads the instances in its own passes.
+                wgpu::BufferUsages::VERTEX
+                    | wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST,
                 144 * 64,
             ),
             draws: Vec::new(),
-            shadow_draws: Vec::new(),
+            shadow_draws: [Vec::new(), Vec::new()],
+            cascade_casters: [0, 0],
+            instance_meshes: Vec::new(),
+            culled: 0,
+            version: 0,
         }
     }
 
@@ -48,6 +75,7 @@ impl MeshSet {
     pub(super) fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
         let gpu = upload(device, mesh)?;
         self.meshes.push(gpu);
+        self.version += 1;
         Ok(RenderMeshId(self.meshes.len() as u32 - 1))
     }
 
@@ -62,46 +90,48 @@ impl MeshSet {
             return Err(RenderError::StaleMesh { index: id.0 });
         }
         self.meshes[id.0 as usize] = upload(device, mesh)?;
+        self.version += 1;
         Ok(())
     }
 
-    /// Upload the frame's instances: all of them grouped by mesh, then the shadow casters grouped
-    /// by mesh.
+    /// Upload the frame's instances: those the view may see (`cull::visible` against
+    /// `view_proj`) grouped by mesh, then the shadow casters that reach each of the moon's
+    /// cascades (`cascades`, world to each cascade's clip space: the same test against its box),
+    /// each cascade's grouped by mesh. A caster out of view can still shadow what is in it; one
+    /// wholly outside a cascade's box leaves no texel in it.
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         frame: &[Instance],
+        view_proj: glam::Mat4,
+        cascades: [glam::Mat4; 2],
     ) {
+        let bounds = || {
+            frame
+                .iter()
+                .map(|i| (i.transform, self.meshes[i.mesh.0 as usize].radius))
+        };
+        let visible = cull::visible(view_proj, bounds());
+        let in_cascade = cascades.map(|m| cull::visible(m, bounds()));
         let mut order: Vec<usize> = (0..frame.len()).collect();
         order.sort_by_key(|&i| frame[i].mesh.0);
-        let raw = |inst: &Instance| {
-            let normal = Mat3::from_mat4(inst.transform).inverse().transpose();
-            let c = |v: Vec3| [v.x, v.y, v.z, 0.0];
-            InstanceRaw {
-                model: inst.transform.to_cols_array_2d(),
-                normal: [c(normal.x_axis), c(normal.y_axis), c(normal.z_axis)],
-                albedo_material: [
-                    inst.albedo[0],
-                    inst.albedo[1],
-                    inst.albedo[2],
-                    inst.material.code(),
-                ],
-                params: [inst.roughness, inst.emission, inst.snow_cover, inst.seed],
-            }
-        };
+        let casters = in_cascade.map(|inside| {
+            order
+                .iter()
+                .copied()
+                .filter(|&i| frame[i].casts_shadow && inside[i])
+                .collect::<Vec<usize>>()
+        });
+        order.retain(|&i| visible[i]);
+        self.culled = frame.len() - order.len();
+        self.cascade_casters = casters.each_ref().map(Vec::len);
         let mut instances: Vec<InstanceRaw> = order.iter().map(|&i| raw(&frame[i])).collect();
-        let casters: Vec<usize> = order
-            .iter()
-            .copied()
-            .filter(|&i| frame[i].casts_shadow)
-            .collect();
-        instances.extend(casters.iter().map(|&i| raw(&frame[i])));
-        let runs = |ids: &[usize], first: u32| {
+        let runs = |ids: &[usize], first: usize| {
             let mut out: Vec<Run> = Vec::new();
             for (k, &i) in ids.iter().enumerate() {
                 let mesh = frame[i].mesh.0;
-                let at = first + k as u32;
+                let at = (first + k) as u32;
                 match out.last_mut() {
                     Some((m, r)) if *m == mesh => r.end = at + 1,
                     _ => out.push((mesh, at..at + 1)),
@@ -110,7 +140,11 @@ impl MeshSet {
             out
         };
         self.draws = runs(&order, 0);
-        self.shadow_draws = runs(&casters, order.len() as u32);
+        self.instance_meshes = order.iter().map(|&i| frame[i].mesh.0).collect();
+        for (cascade, ids) in casters.iter().enumerate() {
+            self.shadow_draws[cascade] = runs(ids, instances.len());
+            instances.extend(ids.iter().map(|&i| raw(&frame[i])));
+        }
         if !instances.is_empty() {
             self.instances
                 .ensure(device, std::mem::size_of_val(instances.as_slice()) as u64);
@@ -118,31 +152,57 @@ impl MeshSet {
         }
     }
 
-    /// Whether the frame has instances (`shadow`: shadow casters) to draw.
-    pub(super) fn has_draws(&self, shadow: bool) -> bool {
-        !if shadow {
-            &self.shadow_draws
-        } else {
-            &self.draws
-        }
-        .is_empty()
+    /// Whether the frame has instances to draw in `set`.
+    pub(super) fn has_draws(&self, set: DrawSet) -> bool {
+        !self.runs(set).is_empty()
     }
 
-    /// Draw the frame's instances (`shadow`: the shadow casters) with the pass's pipeline and
-    /// bind groups set.
-    pub(super) fn draw(&self, p: &mut wgpu::RenderPass<'_>, shadow: bool) {
+    fn runs(&self, set: DrawSet) -> &[Run] {
+        match set {
+            DrawSet::Opaque => &self.draws,
+            DrawSet::Cascade(c) => &self.shadow_draws[c],
+        }
+    }
+
+    /// The instance buffer (all of the frame's instances first, in `instance_meshes`' order).
+    pub(super) fn instance_buffer(&self) -> &wgpu::Buffer {
+        &self.instances.buffer
+    }
+
+    /// Draw every instance without vertex or index buffers: `index_count` vertices an instance,
+    /// which the pipeline pulls from storage (the visibility path).
+    pub(super) fn draw_pulled(&self, p: &mut wgpu::RenderPass<'_>) {
+        for (mesh, range) in &self.draws {
+            p.draw(0..self.meshes[*mesh as usize].index_count, range.clone());
+        }
+    }
+
+    /// Draw the frame's instances of `set` with the pass's pipeline and bind groups set.
+    pub(super) fn draw(&self, p: &mut wgpu::RenderPass<'_>, set: DrawSet) {
         p.set_vertex_buffer(1, self.instances.buffer.slice(..));
-        let runs = if shadow {
-            &self.shadow_draws
-        } else {
-            &self.draws
-        };
-        for (mesh, range) in runs {
+        for (mesh, range) in self.runs(set) {
             let m = &self.meshes[*mesh as usize];
             p.set_vertex_buffer(0, m.vertices.slice(..));
             p.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
             p.draw_indexed(0..m.index_count, 0, range.clone());
         }
+    }
+}
+
+/// The instance as the mesh pipelines read it.
+fn raw(inst: &Instance) -> InstanceRaw {
+    let normal = Mat3::from_mat4(inst.transform).inverse().transpose();
+    let c = |v: Vec3| [v.x, v.y, v.z, 0.0];
+    InstanceRaw {
+        model: inst.transform.to_cols_array_2d(),
+        normal: [c(normal.x_axis), c(normal.y_axis), c(normal.z_axis)],
+        albedo_material: [
+            inst.albedo[0],
+            inst.albedo[1],
+            inst.albedo[2],
+            inst.material.code(),
+        ],
+        params: [inst.roughness, inst.emission, inst.snow_cover, inst.seed],
     }
 }
 
@@ -163,5 +223,6 @@ fn upload(device: &wgpu::Device, mesh: &Mesh) -> RenderResult<GpuMesh> {
         }),
         index_count: indices.len() as u32,
         radius: mesh.bounding_radius(),
+        source: (vertices, indices),
     })
 }

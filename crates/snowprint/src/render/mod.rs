@@ -8,12 +8,13 @@
 //! | `classify` (compute) | heightmap pool, surface table | surface state: material flag, indirect args |
 //! | `heightfield` (compute, indirect) | pool, surface state | per deformed surface: depression, normal, AO texture |
 //! | `shadow` | instances | the moon's shadow map |
-//! | `opaque` | instances, shadow map | scene colour (HDR), depth |
+//! | `opaque` | instances in view, shadow map | scene colour (HDR), depth; or depth and the visibility buffer ([`OpaquePath::Visibility`]) |
 //! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth |
+//! | `opaque_shade` (compute) | visibility buffer, instances, shadow map, depth | scene colour where the snow left the opaque visible (empty on the forward path) |
 //! | `sky` | depth | scene colour |
 //! | `snowfall` | depth | scene colour |
 //! | `spray` | the world's spray ring, depth | scene colour |
-//! | `tonemap` | scene colour, depth | the output |
+//! | `tonemap` (compute; raster for a view that cannot be a storage texture) | scene colour, depth | the output |
 //!
 //! Each snow surface is drawn as the box of its snow slab. A surface whose heightmap is all zero
 //! gets the talk's **basic** material (untouched snow, no heightmap reads); any other the
@@ -64,6 +65,7 @@ mod cascades;
 mod classify;
 mod config;
 pub(crate) mod cpu;
+mod cull;
 mod error;
 mod frame;
 pub(crate) mod geometry;
@@ -103,11 +105,13 @@ use tessellate::banks::BanksPass;
 use tessellate::dice::DicePass;
 use tessellate::snow_shadow::TessSurface;
 
-pub use config::{DebugView, RenderConfig, SearchSettings, SnowLook, Tier};
+pub use config::{DebugView, OpaquePath, RenderConfig, SearchSettings, SnowLook, Tier};
 pub use error::{RenderError, RenderResult};
 pub use graph::{PASSES, PassInfo, PassKind, Resource};
 pub use inputs::{Environment, Instance, MeshMaterial, PointLight, RenderFrame, RenderMeshId};
-pub use report::{FrameReport, PassTime, RenderOutput, SnowMaterialKind, SurfaceShading};
+pub use report::{
+    FrameReport, PassTime, RenderOutput, ShadowStats, SnowMaterialKind, SurfaceShading,
+};
 pub use targets::OUTPUT_FORMAT;
 pub use tessellate::{
     BankSettings, DiceSettings, DicedKind, DicedMesh, DicedVertex, SurfaceFields, SurfaceGeometry,
@@ -160,6 +164,8 @@ pub struct Renderer {
     timestamps: Option<Timestamps>,
     stats: StatsReadback,
     latest: Option<FrameReport>,
+    /// The latest frame's shadow cascades.
+    shadow_stats: ShadowStats,
 }
 
 impl std::fmt::Debug for Renderer {
@@ -206,14 +212,20 @@ impl Renderer {
                 &frame.shadow_layout,
                 filterable,
             ),
-            opaque: opaque::OpaquePass::new(&device, &mesh_module, &frame.layout),
+            opaque: opaque::OpaquePass::new(&device, &mesh_module, &frame.layout, config.opaque),
             snow: snow::SnowPass::new(&device, &frame.layout, filterable),
             sky: sky::SkyPass::new(&device, &frame.layout),
             snowfall: snowfall::SnowfallPass::new(&device, &frame.layout),
             spray: spray::SprayPass::new(&device, &frame.layout),
             tonemap: tonemap::TonemapPass::new(&device, &frame.layout),
             meshes: meshes::MeshSet::new(&device),
-            targets: Targets::new(&device, config.width, config.height, config.supersample),
+            targets: Targets::new(
+                &device,
+                config.width,
+                config.height,
+                config.supersample,
+                config.opaque == OpaquePath::Visibility,
+            ),
             timestamps: gpu
                 .caps
                 .timestamps
@@ -226,6 +238,7 @@ impl Renderer {
             default_geometry: SurfaceGeometry::default(),
             last_surfaces: Vec::new(),
             latest: None,
+            shadow_stats: ShadowStats::default(),
             queue: gpu.queue.clone(),
             device,
             config,
@@ -310,7 +323,13 @@ impl Renderer {
         };
         config.validate(&self.device)?;
         self.config = config;
-        self.targets = Targets::new(&self.device, width, height, supersample);
+        self.targets = Targets::new(
+            &self.device,
+            width,
+            height,
+            supersample,
+            config.opaque == OpaquePath::Visibility,
+        );
         Ok(())
     }
 
@@ -398,6 +417,8 @@ impl Renderer {
             dice_overflow: report.dice_overflow,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
             cpu_encode_ms,
+            culled_instances: self.meshes.culled,
+            shadow: self.shadow_stats,
         })
     }
 
@@ -595,9 +616,28 @@ impl Renderer {
             state,
             ground,
         );
-        self.meshes.prepare(device, queue, frame.instances);
-        self.tonemap
-            .prepare(device, &self.targets, format, self.config.supersample);
+        let view_proj = glam::Mat4::from_cols_array_2d(&uniform.view_proj);
+        self.meshes.prepare(
+            device,
+            queue,
+            frame.instances,
+            view_proj,
+            [shadow.near, shadow.far],
+        );
+        self.shadow_stats = ShadowStats {
+            casters: self.meshes.cascade_casters,
+            texel_m: [shadow.near_texel, shadow.far_texel],
+            view_pixel_m: cascades::view_pixel(frame, self.config.height * self.config.supersample),
+        };
+        self.opaque
+            .prepare(device, queue, &self.meshes, &self.targets);
+        self.tonemap.prepare(
+            device,
+            &self.targets,
+            target,
+            format,
+            self.config.supersample,
+        );
 
         // The table sets the order: pass `slot` of PASSES is recorded `slot`-th.
         let flakes = uniform.options[3];
@@ -643,6 +683,7 @@ impl Renderer {
             pass::OPAQUE => self
                 .opaque
                 .encode(encoder, ts, slot, targets, frame, &self.meshes),
+            pass::OPAQUE_SHADE => self.opaque.encode_shade(encoder, ts, slot, frame),
             pass::SNOW => self.snow.encode(
                 encoder,
                 ts,

@@ -84,4 +84,21 @@ pub struct RenderOutput {
     /// CPU time to build the frame and submit it (every pass's tables written and its commands
     /// recorded), milliseconds: what a frame costs the CPU when nothing is read back.
     pub cpu_encode_ms: f64,
+    /// Instances of the frame outside the view's frustum, not drawn by the opaque pass (shadow
+    /// casters among them still cast).
+    pub culled_instances: usize,
+    /// The moon's shadow cascades this frame: casters drawn and texel sizes.
+    pub shadow: ShadowStats,
+}
+
+/// What the moon's two shadow cascades held in a frame, and the density the view asked of them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ShadowStats {
+    /// Shadow casters drawn into the near and the far cascade (those whose bounds reach its box).
+    pub casters: [usize; 2],
+    /// Side of a texel of the near and the far cascade, metres.
+    pub texel_m: [f32; 2],
+    /// Side of a pixel of the scene (supersampled) at the near cascade's focus, metres: the
+    /// texel the view would need there for one texel a pixel.
+    pub view_pixel_m: f32,
 }

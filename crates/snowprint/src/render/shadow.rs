@@ -2,7 +2,7 @@
 //! one first), with `vs_shadow` of `opaque/mesh.wgsl`. The pass owns the shadow map; the frame's
 //! bind group samples it, and the tessellated tier's `snow_shadow` draws over it.
 
-use super::meshes::MeshSet;
+use super::meshes::{DrawSet, MeshSet};
 use super::readback::{Timestamps, render_span};
 use super::targets::DEPTH_FORMAT;
 use super::{gpu, pipeline};
@@ -119,10 +119,10 @@ impl ShadowPass {
                 "shadow (far cascade)"
             };
             let mut p = self.cascade_pass(encoder, ts, slot, cascade, label, true);
-            if meshes.has_draws(true) {
+            if meshes.has_draws(DrawSet::Cascade(cascade)) {
                 p.set_pipeline(&self.pipelines[cascade]);
                 p.set_bind_group(0, frame, &[]);
-                meshes.draw(&mut p, true);
+                meshes.draw(&mut p, DrawSet::Cascade(cascade));
             }
         }
     }

@@ -1,16 +1,24 @@
 //! The frame's render targets: the supersampled HDR colour and depth the passes draw into, and
 //! the offscreen output with its readback buffer.
 
-/// Format of the offscreen output ([`Renderer::render`](super::Renderer::render)).
-pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// Format of the offscreen output ([`Renderer::render`](super::Renderer::render)): RGBA8 whose
+/// bytes are sRGB encoded by the tonemap itself, stored as `Rgba8Unorm` so that its compute pass
+/// can write it as a storage texture (an sRGB format cannot be one). A caller's view of this
+/// format made with `STORAGE_BINDING` is written by the compute pass too; any other view by the
+/// raster fallback.
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The visibility buffer: instance, triangle, the depth written (as bits).
+pub(super) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 pub(super) const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) struct Targets {
     pub size: (u32, u32),
     pub color_view: wgpu::TextureView,
     pub depth_view: wgpu::TextureView,
+    /// The visibility buffer (only on `OpaquePath::Visibility`).
+    pub visibility_view: Option<wgpu::TextureView>,
     pub output: wgpu::Texture,
     pub output_view: wgpu::TextureView,
     pub readback: wgpu::Buffer,
@@ -18,7 +26,15 @@ pub(super) struct Targets {
 }
 
 impl Targets {
-    pub(super) fn new(device: &wgpu::Device, width: u32, height: u32, supersample: u32) -> Self {
+    /// The targets of a `width` x `height` output drawn `supersample` times larger, with a
+    /// visibility buffer when `visibility`.
+    pub(super) fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        supersample: u32,
+        visibility: bool,
+    ) -> Self {
         let texture = |label, w, h, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -42,8 +58,24 @@ impl Targets {
             iw,
             ih,
             HDR_FORMAT,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+            // Storage only for the visibility buffer's shading, which writes it from compute
+            // (storage use can cost a render target its compression on some GPUs).
+            if visibility {
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::STORAGE_BINDING
+            } else {
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING
+            },
         );
+        let visibility_view = visibility.then(|| {
+            texture(
+                "visibility",
+                iw,
+                ih,
+                VISIBILITY_FORMAT,
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+            )
+            .create_view(&Default::default())
+        });
         let depth = texture(
             "scene depth",
             iw,
@@ -56,7 +88,7 @@ impl Targets {
             width,
             height,
             OUTPUT_FORMAT,
-            U::RENDER_ATTACHMENT | U::COPY_SRC,
+            U::STORAGE_BINDING | U::RENDER_ATTACHMENT | U::COPY_SRC,
         );
         let padded_row = (width * 4).div_ceil(256) * 256;
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
@@ -69,6 +101,7 @@ impl Targets {
             size: (width, height),
             color_view: color.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
+            visibility_view,
             output_view: output.create_view(&Default::default()),
             output,
             readback,

@@ -119,10 +119,11 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
     ("capture", "view", Override::DynamicOffset),
     ("capture", "draw", Override::DynamicOffset),
     // frame.wgsl's group 0 is one layout shared by every pass of the renderer.
-    ("*", "frame", Override::Stages(VERTEX_FRAGMENT)),
-    ("*", "shadow_map", Override::Stages(FRAGMENT)),
-    ("*", "shadow_sampler", Override::Stages(FRAGMENT)),
-    ("*", "linear_sampler", Override::Stages(FRAGMENT)),
+    // (Compute too: the tonemap and the visibility buffer's shading are compute passes.)
+    ("*", "frame", Override::Stages(ALL_STAGES)),
+    ("*", "shadow_map", Override::Stages(FRAGMENT_COMPUTE)),
+    ("*", "shadow_sampler", Override::Stages(FRAGMENT_COMPUTE)),
+    ("*", "linear_sampler", Override::Stages(FRAGMENT_COMPUTE)),
     ("*", "linear_sampler", Override::FilterableIfSupported),
     // The snow passes' heightfield textures (Rgba16Float), filtered where the device can.
     ("surface", "heightfield", Override::FilterableIfSupported),
@@ -170,6 +171,7 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
     ),
     // Read with textureLoad only.
     ("tonemap", "scene_color", Override::NotFiltering),
+    ("tonemap_compute", "scene_color", Override::NotFiltering),
     ("banks", "shape", Override::NotFiltering),
     ("banks", "light", Override::NotFiltering),
     ("banks", "scratch_in", Override::NotFiltering),
@@ -179,6 +181,12 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
 
 const VERTEX_FRAGMENT: u32 = wgpu::ShaderStages::VERTEX_FRAGMENT.bits();
 const FRAGMENT: u32 = wgpu::ShaderStages::FRAGMENT.bits();
+const ALL_STAGES: u32 = wgpu::ShaderStages::VERTEX_FRAGMENT
+    .union(wgpu::ShaderStages::COMPUTE)
+    .bits();
+const FRAGMENT_COMPUTE: u32 = wgpu::ShaderStages::FRAGMENT
+    .union(wgpu::ShaderStages::COMPUTE)
+    .bits();
 
 /// An entry module of the registry.
 #[derive(Clone, Copy, Debug)]
