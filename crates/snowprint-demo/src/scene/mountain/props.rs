@@ -18,10 +18,11 @@ pub fn build(
     clear: impl Fn(Vec2) -> bool,
 ) -> Result<Vec<Instance>, String> {
     let mut v = Vec::new();
-    // The floor: under the snow (a few centimetres down, where prints reach the ground it is the
-    // surfaces' own ground that shows) and snow-covered beyond it, out to the ridges.
+    // The floor: under the snow and snow-covered beyond it, out to the ridges. Under the snow it
+    // lies a little more than the snow's depth down (where prints reach the ground it is the
+    // surfaces' own ground that shows), so that its shadow never falls on the snow it carries.
     let floor = renderer
-        .add_mesh(&terrain::floor_mesh(150.0, 2.0, 0.04))
+        .add_mesh(&terrain::floor_mesh(150.0, 2.0, 0.35))
         .map_err(rerr)?;
     let mut ground = Instance::new(floor, Mat4::IDENTITY, [0.78, 0.8, 0.86]);
     ground.roughness = 0.85;
@@ -79,11 +80,12 @@ fn rocks(renderer: &mut Renderer) -> Result<Vec<Instance>, String> {
         let reach = if k < 8 { 6.0 } else { terrain::LAKE.1 + 3.0 };
         let a = hash(500 + k) * std::f32::consts::TAU;
         let p = around + Vec2::new(a.cos(), a.sin()) * (reach + 2.0 * hash(600 + k));
-        let size = Vec3::new(0.9, 0.55, 0.7) * (0.6 + 0.9 * hash(700 + k));
+        // Boulders of 0.8 to 2 m, sunk to a third of their height so that none floats on a slope.
+        let size = Vec3::new(1.3, 0.9, 1.1) * (0.6 + 0.9 * hash(700 + k));
         let m = Mat4::from_scale_rotation_translation(
             size,
             Quat::from_rotation_y(a),
-            Vec3::new(p.x, terrain::height(p) + 0.1, p.y),
+            Vec3::new(p.x, terrain::height(p) - 0.3 * size.y, p.y),
         );
         let mut r =
             Instance::new(rock, m, [0.27, 0.26, 0.25]).with_material(MeshMaterial::Concrete);
