@@ -107,6 +107,11 @@ struct Scene {
 /// The two patches on their ground (or, `on_ground` false, on flat ground), with their trails
 /// pressed (`pressed`) or untouched.
 fn scene(on_ground: bool, pressed: bool) -> Scene {
+    scene_with(on_ground, pressed, SlopeRule::default())
+}
+
+/// [`scene`] with the ground's slopes holding snow by `slope`.
+fn scene_with(on_ground: bool, pressed: bool, slope: SlopeRule) -> Scene {
     let gpu = common::gpu();
     let mut world = SnowWorld::new(
         gpu,
@@ -121,9 +126,7 @@ fn scene(on_ground: bool, pressed: bool) -> Scene {
         let id = world.add_surface(p.desc.clone()).expect("surface");
         if on_ground {
             let grid = Ground::Grid(grid_of(&p.desc, p.ground));
-            world
-                .set_ground(id, &grid, SlopeRule::default())
-                .expect("ground");
+            world.set_ground(id, &grid, slope).expect("ground");
         }
         surfaces.push(id);
     }
@@ -198,6 +201,54 @@ const TIERS: [(Tier, &str); 3] = [
 fn keep(name: &str, out: &RenderOutput) {
     if let Some(dir) = std::env::var_os("SNOWPRINT_TERRAIN_STILLS") {
         golden_support::save_png(&std::path::Path::new(&dir).join(format!("{name}.png")), out);
+    }
+}
+
+/// Mean luminance (0 to 255) over the slope patch's part of the image, and the share of its pixels
+/// that differ from their right neighbour by more than 40 (speckle).
+fn slope_patch(out: &RenderOutput) -> (f32, f32) {
+    let (w, h) = (out.width as usize, out.height as usize);
+    let lum = |x: usize, y: usize| {
+        let p = &out.rgba8[4 * (y * w + x)..4 * (y * w + x) + 3];
+        0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32
+    };
+    let (mut sum, mut jumps, mut n) = (0.0, 0, 0);
+    for y in h * 35 / 100..h * 75 / 100 {
+        for x in w * 12 / 100..w * 40 / 100 {
+            sum += lum(x, y);
+            jumps += usize::from((lum(x, y) - lum(x + 1, y)).abs() > 40.0);
+            n += 1;
+        }
+    }
+    (sum / n as f32, jumps as f32 / n as f32)
+}
+
+/// Where a slope is too steep to hold snow its rock shows: the 30-degree plane under a rule that
+/// bares it (none held from 20 degrees) draws darker than under one that keeps all its snow, and
+/// without the speckle a division by the little snow held would make.
+#[test]
+fn a_bare_slope_shows_its_rock() {
+    let bare = SlopeRule {
+        full_degrees: 10.0,
+        bare_degrees: 20.0,
+    };
+    for tier in [Tier::Relief, Tier::Pom] {
+        let (snowy, _) = slope_patch(&render(
+            &mut scene_with(true, false, SlopeRule::NEVER_BARE),
+            tier,
+        ));
+        let out = render(&mut scene_with(true, false, bare), tier);
+        keep(&format!("bare_{tier:?}"), &out);
+        let (rock, speckle) = slope_patch(&out);
+        eprintln!("{tier:?}: snow {snowy:.1}, bare {rock:.1}, speckle {speckle:.4}");
+        assert!(
+            rock < 0.7 * snowy,
+            "{tier:?}: the bare slope reads {rock}, its snow {snowy}"
+        );
+        assert!(
+            speckle < 0.02,
+            "{tier:?}: {speckle} of the bare slope's pixels jump"
+        );
     }
 }
 

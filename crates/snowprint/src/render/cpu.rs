@@ -86,6 +86,20 @@ pub fn linear_taps(dir: Vec3, t_max: f32, texel: f32, density: f32, min: f32, ma
     (travel * density).ceil().clamp(min, max) as u32
 }
 
+/// The most linear taps on a surface whose box spans `terrain` (lowest base, highest untouched top;
+/// `None` on flat ground) under snow `snow_depth` deep: the tier's `max`, times the times the box
+/// is taller than the snow, at most [`TERRAIN_TAPS`]. Must match `snow_max_taps` in `snow.wgsl`.
+pub fn max_taps(max: f32, terrain: Option<(f32, f32)>, snow_depth: f32) -> f32 {
+    let Some((low, top)) = terrain else {
+        return max;
+    };
+    let tall = ((top - low) / snow_depth).max(1.0);
+    (max * tall).ceil().min(TERRAIN_TAPS.max(max))
+}
+
+/// The most linear taps a ray over ground that is not flat takes (`SNOW_TERRAIN_TAPS`).
+pub const TERRAIN_TAPS: f32 = 192.0;
+
 fn inside(height: &impl Fn(Vec2) -> f32, ray: &SlabRay, t: f32) -> bool {
     let p = ray.at(t);
     p.y <= height(Vec2::new(p.x, p.z)) + INSIDE_EPSILON
@@ -531,6 +545,12 @@ mod tests {
             19
         );
         assert_eq!(linear_taps(grazing, 10.0, 0.04, 0.5, 4.0, 16.0), 16);
+        // On ground: a box 6.3 m tall over 0.3 m of snow is 21 times the snow, so the relief
+        // tier's 12 taps become 252, held to 192; a box no taller than the snow keeps 12.
+        assert_eq!(max_taps(12.0, None, 0.3), 12.0);
+        assert_eq!(max_taps(12.0, Some((-1.0, 5.3)), 0.3), 192.0);
+        assert_eq!(max_taps(12.0, Some((0.0, 0.9)), 0.3), 36.0);
+        assert_eq!(max_taps(12.0, Some((0.1, 0.3)), 0.3), 12.0);
     }
 
     #[test]

@@ -27,7 +27,7 @@ pub fn build(
     let mut ground = Instance::new(floor, Mat4::IDENTITY, [0.78, 0.8, 0.86]);
     ground.roughness = 0.85;
     ground.snow_cover = 1.0;
-    v.push(ground);
+    v.push(ground.with_shadow(false));
     v.extend(trees(renderer, clear)?);
     v.extend(rocks(renderer)?);
     v.extend(cabin(renderer)?);

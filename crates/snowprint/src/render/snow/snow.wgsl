@@ -259,12 +259,27 @@ fn snow_slab_exit(s: SnowSurface, o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(max(t, 0.0), ground);
 }
 
-// Linear taps for `t_max` metres of ray: s.search.x per texel crossed, within [min, max].
-// Must match `linear_taps` in cpu.rs.
+// Linear taps for `t_max` metres of ray: s.search.x per texel crossed, within [min, max], the
+// max raised on ground that is not flat (`snow_max_taps`). Must match `linear_taps` in cpu.rs.
 fn snow_linear_taps(s: SnowSurface, d: vec3<f32>, t_max: f32) -> u32 {
     let travel = length(d.xz) * t_max / s.texel;
-    return u32(clamp(ceil(travel * s.search.x), s.search.y, s.search.z));
+    return u32(clamp(ceil(travel * s.search.x), s.search.y, snow_max_taps(s)));
 }
+
+// Most linear taps: the tier's, times the times the box is taller than the snow on ground that is
+// not flat (a valley's box holds metres of rise that a ray crosses between taps; with the tier's
+// taps alone the search steps over the slopes and their hits band into contours), at most
+// SNOW_TERRAIN_TAPS. Must match `max_taps` in cpu.rs.
+fn snow_max_taps(s: SnowSurface) -> f32 {
+    if s.terrain == SNOW_NO_GROUND {
+        return s.search.z;
+    }
+    let tall = max((s.terrain_top - s.terrain_low) / s.snow_depth, 1.0);
+    return min(ceil(s.search.z * tall), max(SNOW_TERRAIN_TAPS, s.search.z));
+}
+
+// The most linear taps a ray over ground that is not flat takes.
+const SNOW_TERRAIN_TAPS: f32 = 192.0;
 
 // Relief mapping: linear taps, then binary refinement. Returns (t, found).
 // Must match `relief_search` in cpu.rs.

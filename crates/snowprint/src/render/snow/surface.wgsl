@@ -310,6 +310,12 @@ fn on_ground(hit: SnowHit, hf_in: vec4<f32>, uv: vec2<f32>) -> OnGround {
     let hn = vec3<f32>(hf_in.y, hf_in.z, sqrt(max(1.0 - hf_in.y * hf_in.y - hf_in.z * hf_in.z, 0.0)));
     let n = snow_rnm(base_n, hn);
     out.hf = vec4<f32>(hf_in.x / held, n.x, n.y, hf_in.w);
+    // Where a slope holds almost none of the depth (under a tenth) the division above magnifies
+    // the search's last bits into speckle: the rock shows there, as where a print reaches the
+    // ground, fading in as the snow thins.
+    let snow = smoothstep(0.0, 0.1, held);
+    out.hit.position.y = mix(0.0, out.hit.position.y, snow);
+    out.hf.x = mix(1.0, out.hf.x, snow);
     return out;
 }
 
