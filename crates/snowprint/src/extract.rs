@@ -22,6 +22,9 @@ pub struct SurfaceView<'a> {
     pub normals: Option<u32>,
     /// Precision of its heights in the pool.
     pub precision: Precision,
+    /// Its toroidal storage offsets (`ox | oy << 16`, 0 for an ordinary surface): logical texel
+    /// (x, y) lives at ((x + ox) mod width, (y + oy) mod height) (`pool/texel.wgsl`).
+    pub wrap: u32,
 }
 
 /// Everything of a world a frame reads: the pool buffer, its format, and every live surface
@@ -68,6 +71,7 @@ impl SnowWorld {
                     heights,
                     normals,
                     precision: pool_format.precision,
+                    wrap: self.wrap(id).ok()?,
                 })
             })
             .collect();

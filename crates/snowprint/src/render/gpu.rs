@@ -259,8 +259,10 @@ pub struct ClassifyRecord {
     pub box_vertices: u32,
     /// Bits a channel of the pool's heightmaps.
     pub bits: u32,
+    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    pub wrap: u32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
@@ -281,8 +283,8 @@ pub struct HeightfieldParams {
     pub texel_x: f32,
     /// Texel side along z, metres.
     pub texel_z: f32,
-    /// Padding.
-    pub _pad2: f32,
+    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    pub wrap: u32,
     /// Unit direction towards the moon in the surface's local frame; w unused.
     pub light: [f32; 4],
 }

@@ -33,6 +33,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("skin", "skin/skin.wgsl", true),
     // Ground meshes rasterised into surfaces' texels (`ground/`).
     ("ground_raster", "ground/raster.wgsl", true),
+    // A terrain's sliding window: strips paged between the pool and the CPU (`window/`).
+    ("window_strip", "window/strip.wgsl", true),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe/probe.wgsl", true),
     // The renderer.

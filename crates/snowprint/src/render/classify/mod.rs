@@ -64,7 +64,8 @@ impl ClassifyPass {
                 height: s.view.layout.height,
                 box_vertices: BOX_VERTICES,
                 bits: s.view.precision.bits(),
-                _pad: [0; 3],
+                wrap: s.view.wrap,
+                _pad: [0; 2],
             })
             .collect();
         if n > 0 {

@@ -126,7 +126,7 @@ impl HeightfieldPass {
                 snow_depth: desc.snow_depth,
                 texel_x: desc.size.x / layout.width as f32,
                 texel_z: desc.size.y / layout.height as f32,
-                _pad2: 0.0,
+                wrap: surface.view.wrap,
                 light: {
                     let l = local_to_world
                         .inverse()

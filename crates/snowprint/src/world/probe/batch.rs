@@ -28,7 +28,7 @@ impl SnowWorld {
         let i = best?.1;
         let s = self.surfaces[i].as_ref()?;
         let id = SurfaceId(i as u32, self.generations[i]);
-        Some(cpu::query(
+        let (mut query, info) = cpu::query(
             &s.desc,
             &s.layout,
             precision,
@@ -36,7 +36,9 @@ impl SnowWorld {
             Some(id),
             s.ground.as_ref().map(|g| &g.field),
             point,
-        ))
+        );
+        query.wrap = s.wrap;
+        Some((query, info))
     }
 
     /// Record the queued probes as one batch into a free ring slot (the slot was kept free when

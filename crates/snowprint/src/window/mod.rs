@@ -1,0 +1,329 @@
+//! A terrain-wide snow layer whose heightmap is a window that follows a focus (the player or the
+//! camera): a clip map of nested levels, each one surface of a fixed texel size in the world's
+//! pool, stored toroidally so that moving the window rewrites only the strips that enter it.
+//!
+//! Each frame the game gives [`Terrain::follow`] the focus; every level's window is centred on it,
+//! snapped to whole texels of that level (`plan.rs`). When a level moves by `(dx, dz)` texels,
+//! the strip that leaves is gathered from the pool (`strip.rs`, `strip.wgsl`) and paged out into
+//! the terrain's store (`store.rs`), the strip that enters is written from the store (what was
+//! paged out there before, else fresh snow) and the level's offsets and rectangle move: nothing
+//! else in the pool is rewritten. Deformers are captured into every level as into any surface,
+//! by the world's own update, under the same budget and pool; the far levels' coarse texels keep
+//! the broad shape of trails that the near level has paged out.
+//!
+//! Every pass computes in logical texels (the capture's and the blur's space); only the pool's
+//! texel functions map a logical texel to where it is stored (`pool/texel.wgsl`).
+
+pub mod plan;
+pub mod store;
+pub mod strip;
+
+use glam::{Vec2, Vec3};
+
+use crate::error::{Result, SnowError};
+use crate::material::Material;
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+use crate::world::SnowWorld;
+use strip::{Direction, StripGpu, StripParams};
+
+/// One level of a terrain's clip map: a window of `texels` at `texel_size` metres a texel.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LevelDesc {
+    /// Texels along world x and z.
+    pub texels: [u32; 2],
+    /// Texel side, metres.
+    pub texel_size: f32,
+}
+
+/// A terrain-wide snow layer: flat ground at `ground_height`, its snow and its levels, finest
+/// first (e.g. near 1024^2 at 5 cm, far 512^2 at 40 cm).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TerrainDesc {
+    /// Name; level `i`'s surface is named `"{name}/{i}"`.
+    pub name: String,
+    /// World height of the ground under the snow, metres.
+    pub ground_height: f32,
+    /// Depth of fresh snow, metres.
+    pub snow_depth: f32,
+    /// Fraction of the snow depth refilled per second while it snows.
+    pub replenish_rate: f32,
+    /// What it is made of.
+    pub material: Material,
+    /// The levels, finest first.
+    pub levels: Vec<LevelDesc>,
+}
+
+/// What scrolling the window has cost, since the terrain was made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ScrollStats {
+    /// Scrolls that moved at least one level.
+    pub scrolls: u64,
+    /// Texels paged out of the pool.
+    pub texels_out: u64,
+    /// Texels written into the pool.
+    pub texels_in: u64,
+    /// Pool bytes written by the strips that entered, counted on the GPU as they were stored.
+    pub bytes_written: u64,
+    /// Of the entering texels, those paged back in (visited before) rather than fresh snow.
+    pub texels_paged_in: u64,
+    /// Compressed bytes the page store holds now.
+    pub store_bytes: u64,
+}
+
+/// One level as the terrain keeps it.
+#[derive(Clone, Copy, Debug)]
+struct Level {
+    surface: SurfaceId,
+    desc: LevelDesc,
+    /// World texel of its logical texel (0, 0).
+    origin: [i64; 2],
+}
+
+/// A terrain-wide snow layer in a [`SnowWorld`]: its levels are surfaces of the world (drawn by
+/// the renderer, probed, captured and updated as any surface); [`Terrain::follow`] moves them.
+pub struct Terrain {
+    desc: TerrainDesc,
+    levels: Vec<Level>,
+    store: store::StripStore,
+    strips: StripGpu,
+    stats: ScrollStats,
+    /// Pool bytes the last scroll wrote.
+    last_written: u64,
+}
+
+impl Terrain {
+    /// Add the terrain's levels to `world`, centred on `focus`. Refused, in one sentence naming
+    /// the value, when a level has no texels, a texel side not above 0 or is larger than the
+    /// capture atlas, when the levels do not fit the pool, or when the focus is not finite;
+    /// nothing is added then.
+    pub fn new(world: &mut SnowWorld, desc: TerrainDesc, focus: Vec3) -> Result<Self> {
+        validate(&desc, world)?;
+        check_focus(&desc.name, focus)?;
+        let mut levels: Vec<Level> = Vec::new();
+        for (i, l) in desc.levels.iter().enumerate() {
+            let origin = plan::origin_for(
+                [focus.x as f64, focus.z as f64],
+                l.texel_size as f64,
+                l.texels,
+                world.pool_format().precision.unit_texels(),
+            );
+            let layout = SurfaceLayout {
+                width: l.texels[0],
+                height: l.texels[1],
+            };
+            let surface = SurfaceDesc {
+                name: format!("{}/{i}", desc.name),
+                center: center_of(&desc, l, origin),
+                size: Vec2::new(l.texels[0] as f32, l.texels[1] as f32) * l.texel_size,
+                yaw_degrees: 0.0,
+                snow_depth: desc.snow_depth,
+                replenish_rate: desc.replenish_rate,
+                material: desc.material.clone(),
+            };
+            let added = world.add_level(surface, layout).and_then(|id| {
+                world.move_level(id, center_of(&desc, l, origin), plan::wrap_for(origin, l.texels))?;
+                Ok(id)
+            });
+            match added {
+                Ok(id) => levels.push(Level {
+                    surface: id,
+                    desc: *l,
+                    origin,
+                }),
+                Err(e) => {
+                    for l in &levels {
+                        let _ = world.remove_surface(l.surface);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        Ok(Self {
+            strips: StripGpu::new(world.device(), world.pool_format().precision),
+            desc,
+            levels,
+            store: Default::default(),
+            stats: Default::default(),
+            last_written: 0,
+        })
+    }
+
+    /// The description.
+    pub fn desc(&self) -> &TerrainDesc {
+        &self.desc
+    }
+
+    /// Each level's surface, finest first.
+    pub fn surfaces(&self) -> Vec<SurfaceId> {
+        self.levels.iter().map(|l| l.surface).collect()
+    }
+
+    /// World texel of level `level`'s logical texel (0, 0) (`None` past the last level).
+    pub fn origin(&self, level: usize) -> Option<[i64; 2]> {
+        self.levels.get(level).map(|l| l.origin)
+    }
+
+    /// What scrolling has cost so far.
+    pub fn stats(&self) -> ScrollStats {
+        ScrollStats {
+            store_bytes: self.store.bytes(),
+            ..self.stats
+        }
+    }
+
+    /// Pool bytes the last [`Terrain::follow`] wrote (0 when no level moved).
+    pub fn last_bytes_written(&self) -> u64 {
+        self.last_written
+    }
+
+    /// Centre every level on `focus` (world metres; y is ignored), scrolling those that move:
+    /// their leaving strips paged out, their entering strips written, their offsets moved. Waits
+    /// for the GPU when a level moved (the leaving texels are read back). Call it between frames,
+    /// not between `encode_step` and `submitted`.
+    pub fn follow(&mut self, world: &mut SnowWorld, focus: Vec3) -> Result<u64> {
+        check_focus(&self.desc.name, focus)?;
+        let unit = world.pool_format().precision.unit_texels();
+        let mut dispatches = Vec::new();
+        let mut incoming = Vec::new();
+        let mut leaving = Vec::new();
+        let mut moves = Vec::new();
+        let (mut out_texels, mut in_texels) = (0u32, 0u32);
+        for (i, level) in self.levels.iter().enumerate() {
+            let l = level.desc;
+            let to = plan::origin_for([focus.x as f64, focus.z as f64], l.texel_size as f64, l.texels, unit);
+            if to == level.origin {
+                continue;
+            }
+            let (heights, layout, _) = world.level_slot(level.surface)?;
+            let mut wrap = plan::wrap_for(level.origin, l.texels);
+            for step in plan::scroll(level.origin, to, l.texels) {
+                let params = |s: &plan::Strip, wrap: u32, first: u32| StripParams {
+                    heights,
+                    width: layout.width,
+                    height: layout.height,
+                    wrap,
+                    x0: s.x0,
+                    y0: s.y0,
+                    columns: s.columns,
+                    rows: s.rows,
+                    first,
+                    unit_bytes: self.strips.unit_bytes(),
+                    _pad: [0; 2],
+                };
+                dispatches.push((Direction::Out, params(&step.leaving, wrap, out_texels)));
+                leaving.push((i, step.leaving));
+                out_texels += step.leaving.texels() as u32;
+                let e = step.entering;
+                let texels = self.store.get(i, e.world, e.columns, e.rows);
+                self.stats.texels_paged_in += texels.chunks_exact(2).filter(|p| p != &[0, 0]).count() as u64;
+                incoming.extend(texels);
+                dispatches.push((Direction::In, params(&e, step.wrap, in_texels)));
+                in_texels += e.texels() as u32;
+                wrap = step.wrap;
+            }
+            moves.push((i, to, wrap));
+        }
+        if moves.is_empty() {
+            self.last_written = 0;
+            return Ok(0);
+        }
+        let mut enc = world.device().create_command_encoder(&Default::default());
+        let read = self.strips.encode(world.device(), world.queue(), &mut enc, world.pool_buffer(), &dispatches, &incoming);
+        world.queue().submit([enc.finish()]);
+        let (pairs, written) = read.wait(world.device())?;
+        let mut at = 0usize;
+        for (i, s) in leaving {
+            let n = 2 * s.texels() as usize;
+            self.store.put(i, s.world, s.columns, s.rows, &pairs[at..at + n]);
+            at += n;
+        }
+        for (i, to, wrap) in moves {
+            let l = &mut self.levels[i];
+            l.origin = to;
+            world.move_level(l.surface, center_of(&self.desc, &l.desc, to), wrap)?;
+        }
+        self.stats.scrolls += 1;
+        self.stats.texels_out += out_texels as u64;
+        self.stats.texels_in += in_texels as u64;
+        self.stats.bytes_written += written;
+        self.last_written = written;
+        Ok(written)
+    }
+}
+
+/// The world centre of a level's rectangle whose first world texel is `origin`, on the ground.
+fn center_of(desc: &TerrainDesc, l: &LevelDesc, origin: [i64; 2]) -> Vec3 {
+    let s = l.texel_size as f64;
+    Vec3::new(
+        ((origin[0] as f64 + l.texels[0] as f64 / 2.0) * s) as f32,
+        desc.ground_height,
+        ((origin[1] as f64 + l.texels[1] as f64 / 2.0) * s) as f32,
+    )
+}
+
+fn check_focus(name: &str, focus: Vec3) -> Result<()> {
+    if focus.is_finite() && focus.x.abs() < 1.0e7 && focus.z.abs() < 1.0e7 {
+        return Ok(());
+    }
+    Err(SnowError::InvalidTerrain {
+        name: name.to_owned(),
+        what: "the focus".into(),
+        value: format!("{:?}", focus.to_array()),
+        expected: "a finite point within 10000 km of the origin".into(),
+    })
+}
+
+/// Check a terrain against the world it goes into, naming the first thing that is wrong.
+fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
+    let bad = |what: String, value: String, expected: String| {
+        Err(SnowError::InvalidTerrain {
+            name: desc.name.clone(),
+            what,
+            value,
+            expected,
+        })
+    };
+    if desc.levels.is_empty() {
+        return bad("levels".into(), "empty".into(), "at least one level".into());
+    }
+    if !(desc.ground_height.is_finite()) {
+        return bad("ground_height".into(), desc.ground_height.to_string(), "finite".into());
+    }
+    let format = world.pool_format();
+    let side = world.config().atlas_side;
+    let mut bytes = 0u64;
+    for (i, l) in desc.levels.iter().enumerate() {
+        let [w, h] = l.texels;
+        if w == 0 || h == 0 || w > side || h > side || w > 0xffff || h > 0xffff {
+            return bad(
+                format!("level {i}'s texels"),
+                format!("[{w}, {h}]"),
+                format!("between 1 and {side} a side (the capture atlas's side, WorldConfig.atlas_side)"),
+            );
+        }
+        if format.precision.unit_texels() == 2 && w % 2 == 1 {
+            return bad(
+                format!("level {i}'s texels"),
+                format!("[{w}, {h}]"),
+                "an even number of texels along x in an 8-bit pool".into(),
+            );
+        }
+        if !(l.texel_size.is_finite() && l.texel_size >= crate::MIN_TEXEL_SIZE && l.texel_size <= 100.0) {
+            return bad(
+                format!("level {i}'s texel_size"),
+                l.texel_size.to_string(),
+                format!("a number of metres from {} to 100", crate::MIN_TEXEL_SIZE),
+            );
+        }
+        bytes += format.slot_bytes(w, h);
+    }
+    let budget = world.memory().pool_budget;
+    if bytes > budget {
+        return bad(
+            "the levels' heightmaps".into(),
+            format!("{bytes} bytes"),
+            format!("at most the pool's {budget} bytes (WorldConfig.pool_bytes, or fewer or smaller levels)"),
+        );
+    }
+    Ok(())
+}
