@@ -1,0 +1,247 @@
+//! A terrain's sliding window (`Terrain`, `window/`): a walker leaves the near level's window and
+//! comes back to find its trail as a window that never scrolled keeps it; a scroll by k columns
+//! writes exactly the entering strip's bytes and nothing else in the pool; wrapped and unwrapped
+//! storage give the same logical heightmap; the far level keeps the trail's broad shape after the
+//! near one paged it out; refusals in one sentence.
+
+mod common;
+
+use glam::Vec3;
+use snowprint::{
+    Deformer, LevelDesc, Material, Pose, Precision, PoolFormat, Shape, SnowError, SnowWorld,
+    SurfaceDesc, Terrain, TerrainDesc, WorldConfig,
+};
+
+const DEPTH: f32 = 0.3;
+
+fn world(precision: Precision) -> SnowWorld {
+    let config = WorldConfig {
+        format: PoolFormat::new(precision),
+        ..WorldConfig::default()
+    };
+    SnowWorld::new(common::gpu(), config).expect("world")
+}
+
+fn terrain(name: &str, levels: &[([u32; 2], f32)]) -> TerrainDesc {
+    TerrainDesc {
+        name: name.into(),
+        ground_height: 1.0,
+        snow_depth: DEPTH,
+        replenish_rate: 0.0,
+        material: Material::snow(),
+        levels: levels
+            .iter()
+            .map(|&(texels, texel_size)| LevelDesc { texels, texel_size })
+            .collect(),
+    }
+}
+
+/// A foot: a 6 cm ball pressed 15 cm into the snow at world (x, z).
+fn foot(x: f32, z: f32) -> Deformer {
+    Deformer::new(
+        Shape::Sphere { radius: 0.06 },
+        Pose::at([x, 1.0 + DEPTH - 0.15 + 0.06, z]),
+    )
+}
+
+/// The walker's prints: left and right of a line along x, one a frame.
+fn walk() -> Vec<Deformer> {
+    (0..40)
+        .map(|i| foot(0.3 + i as f32 * 0.07, if i % 2 == 0 { 0.1 } else { -0.1 }))
+        .collect()
+}
+
+/// Depression channel of a level, logical order, by world texel.
+fn by_world(w: &SnowWorld, t: &Terrain, level: usize) -> std::collections::HashMap<(i64, i64), u32> {
+    let id = t.surfaces()[level];
+    let l = w.layout(id).unwrap();
+    let (dep, _) = w.read_channels(id).unwrap();
+    let o = t.origin(level).unwrap();
+    let mut m = std::collections::HashMap::new();
+    for y in 0..l.height {
+        for x in 0..l.width {
+            m.insert((o[0] + x as i64, o[1] + y as i64), dep[(y * l.width + x) as usize]);
+        }
+    }
+    m
+}
+
+/// The walker prints its trail while a camera a little behind it is the near window's focus; the
+/// camera then goes 12 m away (the near window pages the trail out and rewrites itself twice
+/// over) and comes back. The trail it finds is texel for texel the trail of a window large enough
+/// never to scroll, and without the page store it would be gone.
+#[test]
+fn a_walker_leaves_the_window_and_finds_its_trail_texel_for_texel() {
+    let (mut w, mut big) = (world(Precision::Bits16), world(Precision::Bits16));
+    let near = [([64, 48], 0.05)];
+    let mut t = Terrain::new(&mut w, terrain("valley", &near), Vec3::ZERO).unwrap();
+    let never = Terrain::new(&mut big, terrain("valley", &[([256, 64], 0.05)]), Vec3::new(2.0, 0.0, 0.0)).unwrap();
+    for d in walk() {
+        let camera = d.pose.position - Vec3::new(0.3, 0.0, 0.0);
+        t.follow(&mut w, camera).unwrap();
+        w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        big.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    assert_eq!(never.stats().scrolls, 0);
+    let reference = by_world(&big, &never, 0);
+    for x in [6.0f32, 12.0, 6.0, 1.5] {
+        t.follow(&mut w, Vec3::new(x, 0.0, 0.0)).unwrap();
+        w.step(1.0 / 60.0, &[]).unwrap();
+    }
+    let back = by_world(&w, &t, 0);
+    let (mut compared, mut pressed) = (0, 0);
+    for (texel, &v) in &back {
+        let r = reference[texel];
+        assert_eq!(v, r, "world texel {texel:?}: {v} after the walk out and back, {r} in the window that never scrolled");
+        compared += 1;
+        pressed += (r > 0) as u32;
+    }
+    assert_eq!(compared, 64 * 48);
+    assert!(pressed > 200, "only {pressed} texels of the trail were compared");
+    let s = t.stats();
+    assert!(s.texels_paged_in >= pressed as u64, "{s:?}");
+    println!("walk out and back: {compared} texels compared, {pressed} pressed, {s:?}");
+}
+
+/// A scroll by k columns writes k x rows texels' bytes, counted by the GPU as it stores them, at
+/// every precision; in the pool, only the entering strip's storage changed.
+#[test]
+fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
+    for (p, texel_bytes) in [(Precision::Bits8, 2u64), (Precision::Bits16, 4), (Precision::Bits32, 8)] {
+        let mut w = world(p);
+        let (cols, rows) = (64u32, 48u32);
+        let mut t = Terrain::new(&mut w, terrain("strip", &[([cols, rows], 0.05)]), Vec3::ZERO).unwrap();
+        let id = t.surfaces()[0];
+        // Press the whole window so that fresh snow entering shows.
+        let slab = Deformer::new(Shape::Box { half_extents: Vec3::new(2.0, 0.1, 2.0) }, Pose::at([0.0, 1.2, 0.0]));
+        w.step(1.0 / 60.0, &[slab]).unwrap();
+        let before = w.read_packed(id).unwrap();
+        let wrap0 = w.wrap(id).unwrap();
+        for k in [2u32, 6] {
+            let focus = Vec3::new(k as f32 * 0.05, 0.0, 0.0);
+            let packed = w.read_packed(id).unwrap();
+            let written = t.follow(&mut w, focus).unwrap();
+            assert_eq!(written, k as u64 * rows as u64 * texel_bytes, "{p}: scroll by {k} columns");
+            assert_eq!(t.last_bytes_written(), written);
+            let after = w.read_packed(id).unwrap();
+            let changed = packed.iter().zip(&after).filter(|(a, b)| a != b).count();
+            // The pressed texels of the strip came back as fresh snow; nothing else moved.
+            let words_a_column = match p {
+                Precision::Bits8 => rows as usize / 2,
+                Precision::Bits16 => rows as usize,
+                Precision::Bits32 => 2 * rows as usize,
+            };
+            assert_eq!(changed, k as usize * words_a_column, "{p}: {k}");
+            t.follow(&mut w, Vec3::ZERO).unwrap();
+        }
+        // Back where it started: the same storage, the same offsets, every texel as before.
+        assert_eq!(w.wrap(id).unwrap(), wrap0);
+        assert_eq!(w.read_packed(id).unwrap(), before, "{p}");
+        let s = t.stats();
+        assert_eq!(s.bytes_written, s.texels_in * texel_bytes, "{p}: {s:?}");
+    }
+}
+
+/// The same walk on a level stored wrapped (offsets (13, 7) after a scroll) and on an ordinary
+/// surface of the same rectangle and layout: the same logical heightmap bit for bit, and the
+/// level's storage is the surface's rotated by the offsets.
+#[test]
+fn wrapped_and_unwrapped_storage_give_the_same_logical_heightmap() {
+    for p in [Precision::Bits8, Precision::Bits16, Precision::Bits32] {
+        let (mut a, mut b) = (world(p), world(p));
+        let desc = terrain("wrapped", &[([64, 48], 0.04)]);
+        let mut t = Terrain::new(&mut a, desc, Vec3::new(-5.0, 0.0, 3.0)).unwrap();
+        // A window whose first world texel is (14, 7): stored with offsets (14, 7).
+        let focus = Vec3::new((14.0 + 32.0) * 0.04, 0.0, (7.0 + 24.0) * 0.04);
+        t.follow(&mut a, focus).unwrap();
+        let level = t.surfaces()[0];
+        assert_eq!(a.wrap(level).unwrap(), 14 | 7 << 16, "{p}");
+        let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
+        assert_eq!(b.layout(plain).unwrap(), a.layout(level).unwrap());
+        assert_eq!(b.wrap(plain).unwrap(), 0);
+        for d in walk() {
+            let d = Deformer { pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()), ..d };
+            a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+            b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        }
+        let (la, lb) = (a.read_channels(level).unwrap(), b.read_channels(plain).unwrap());
+        assert!(la.0.iter().filter(|&&v| v > 0).count() > 200, "{p}: the walk pressed nothing");
+        assert_eq!(la, lb, "{p}: wrapped and unwrapped heightmaps differ");
+        assert_ne!(a.read_packed(level).unwrap(), b.read_packed(plain).unwrap(), "{p}: not stored wrapped");
+        // Snapshots are in logical order too.
+        let sa = a.snapshot_surfaces(&[level]).unwrap();
+        let sb = b.snapshot_surfaces(&[plain]).unwrap();
+        assert_eq!(sa[0].words, sb[0].words, "{p}");
+        // Probes read through the wrap: the same answers at the prints.
+        let points: Vec<Vec3> = (0..8).map(|i| Vec3::new(0.7 + 0.07 * i as f32, 1.0, 1.3)).collect();
+        let (pa, pb) = (probe(&mut a, &points), probe(&mut b, &points));
+        assert!(pa.iter().any(|x| x.depression_m > 0.01), "{p}: the probes missed the prints");
+        for (x, y) in pa.iter().zip(&pb) {
+            assert_eq!((x.depression_m, x.normal), (y.depression_m, y.normal), "{p}");
+        }
+    }
+}
+
+fn probe(w: &mut SnowWorld, points: &[Vec3]) -> Vec<snowprint::ProbeSample> {
+    let ticket = w.probe(points).unwrap();
+    for _ in 0..4 {
+        w.step(1.0 / 60.0, &[]).unwrap();
+        if let snowprint::ProbeStatus::Ready(s) = w.probe_result(ticket).unwrap() {
+            return s;
+        }
+    }
+    panic!("probes not answered in 4 frames");
+}
+
+/// Two levels: the near one (5 cm) pages the trail out when the focus walks 4 m away, the far one
+/// (20 cm) still covers it and holds its broad shape: pressed under the prints' line, untouched
+/// beside it.
+#[test]
+fn the_far_level_keeps_the_trails_broad_shape() {
+    let mut w = world(Precision::Bits16);
+    let levels = [([48, 48], 0.05), ([64, 64], 0.2)];
+    let mut t = Terrain::new(&mut w, terrain("clip", &levels), Vec3::new(1.5, 0.0, 0.0)).unwrap();
+    for d in walk() {
+        w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    t.follow(&mut w, Vec3::new(5.5, 0.0, 0.0)).unwrap();
+    let near = by_world(&w, &t, 0);
+    assert!(near.values().all(|&v| v == 0), "the near level still holds the trail");
+    let far = by_world(&w, &t, 1);
+    // World texels of 20 cm: the trail runs along z = 0 (rows -1 and 0) from x = 0.3 to 3.0 m.
+    let on_trail: Vec<u32> = (2..15).map(|i| far[&(i, -1)].max(far[&(i, 0)])).collect();
+    let beside: Vec<u32> = (2..15).flat_map(|i| [far[&(i, -4)], far[&(i, 3)]]).collect();
+    // A 20 cm texel samples the 6 cm balls at its centre: about 9 % of the depth on this line.
+    assert!(on_trail.iter().all(|&v| v > 65535 / 20), "far level along the trail: {on_trail:?}");
+    assert!(beside.iter().all(|&v| v == 0), "far level beside the trail: {beside:?}");
+    assert!(t.stats().texels_out > 0);
+}
+
+#[test]
+fn bad_terrains_and_foci_are_refused_in_one_sentence() {
+    let mut w = SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            pool_bytes: 1 << 20,
+            ..WorldConfig::default()
+        },
+    )
+    .unwrap();
+    let cases: [(TerrainDesc, &str); 4] = [
+        (terrain("a", &[([0, 16], 0.05)]), "level 0's texels is [0, 16]"),
+        (terrain("b", &[([16, 16], 0.05), ([16, 16], f32::NAN)]), "level 1's texel_size is NaN"),
+        (terrain("c", &[([1024, 1024], 0.05)]), "the levels' heightmaps is 4194304 bytes, but it must be at most the pool's 1048576 bytes"),
+        (terrain("d", &[]), "levels is empty"),
+    ];
+    for (desc, expected) in cases {
+        let e = Terrain::new(&mut w, desc, Vec3::ZERO).err().expect("refused").to_string();
+        assert!(e.contains(expected), "{e}");
+        assert_eq!(e.lines().count(), 1);
+    }
+    assert_eq!(w.surfaces().count(), 0, "a refused terrain left surfaces behind");
+    let mut t = Terrain::new(&mut w, terrain("e", &[([16, 16], 0.05)]), Vec3::ZERO).unwrap();
+    let e = t.follow(&mut w, Vec3::new(f32::NAN, 0.0, 0.0)).unwrap_err();
+    assert!(matches!(e, SnowError::InvalidTerrain { .. }), "{e}");
+    assert!(e.to_string().contains("the focus is [NaN, 0.0, 0.0]"), "{e}");
+    let _ = SurfaceDesc::new("unused", [0.0; 3], [1.0, 1.0], DEPTH);
+}
