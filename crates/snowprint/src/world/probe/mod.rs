@@ -216,7 +216,7 @@ impl Probes {
         Self {
             pipeline,
             layout,
-            queries: Growable::new(device, "probe queries", U::STORAGE | U::COPY_DST, 32 * 64),
+            queries: Growable::new(device, "probe queries", U::STORAGE | U::COPY_DST, 36 * 64),
             results: Growable::new(device, "probe results", U::STORAGE | U::COPY_SRC, 16 * 64),
             ring: (0..PROBE_RING)
                 .map(|_| RingSlot {
