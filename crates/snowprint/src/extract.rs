@@ -25,6 +25,10 @@ pub struct SurfaceView<'a> {
     /// Its toroidal storage offsets (`ox | oy << 16`, 0 for an ordinary surface): logical texel
     /// (x, y) lives at ((x + ox) mod width, (y + oy) mod height) (`pool/texel.wgsl`).
     pub wrap: u32,
+    /// A rectangle of its local xz `(x0, z0, x1, z1)` that a finer level of the same terrain
+    /// window draws instead (`crate::Terrain`); renderers leave it out. `None` for any other
+    /// surface.
+    pub hole: Option<[f32; 4]>,
 }
 
 /// Everything of a world a frame reads: the pool buffer, its format, and every live surface
@@ -72,6 +76,7 @@ impl SnowWorld {
                     normals,
                     precision: pool_format.precision,
                     wrap: self.wrap(id).ok()?,
+                    hole: self.hole(id).ok()?,
                 })
             })
             .collect();

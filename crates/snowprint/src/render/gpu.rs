@@ -126,7 +126,17 @@ pub struct SurfaceUniform {
     pub grain: [f32; 4],
     /// Translucency (x: the sky tint of prints' walls and the diffuse wrap); yzw unused.
     pub translucency: [f32; 4],
+    /// A rectangle of the surface's local xz `(x0, z0, x1, z1)` it does not draw, because a finer
+    /// level of the same terrain window draws it (`crate::Terrain`); empty (`x1 < x0`) otherwise.
+    pub hole: [f32; 4],
+    /// The heights' toroidal storage offsets, `ox | oy << 16` ([`crate::SurfaceView::wrap`]).
+    pub wrap: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
 }
+
+/// `SurfaceUniform::hole` of a surface that draws all of itself.
+pub const NO_HOLE: [f32; 4] = [1.0, 1.0, -1.0, -1.0];
 
 /// Room for rims above the snow top that the relief and POM tiers raise their slab by, metres:
 /// the material's share of the pushed volume times the snow depth (a rim a whole depth high needs
@@ -218,6 +228,9 @@ impl SurfaceUniform {
                 1.0,
                 rim_room(&desc.material, desc.snow_depth),
             ],
+            hole: surface.hole.unwrap_or(NO_HOLE),
+            wrap: surface.wrap,
+            _pad: [0; 3],
         }
     }
 
@@ -448,6 +461,8 @@ mod tests {
                 "translucency",
                 std::mem::offset_of!(SurfaceUniform, translucency),
             ),
+            ("hole", std::mem::offset_of!(SurfaceUniform, hole)),
+            ("wrap", std::mem::offset_of!(SurfaceUniform, wrap)),
         ];
         for (name, offset) in offsets {
             let m = members
@@ -490,7 +505,9 @@ mod tests {
             albedo,
             disturbed,
             grain,
-            translucency
+            translucency,
+            hole,
+            wrap
         );
         for (source, name) in [
             (&engine, "snowprint_Surface"),

@@ -138,14 +138,29 @@ impl Terrain {
                 }
             }
         }
-        Ok(Self {
+        let terrain = Self {
             strips: StripGpu::new(world.device(), world.pool_format().precision),
             desc,
             levels,
             store: Default::default(),
             stats: Default::default(),
             last_written: 0,
-        })
+        };
+        terrain.set_holes(world)?;
+        Ok(terrain)
+    }
+
+    /// Leave each level's finer neighbour's extent to it: level `i > 0` does not draw the
+    /// rectangle of level `i - 1` (in its own local frame), so the two never draw over each other.
+    fn set_holes(&self, world: &mut SnowWorld) -> Result<()> {
+        for pair in self.levels.windows(2) {
+            let (fine, coarse) = (&pair[0], &pair[1]);
+            let c = center_of(&self.desc, &coarse.desc, coarse.origin);
+            let (lo, hi) = extent_of(&fine.desc, fine.origin);
+            let hole = [lo.x - c.x, lo.y - c.z, hi.x - c.x, hi.y - c.z];
+            world.set_level_hole(coarse.surface, Some(hole))?;
+        }
+        Ok(())
     }
 
     /// The description.
@@ -242,6 +257,7 @@ impl Terrain {
             l.origin = to;
             world.move_level(l.surface, center_of(&self.desc, &l.desc, to), wrap)?;
         }
+        self.set_holes(world)?;
         self.stats.scrolls += 1;
         self.stats.texels_out += out_texels as u64;
         self.stats.texels_in += in_texels as u64;
@@ -258,6 +274,19 @@ fn center_of(desc: &TerrainDesc, l: &LevelDesc, origin: [i64; 2]) -> Vec3 {
         ((origin[0] as f64 + l.texels[0] as f64 / 2.0) * s) as f32,
         desc.ground_height,
         ((origin[1] as f64 + l.texels[1] as f64 / 2.0) * s) as f32,
+    )
+}
+
+/// The world xz rectangle `(min, max)` of a level whose first world texel is `origin`.
+fn extent_of(l: &LevelDesc, origin: [i64; 2]) -> (Vec2, Vec2) {
+    let s = l.texel_size as f64;
+    let at = |i: i64| (i as f64 * s) as f32;
+    (
+        Vec2::new(at(origin[0]), at(origin[1])),
+        Vec2::new(
+            at(origin[0] + l.texels[0] as i64),
+            at(origin[1] + l.texels[1] as i64),
+        ),
     )
 }
 

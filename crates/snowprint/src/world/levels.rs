@@ -33,6 +33,7 @@ impl SnowWorld {
             settle: Default::default(),
             ground: None,
             wrap: 0,
+            hole: None,
         }))
     }
 
@@ -53,6 +54,16 @@ impl SnowWorld {
         s.wrap = wrap;
         // The settling rectangle was in the old logical coordinates.
         s.settle = Default::default();
+        Ok(())
+    }
+
+    /// Leave `hole` (local xz, `(x0, z0, x1, z1)`) of a window level undrawn: a finer level
+    /// draws it.
+    pub(crate) fn set_level_hole(&mut self, id: SurfaceId, hole: Option<[f32; 4]>) -> Result<()> {
+        self.state(id)?;
+        if let Some(s) = self.surfaces[id.0 as usize].as_mut() {
+            s.hole = hole;
+        }
         Ok(())
     }
 

@@ -63,6 +63,8 @@ struct SurfaceState {
     /// Toroidal storage offsets of its slot, `ox | oy << 16` (a terrain window's level,
     /// `crate::window`); 0 for every other surface.
     wrap: u32,
+    /// The local rectangle a finer window level draws instead (`crate::window`).
+    hole: Option<[f32; 4]>,
 }
 
 /// What the last frame did, for debug readbacks.
@@ -367,6 +369,7 @@ impl SnowWorld {
             settle: Default::default(),
             ground: None,
             wrap: 0,
+            hole: None,
         }))
     }
 
@@ -519,6 +522,12 @@ impl SnowWorld {
     /// every surface but a terrain window's levels (`crate::Terrain`).
     pub fn wrap(&self, id: SurfaceId) -> Result<u32> {
         Ok(self.state(id)?.wrap)
+    }
+
+    /// The rectangle of a surface's local xz that a finer level of its terrain window draws
+    /// instead (see [`crate::SurfaceView::hole`]).
+    pub fn hole(&self, id: SurfaceId) -> Result<Option<[f32; 4]>> {
+        Ok(self.state(id)?.hole)
     }
 
     /// How the pool stores heightmaps.

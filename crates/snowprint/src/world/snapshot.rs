@@ -317,6 +317,7 @@ impl SnowWorld {
             settle: Default::default(),
             ground: None,
             wrap: 0,
+            hole: None,
         }))
     }
 }

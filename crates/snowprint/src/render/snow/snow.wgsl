@@ -69,6 +69,17 @@ struct SnowSurface {
     disturbed: vec4<f32>,   // xyz: disturbed albedo at the bottom of prints, w: wet roughness
     grain: vec4<f32>,       // x: grain, y: sparkle, z: wetness, w: water depth below the top (m, 0: none)
     translucency: vec4<f32>, // x: translucency (sky tint of walls, diffuse wrap; 1 snow, 0 sand and mud), y: depression where the material's ground starts to show (0: look.x's), z: where it shows fully, w: room for rims above the snow top (m, 0: none)
+    hole: vec4<f32>,        // local (x0, z0, x1, z1) a finer terrain window level draws instead (empty: x1 < x0)
+    wrap: u32,              // the heights' toroidal storage offsets (engine.wgsl, pool/texel.wgsl)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// Whether local xz lies in the surface's hole: a coarser terrain window level leaves the extent
+// of the finer one to it, so that the two never draw over each other (no seam, no fight).
+fn snow_in_hole(s: SnowSurface, xz: vec2<f32>) -> bool {
+    return all(xz >= s.hole.xy) && all(xz < s.hole.zw);
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;
