@@ -245,3 +245,113 @@ fn bad_terrains_and_foci_are_refused_in_one_sentence() {
     assert!(e.to_string().contains("the focus is [NaN, 0.0, 0.0]"), "{e}");
     let _ = SurfaceDesc::new("unused", [0.0; 3], [1.0, 1.0], DEPTH);
 }
+
+mod render {
+    use super::*;
+    use snowprint::render::{Environment, RenderConfig, RenderFrame, Renderer, Tier};
+    use snowprint::{Camera, GroundMaterial, SurfaceId};
+
+    fn shoot(w: &SnowWorld, ids: &[SurfaceId], tier: Tier, camera: Camera, size: (u32, u32)) -> Vec<u8> {
+        let mut c = RenderConfig::new(size.0, size.1, tier);
+        c.shadow_map_size = 256;
+        c.snowflakes = 0;
+        let surfaces: Vec<_> = ids.iter().map(|&i| (i, GroundMaterial::Concrete)).collect();
+        let mut r = Renderer::new(common::gpu(), c).unwrap();
+        let f = RenderFrame {
+            camera,
+            time: 0.0,
+            surfaces: &surfaces,
+            instances: &[],
+            lights: &[],
+            environment: Environment::moonlit_night(),
+            snowfall: false,
+        };
+        r.render(w, &f).unwrap().rgba8
+    }
+
+    fn save(name: &str, rgba: &[u8], size: (u32, u32)) {
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
+        std::fs::create_dir_all(&dir).unwrap();
+        image::save_buffer(dir.join(name), rgba, size.0, size.1, image::ColorType::Rgba8).unwrap();
+    }
+
+    /// The renderer's heightfield pass reads a wrapped level through the wrap: the walk on a level
+    /// stored with offsets (14, 7) and on the same rectangle stored plainly give the same image,
+    /// bit for bit, in the relief and tessellated tiers (and not the untouched snow's).
+    #[test]
+    fn a_wrapped_level_renders_as_the_same_surface_stored_plainly() {
+        let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
+        let mut t = Terrain::new(&mut a, terrain("wrapped", &[([64, 48], 0.04)]), Vec3::ZERO).unwrap();
+        t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04)).unwrap();
+        let level = t.surfaces()[0];
+        let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
+        let camera = Camera {
+            eye: Vec3::new(1.9, 2.6, -0.9),
+            target: Vec3::new(1.9, 1.0, 1.25),
+            fov_y_degrees: 50.0,
+        };
+        let size = (160, 90);
+        let untouched = shoot(&a, &[level], Tier::Relief, camera, size);
+        for d in walk() {
+            let d = Deformer { pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()), ..d };
+            a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+            b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        }
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            let wrapped = shoot(&a, &[level], tier, camera, size);
+            let plainly = shoot(&b, &[plain], tier, camera, size);
+            save(&format!("wrapped_{tier:?}.png"), &wrapped, size);
+            assert!(wrapped == plainly, "{tier:?}: the wrapped level renders differently");
+            if tier == Tier::Relief {
+                let changed = wrapped.iter().zip(&untouched).filter(|(x, y)| x != y).count();
+                assert!(changed > 2000, "the trail changed only {changed} bytes of the image");
+            }
+        }
+    }
+
+    /// Two levels of one window, both untouched, drawn together look as the far level alone: the
+    /// far one leaves the near one's extent to it (no overlap, no seam where they meet); with a
+    /// trail across the near level, the still shows it inside the far level's snow.
+    #[test]
+    fn near_and_far_levels_meet_without_a_seam() {
+        let mut w = world(Precision::Bits16);
+        let levels = [([64, 64], 0.05), ([64, 64], 0.2)];
+        let t = Terrain::new(&mut w, terrain("clip", &levels), Vec3::new(1.6, 0.0, 0.0)).unwrap();
+        let [near, far] = [t.surfaces()[0], t.surfaces()[1]];
+        let hole = w.frame_view().surface(far).unwrap().hole.expect("the far level has a hole");
+        // The near level's extent, inset by a quarter of its texel (the two overlap that much).
+        let q = 0.25 * 0.05;
+        for (h, e) in hole.iter().zip([-1.6 + q, -1.6 + q, 1.6 - q, 1.6 - q]) {
+            assert!((h - e).abs() < 1e-5, "{hole:?}");
+        }
+        let camera = Camera {
+            eye: Vec3::new(1.6, 5.0, -5.5),
+            target: Vec3::new(1.6, 1.0, 0.5),
+            fov_y_degrees: 55.0,
+        };
+        let size = (320, 180);
+        let mut alone = world(Precision::Bits16);
+        let only = Terrain::new(&mut alone, terrain("clip", &levels[1..]), Vec3::new(1.6, 0.0, 0.0)).unwrap();
+        let far_only = only.surfaces()[0];
+        assert_eq!(alone.surface(far_only).unwrap().center, w.surface(far).unwrap().center);
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            let both = shoot(&w, &[near, far], tier, camera, size);
+            let reference = shoot(&alone, &[far_only], tier, camera, size);
+            save(&format!("levels_untouched_{tier:?}.png"), &both, size);
+            let differ: Vec<usize> = (0..both.len() / 4)
+                .filter(|&i| (0..3).any(|c| both[4 * i + c].abs_diff(reference[4 * i + c]) > 2))
+                .collect();
+            let at: Vec<(usize, usize)> = differ.iter().take(8).map(|i| (i % size.0 as usize, i / size.0 as usize)).collect();
+            println!("{tier:?}: untouched levels against the far level alone: {} pixels differ by more than 2 of 255, at {at:?}", differ.len());
+            // A crack where the meshes meet is a pixel or two: none is allowed.
+            assert!(differ.is_empty(), "{tier:?}: {} pixels differ, at {at:?}", differ.len());
+        }
+        for d in walk() {
+            w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        }
+        let trail = shoot(&w, &[near, far], Tier::Relief, camera, size);
+        save("levels_trail.png", &trail, size);
+        let trail_t = shoot(&w, &[near, far], Tier::Tessellated, camera, size);
+        save("levels_trail_tessellated.png", &trail_t, size);
+    }
+}

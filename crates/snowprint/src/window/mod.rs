@@ -26,6 +26,9 @@ use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 use crate::world::SnowWorld;
 use strip::{Direction, StripGpu, StripParams};
 
+/// How far inside a finer level's extent a coarser level's hole starts, in fine texels.
+const HOLE_INSET: f32 = 0.25;
+
 /// One level of a terrain's clip map: a window of `texels` at `texel_size` metres a texel.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LevelDesc {
@@ -157,7 +160,15 @@ impl Terrain {
             let (fine, coarse) = (&pair[0], &pair[1]);
             let c = center_of(&self.desc, &coarse.desc, coarse.origin);
             let (lo, hi) = extent_of(&fine.desc, fine.origin);
-            let hole = [lo.x - c.x, lo.y - c.z, hi.x - c.x, hi.y - c.z];
+            // Inset by a quarter of a fine texel: the two overlap by that much, so that no pixel
+            // on the edge is left to neither (the tessellated tier's meshes meet there).
+            let inset = fine.desc.texel_size * HOLE_INSET;
+            let hole = [
+                lo.x - c.x + inset,
+                lo.y - c.z + inset,
+                hi.x - c.x - inset,
+                hi.y - c.z - inset,
+            ];
             world.set_level_hole(coarse.surface, Some(hole))?;
         }
         Ok(())
