@@ -355,3 +355,40 @@ mod render {
         save("levels_trail_tessellated.png", &trail_t, size);
     }
 }
+
+/// `[[terrain]]` in a scene file: its keys become a `TerrainDesc` (levels finest first, inline or
+/// as `[[terrain.levels]]`), and its refusals name the file and line (more in
+/// `tests/hostile/scenes/terrain_*`).
+#[test]
+fn scene_keys_make_a_terrain_and_refuse_bad_ones_with_their_line() {
+    use snowprint::scene::{Scene, TerrainFollow};
+    let path = std::path::Path::new("valley.toml");
+    let text = "version = 1\n\n[[material]]\nname = \"dry\"\nlike = \"powder\"\n\n\
+                [[terrain]]\nname = \"valley\"\nground_height = 12.5\nsnow_depth = 0.4\n\
+                replenish_rate = 0.01\nmaterial = \"dry\"\n\n\
+                [[terrain.levels]]\ntexels = [1024, 1024]\ntexel_size = 0.05\n\n\
+                [[terrain.levels]]\ntexels = [512, 256]\ntexel_size = 0.4\n";
+    let scene = Scene::parse(text, path).unwrap();
+    assert!(scene.surfaces.is_empty());
+    let t = &scene.terrains[0];
+    assert_eq!((t.line, t.follow), (7, TerrainFollow::Player));
+    assert_eq!(t.desc.name, "valley");
+    assert_eq!((t.desc.ground_height, t.desc.snow_depth, t.desc.replenish_rate), (12.5, 0.4, 0.01));
+    assert_eq!(t.desc.material.look, Material::powder().look);
+    assert_eq!(
+        t.desc.levels,
+        vec![
+            LevelDesc { texels: [1024, 1024], texel_size: 0.05 },
+            LevelDesc { texels: [512, 256], texel_size: 0.4 },
+        ]
+    );
+    let refused = |extra: &str| {
+        Scene::parse(&format!("{text}{extra}"), path).unwrap_err().to_string()
+    };
+    let twice = refused("\n[[surface]]\nname = \"valley\"\ncenter = [0, 0, 0]\nsize = [1, 1]\nsnow_depth = 0.3\n");
+    assert!(twice.starts_with("valley.toml:8: surface name \"valley\" is used twice"), "{twice}");
+    let size = refused("\n[[terrain]]\nname = \"b\"\nsnow_depth = 0.3\nlevels = [{ texels = [64, 64], texel_size = 0.01 }]\n");
+    assert!(size.starts_with("valley.toml:25: terrain \"b\"'s level 0 has texel_size 0.01"), "{size}");
+    let pool = refused("\n[budget]\npool_bytes = 4194304\n");
+    assert!(pool.starts_with("valley.toml:14: terrain \"valley\"'s levels need 4718592 bytes of heightmap pool, and the pool has 4194304 left"), "{pool}");
+}
