@@ -193,28 +193,45 @@ fn probe(w: &mut SnowWorld, points: &[Vec3]) -> Vec<snowprint::ProbeSample> {
     panic!("probes not answered in 4 frames");
 }
 
-/// Two levels: the near one (5 cm) pages the trail out when the focus walks 4 m away, the far one
-/// (20 cm) still covers it and holds its broad shape: pressed under the prints' line, untouched
-/// beside it.
+/// Two levels: the near one (5 cm) pages the trail out when the focus walks 5 m away; the far one
+/// (40 cm) covers it, and its own coarse capture missed the 6 cm balls (its texel centres lie
+/// 20 cm either side of the line); the near level's leaving strips folded into it give it the
+/// trail's broad shape: pressed along the line, untouched beside it.
 #[test]
 fn the_far_level_keeps_the_trails_broad_shape() {
     let mut w = world(Precision::Bits16);
-    let levels = [([48, 48], 0.05), ([64, 64], 0.2)];
+    let levels = [([80, 48], 0.05), ([64, 64], 0.4)];
     let mut t = Terrain::new(&mut w, terrain("clip", &levels), Vec3::new(1.5, 0.0, 0.0)).unwrap();
     for d in walk() {
         w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
     }
-    t.follow(&mut w, Vec3::new(5.5, 0.0, 0.0)).unwrap();
+    // World texels of 40 cm: the trail runs along z = 0 (rows -1 and 0) from x = 0.3 to 3.0 m.
+    let line = |far: &std::collections::HashMap<(i64, i64), u32>| -> Vec<u32> {
+        (1..8).map(|i| far[&(i, -1)].max(far[&(i, 0)])).collect()
+    };
+    assert!(line(&by_world(&w, &t, 1)).iter().all(|&v| v == 0), "the far level captured the balls itself");
+    // The fold's reference: the deepest near texel whose centre lies in each 40 cm texel (8 x 8
+    // near texels of 5 cm), from the near level before it scrolls.
+    let mut expected = std::collections::HashMap::<(i64, i64), u32>::new();
+    for (&(x, z), &v) in &by_world(&w, &t, 0) {
+        let e = expected.entry((x.div_euclid(8), z.div_euclid(8))).or_default();
+        *e = (*e).max(v);
+    }
+    t.follow(&mut w, Vec3::new(6.5, 0.0, 0.0)).unwrap();
     let near = by_world(&w, &t, 0);
     assert!(near.values().all(|&v| v == 0), "the near level still holds the trail");
     let far = by_world(&w, &t, 1);
-    // World texels of 20 cm: the trail runs along z = 0 (rows -1 and 0) from x = 0.3 to 3.0 m.
-    let on_trail: Vec<u32> = (2..15).map(|i| far[&(i, -1)].max(far[&(i, 0)])).collect();
-    let beside: Vec<u32> = (2..15).flat_map(|i| [far[&(i, -4)], far[&(i, 3)]]).collect();
-    // A 20 cm texel samples the 6 cm balls at its centre: about 9 % of the depth on this line.
-    assert!(on_trail.iter().all(|&v| v > 65535 / 20), "far level along the trail: {on_trail:?}");
+    let on_trail = line(&far);
+    let beside: Vec<u32> = (1..8).flat_map(|i| [far[&(i, -3)], far[&(i, 2)]]).collect();
+    assert!(on_trail.iter().all(|&v| v > 65535 / 5), "far level along the trail: {on_trail:?}");
+    for i in 1..8 {
+        for z in [-3, -1, 0, 2] {
+            assert_eq!(far[&(i, z)], expected[&(i, z)], "far texel ({i}, {z})");
+        }
+    }
     assert!(beside.iter().all(|&v| v == 0), "far level beside the trail: {beside:?}");
-    assert!(t.stats().texels_out > 0);
+    let s = t.stats();
+    assert!(s.texels_out > 0 && s.bytes_folded > 0, "{s:?}");
 }
 
 #[test]

@@ -81,6 +81,25 @@ pub struct SceneTerrain {
     pub line: usize,
 }
 
+impl SceneTerrain {
+    /// Where its window is centred at time `t` of `scene`: the player deformer's position (else
+    /// the first deformer's, else the camera's target) or the camera's eye, else the origin.
+    pub fn focus(&self, scene: &Scene, t: f32) -> Vec3 {
+        let camera = scene.camera.as_ref();
+        match self.follow {
+            TerrainFollow::Player => scene
+                .deformers
+                .iter()
+                .find(|d| d.player)
+                .or(scene.deformers.first())
+                .map(|d| d.pose_at(t).position)
+                .or(camera.map(|c| c.target))
+                .unwrap_or(Vec3::ZERO),
+            TerrainFollow::Camera => camera.map_or(Vec3::ZERO, |c| c.at(t).eye),
+        }
+    }
+}
+
 /// What a scene's terrain window is centred on each frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TerrainFollow {

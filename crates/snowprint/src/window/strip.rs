@@ -42,12 +42,16 @@ pub enum Direction {
     Out,
     /// From the in strip buffer into the pool (an entering rectangle).
     In,
+    /// The in strip buffer folded into the pool by the larger of each channel (a finer level's
+    /// leaving strip, summed up at this level's texels).
+    Max,
 }
 
 /// The pass's pipelines and buffers (one set a terrain).
 pub struct StripGpu {
     out: wgpu::ComputePipeline,
     into: wgpu::ComputePipeline,
+    max: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     params: Growable,
     strip_out: Growable,
@@ -115,6 +119,7 @@ impl StripGpu {
         Self {
             out: make("strip_out"),
             into: make("strip_in"),
+            max: make("strip_max"),
             layout,
             params: Growable::new(device, "strip params", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 8),
             strip_out: Growable::new(device, "strip out", U::STORAGE | U::COPY_SRC, 4096),
@@ -139,7 +144,7 @@ impl StripGpu {
     }
 
     /// Record `dispatches` in order (each a rectangle and its direction; `params[i].first` set by
-    /// the caller), the entering texels `incoming` (word pairs, in the order of the `In`
+    /// the caller), the entering texels `incoming` (word pairs, in the order of the `In` and `Max`
     /// rectangles) uploaded first, and the readback of the leaving texels and of the counter.
     pub fn encode(
         &mut self,
@@ -157,7 +162,10 @@ impl StripGpu {
                 .map(|x| x.1.columns as u64 * x.1.rows as u64)
                 .sum()
         };
-        let (out_texels, in_texels) = (texels(Direction::Out), texels(Direction::In));
+        let (out_texels, in_texels) = (
+            texels(Direction::Out),
+            texels(Direction::In) + texels(Direction::Max),
+        );
         self.params.ensure(device, dispatches.len().max(1) as u64 * UNIFORM_STRIDE);
         self.strip_out.ensure(device, out_texels.max(1) * 8);
         self.strip_in.ensure(device, in_texels.max(1) * 8);
@@ -177,7 +185,7 @@ impl StripGpu {
         for (i, (dir, p)) in dispatches.iter().enumerate() {
             let strip = match dir {
                 Direction::Out => &self.strip_out.buffer,
-                Direction::In => &self.strip_in.buffer,
+                Direction::In | Direction::Max => &self.strip_in.buffer,
             };
             let bg = bind_group(
                 device,
@@ -199,6 +207,7 @@ impl StripGpu {
             pass.set_pipeline(match dir {
                 Direction::Out => &self.out,
                 Direction::In => &self.into,
+                Direction::Max => &self.max,
             });
             pass.set_bind_group(0, &bg, &[]);
             let g = crate::wgsl::consts::WORKGROUP;

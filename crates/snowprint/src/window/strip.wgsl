@@ -72,3 +72,27 @@ fn strip_in(@builtin(global_invocation_id) gid: vec3<u32>) {
         params.x0 + at.x, params.y0 + at.y, a, b);
     atomicAdd(&written[0], params.unit_bytes);
 }
+
+// A finer level's leaving strip folded into this (coarser) level: each channel becomes the
+// larger of what is stored and the strip's (the deepest fine texel over the coarse one, summed
+// up on the CPU: window/mod.rs), so the far level keeps the broad shape of trails the near level
+// pages out even where its own coarse capture missed them.
+@compute @workgroup_size(WORKGROUP, WORKGROUP, 1)
+fn strip_max(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let at = unit_of(gid);
+    if at.z == 0u {
+        return;
+    }
+    let i = 2u * (params.first + at.y * params.columns + at.x);
+    let x = params.x0 + at.x;
+    let y = params.y0 + at.y;
+    let a = max(vec2<u32>(strip[i], strip[i + 1u]),
+        pool_texel(PRECISION, params.heights, params.width, params.height, params.wrap, x, y));
+    var b = vec2<u32>(0u);
+    if unit_texels(PRECISION) == 2u {
+        b = max(vec2<u32>(strip[i + 2u], strip[i + 3u]),
+            pool_texel(PRECISION, params.heights, params.width, params.height, params.wrap, x + 1u, y));
+    }
+    pool_store_unit(PRECISION, params.heights, params.width, params.height, params.wrap, x, y, a, b);
+    atomicAdd(&written[0], params.unit_bytes);
+}
