@@ -52,7 +52,12 @@ impl Windows {
     }
 
     /// Centre every window on its focus at time `t`.
-    pub fn follow(&mut self, world: &mut SnowWorld, scene: &Scene, t: f32) -> snowprint::Result<()> {
+    pub fn follow(
+        &mut self,
+        world: &mut SnowWorld,
+        scene: &Scene,
+        t: f32,
+    ) -> snowprint::Result<()> {
         for (terrain, st) in self.terrains.iter_mut().zip(&scene.terrains) {
             terrain.follow(world, st.focus(scene, t))?;
         }
@@ -60,9 +65,19 @@ impl Windows {
     }
 
     /// Write every level's heightmap and description into the dump.
-    pub fn dump(&self, world: &SnowWorld, scene: &Scene, set: &mut OutputSet) -> Result<(), String> {
+    pub fn dump(
+        &self,
+        world: &SnowWorld,
+        scene: &Scene,
+        set: &mut OutputSet,
+    ) -> Result<(), String> {
         for (terrain, st) in self.terrains.iter().zip(&scene.terrains) {
-            for ((i, id), name) in terrain.surfaces().into_iter().enumerate().zip(level_names(st)) {
+            for ((i, id), name) in terrain
+                .surfaces()
+                .into_iter()
+                .enumerate()
+                .zip(level_names(st))
+            {
                 let map = world.read_heightmap(id).map_err(|e| e.to_string())?;
                 map.save_png(&set.path(&format!("{name}.png")))
                     .map_err(|e| e.to_string())?;

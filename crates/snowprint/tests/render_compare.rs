@@ -93,7 +93,7 @@ fn heightfield_pass_matches_its_cpu_reference() {
         snow_depth: depth,
         texel_x: texel.x,
         texel_z: texel.y,
-        _pad2: 0.0,
+        wrap: 0,
         light: [light.x, light.y, light.z, 0.0],
     };
     let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {

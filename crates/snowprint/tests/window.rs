@@ -8,7 +8,7 @@ mod common;
 
 use glam::Vec3;
 use snowprint::{
-    Deformer, LevelDesc, Material, Pose, Precision, PoolFormat, Shape, SnowError, SnowWorld,
+    Deformer, LevelDesc, Material, PoolFormat, Pose, Precision, Shape, SnowError, SnowWorld,
     SurfaceDesc, Terrain, TerrainDesc, WorldConfig,
 };
 
@@ -52,7 +52,11 @@ fn walk() -> Vec<Deformer> {
 }
 
 /// Depression channel of a level, logical order, by world texel.
-fn by_world(w: &SnowWorld, t: &Terrain, level: usize) -> std::collections::HashMap<(i64, i64), u32> {
+fn by_world(
+    w: &SnowWorld,
+    t: &Terrain,
+    level: usize,
+) -> std::collections::HashMap<(i64, i64), u32> {
     let id = t.surfaces()[level];
     let l = w.layout(id).unwrap();
     let (dep, _) = w.read_channels(id).unwrap();
@@ -60,7 +64,10 @@ fn by_world(w: &SnowWorld, t: &Terrain, level: usize) -> std::collections::HashM
     let mut m = std::collections::HashMap::new();
     for y in 0..l.height {
         for x in 0..l.width {
-            m.insert((o[0] + x as i64, o[1] + y as i64), dep[(y * l.width + x) as usize]);
+            m.insert(
+                (o[0] + x as i64, o[1] + y as i64),
+                dep[(y * l.width + x) as usize],
+            );
         }
     }
     m
@@ -75,7 +82,12 @@ fn a_walker_leaves_the_window_and_finds_its_trail_texel_for_texel() {
     let (mut w, mut big) = (world(Precision::Bits16), world(Precision::Bits16));
     let near = [([64, 48], 0.05)];
     let mut t = Terrain::new(&mut w, terrain("valley", &near), Vec3::ZERO).unwrap();
-    let never = Terrain::new(&mut big, terrain("valley", &[([256, 64], 0.05)]), Vec3::new(2.0, 0.0, 0.0)).unwrap();
+    let never = Terrain::new(
+        &mut big,
+        terrain("valley", &[([256, 64], 0.05)]),
+        Vec3::new(2.0, 0.0, 0.0),
+    )
+    .unwrap();
     for d in walk() {
         let camera = d.pose.position - Vec3::new(0.3, 0.0, 0.0);
         t.follow(&mut w, camera).unwrap();
@@ -92,12 +104,18 @@ fn a_walker_leaves_the_window_and_finds_its_trail_texel_for_texel() {
     let (mut compared, mut pressed) = (0, 0);
     for (texel, &v) in &back {
         let r = reference[texel];
-        assert_eq!(v, r, "world texel {texel:?}: {v} after the walk out and back, {r} in the window that never scrolled");
+        assert_eq!(
+            v, r,
+            "world texel {texel:?}: {v} after the walk out and back, {r} in the window that never scrolled"
+        );
         compared += 1;
         pressed += (r > 0) as u32;
     }
     assert_eq!(compared, 64 * 48);
-    assert!(pressed > 200, "only {pressed} texels of the trail were compared");
+    assert!(
+        pressed > 200,
+        "only {pressed} texels of the trail were compared"
+    );
     let s = t.stats();
     assert!(s.texels_paged_in >= pressed as u64, "{s:?}");
     println!("walk out and back: {compared} texels compared, {pressed} pressed, {s:?}");
@@ -107,13 +125,27 @@ fn a_walker_leaves_the_window_and_finds_its_trail_texel_for_texel() {
 /// every precision; in the pool, only the entering strip's storage changed.
 #[test]
 fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
-    for (p, texel_bytes) in [(Precision::Bits8, 2u64), (Precision::Bits16, 4), (Precision::Bits32, 8)] {
+    for (p, texel_bytes) in [
+        (Precision::Bits8, 2u64),
+        (Precision::Bits16, 4),
+        (Precision::Bits32, 8),
+    ] {
         let mut w = world(p);
         let (cols, rows) = (64u32, 48u32);
-        let mut t = Terrain::new(&mut w, terrain("strip", &[([cols, rows], 0.05)]), Vec3::ZERO).unwrap();
+        let mut t = Terrain::new(
+            &mut w,
+            terrain("strip", &[([cols, rows], 0.05)]),
+            Vec3::ZERO,
+        )
+        .unwrap();
         let id = t.surfaces()[0];
         // Press the whole window so that fresh snow entering shows.
-        let slab = Deformer::new(Shape::Box { half_extents: Vec3::new(2.0, 0.1, 2.0) }, Pose::at([0.0, 1.2, 0.0]));
+        let slab = Deformer::new(
+            Shape::Box {
+                half_extents: Vec3::new(2.0, 0.1, 2.0),
+            },
+            Pose::at([0.0, 1.2, 0.0]),
+        );
         w.step(1.0 / 60.0, &[slab]).unwrap();
         let before = w.read_packed(id).unwrap();
         let wrap0 = w.wrap(id).unwrap();
@@ -121,7 +153,11 @@ fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
             let focus = Vec3::new(k as f32 * 0.05, 0.0, 0.0);
             let packed = w.read_packed(id).unwrap();
             let written = t.follow(&mut w, focus).unwrap();
-            assert_eq!(written, k as u64 * rows as u64 * texel_bytes, "{p}: scroll by {k} columns");
+            assert_eq!(
+                written,
+                k as u64 * rows as u64 * texel_bytes,
+                "{p}: scroll by {k} columns"
+            );
             assert_eq!(t.last_bytes_written(), written);
             let after = w.read_packed(id).unwrap();
             let changed = packed.iter().zip(&after).filter(|(a, b)| a != b).count();
@@ -160,24 +196,46 @@ fn wrapped_and_unwrapped_storage_give_the_same_logical_heightmap() {
         assert_eq!(b.layout(plain).unwrap(), a.layout(level).unwrap());
         assert_eq!(b.wrap(plain).unwrap(), 0);
         for d in walk() {
-            let d = Deformer { pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()), ..d };
+            let d = Deformer {
+                pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()),
+                ..d
+            };
             a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
             b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
         }
-        let (la, lb) = (a.read_channels(level).unwrap(), b.read_channels(plain).unwrap());
-        assert!(la.0.iter().filter(|&&v| v > 0).count() > 200, "{p}: the walk pressed nothing");
+        let (la, lb) = (
+            a.read_channels(level).unwrap(),
+            b.read_channels(plain).unwrap(),
+        );
+        assert!(
+            la.0.iter().filter(|&&v| v > 0).count() > 200,
+            "{p}: the walk pressed nothing"
+        );
         assert_eq!(la, lb, "{p}: wrapped and unwrapped heightmaps differ");
-        assert_ne!(a.read_packed(level).unwrap(), b.read_packed(plain).unwrap(), "{p}: not stored wrapped");
+        assert_ne!(
+            a.read_packed(level).unwrap(),
+            b.read_packed(plain).unwrap(),
+            "{p}: not stored wrapped"
+        );
         // Snapshots are in logical order too.
         let sa = a.snapshot_surfaces(&[level]).unwrap();
         let sb = b.snapshot_surfaces(&[plain]).unwrap();
         assert_eq!(sa[0].words, sb[0].words, "{p}");
         // Probes read through the wrap: the same answers at the prints.
-        let points: Vec<Vec3> = (0..8).map(|i| Vec3::new(0.7 + 0.07 * i as f32, 1.0, 1.3)).collect();
+        let points: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new(0.7 + 0.07 * i as f32, 1.0, 1.3))
+            .collect();
         let (pa, pb) = (probe(&mut a, &points), probe(&mut b, &points));
-        assert!(pa.iter().any(|x| x.depression_m > 0.01), "{p}: the probes missed the prints");
+        assert!(
+            pa.iter().any(|x| x.depression_m > 0.01),
+            "{p}: the probes missed the prints"
+        );
         for (x, y) in pa.iter().zip(&pb) {
-            assert_eq!((x.depression_m, x.normal), (y.depression_m, y.normal), "{p}");
+            assert_eq!(
+                (x.depression_m, x.normal),
+                (y.depression_m, y.normal),
+                "{p}"
+            );
         }
     }
 }
@@ -209,27 +267,41 @@ fn the_far_level_keeps_the_trails_broad_shape() {
     let line = |far: &std::collections::HashMap<(i64, i64), u32>| -> Vec<u32> {
         (1..8).map(|i| far[&(i, -1)].max(far[&(i, 0)])).collect()
     };
-    assert!(line(&by_world(&w, &t, 1)).iter().all(|&v| v == 0), "the far level captured the balls itself");
+    assert!(
+        line(&by_world(&w, &t, 1)).iter().all(|&v| v == 0),
+        "the far level captured the balls itself"
+    );
     // The fold's reference: the deepest near texel whose centre lies in each 40 cm texel (8 x 8
     // near texels of 5 cm), from the near level before it scrolls.
     let mut expected = std::collections::HashMap::<(i64, i64), u32>::new();
     for (&(x, z), &v) in &by_world(&w, &t, 0) {
-        let e = expected.entry((x.div_euclid(8), z.div_euclid(8))).or_default();
+        let e = expected
+            .entry((x.div_euclid(8), z.div_euclid(8)))
+            .or_default();
         *e = (*e).max(v);
     }
     t.follow(&mut w, Vec3::new(6.5, 0.0, 0.0)).unwrap();
     let near = by_world(&w, &t, 0);
-    assert!(near.values().all(|&v| v == 0), "the near level still holds the trail");
+    assert!(
+        near.values().all(|&v| v == 0),
+        "the near level still holds the trail"
+    );
     let far = by_world(&w, &t, 1);
     let on_trail = line(&far);
     let beside: Vec<u32> = (1..8).flat_map(|i| [far[&(i, -3)], far[&(i, 2)]]).collect();
-    assert!(on_trail.iter().all(|&v| v > 65535 / 5), "far level along the trail: {on_trail:?}");
+    assert!(
+        on_trail.iter().all(|&v| v > 65535 / 5),
+        "far level along the trail: {on_trail:?}"
+    );
     for i in 1..8 {
         for z in [-3, -1, 0, 2] {
             assert_eq!(far[&(i, z)], expected[&(i, z)], "far texel ({i}, {z})");
         }
     }
-    assert!(beside.iter().all(|&v| v == 0), "far level beside the trail: {beside:?}");
+    assert!(
+        beside.iter().all(|&v| v == 0),
+        "far level beside the trail: {beside:?}"
+    );
     let s = t.stats();
     assert!(s.texels_out > 0 && s.bytes_folded > 0, "{s:?}");
 }
@@ -245,21 +317,40 @@ fn bad_terrains_and_foci_are_refused_in_one_sentence() {
     )
     .unwrap();
     let cases: [(TerrainDesc, &str); 4] = [
-        (terrain("a", &[([0, 16], 0.05)]), "level 0's texels is [0, 16]"),
-        (terrain("b", &[([16, 16], 0.05), ([16, 16], f32::NAN)]), "level 1's texel_size is NaN"),
-        (terrain("c", &[([1024, 1024], 0.05)]), "the levels' heightmaps is 4194304 bytes, but it must be at most the pool's 1048576 bytes"),
+        (
+            terrain("a", &[([0, 16], 0.05)]),
+            "level 0's texels is [0, 16]",
+        ),
+        (
+            terrain("b", &[([16, 16], 0.05), ([16, 16], f32::NAN)]),
+            "level 1's texel_size is NaN",
+        ),
+        (
+            terrain("c", &[([1024, 1024], 0.05)]),
+            "the levels' heightmaps is 4194304 bytes, but it must be at most the pool's 1048576 bytes",
+        ),
         (terrain("d", &[]), "levels is empty"),
     ];
     for (desc, expected) in cases {
-        let e = Terrain::new(&mut w, desc, Vec3::ZERO).err().expect("refused").to_string();
+        let e = Terrain::new(&mut w, desc, Vec3::ZERO)
+            .err()
+            .expect("refused")
+            .to_string();
         assert!(e.contains(expected), "{e}");
         assert_eq!(e.lines().count(), 1);
     }
-    assert_eq!(w.surfaces().count(), 0, "a refused terrain left surfaces behind");
+    assert_eq!(
+        w.surfaces().count(),
+        0,
+        "a refused terrain left surfaces behind"
+    );
     let mut t = Terrain::new(&mut w, terrain("e", &[([16, 16], 0.05)]), Vec3::ZERO).unwrap();
     let e = t.follow(&mut w, Vec3::new(f32::NAN, 0.0, 0.0)).unwrap_err();
     assert!(matches!(e, SnowError::InvalidTerrain { .. }), "{e}");
-    assert!(e.to_string().contains("the focus is [NaN, 0.0, 0.0]"), "{e}");
+    assert!(
+        e.to_string().contains("the focus is [NaN, 0.0, 0.0]"),
+        "{e}"
+    );
     let _ = SurfaceDesc::new("unused", [0.0; 3], [1.0, 1.0], DEPTH);
 }
 
@@ -268,7 +359,13 @@ mod render {
     use snowprint::render::{Environment, RenderConfig, RenderFrame, Renderer, Tier};
     use snowprint::{Camera, GroundMaterial, SurfaceId};
 
-    fn shoot(w: &SnowWorld, ids: &[SurfaceId], tier: Tier, camera: Camera, size: (u32, u32)) -> Vec<u8> {
+    fn shoot(
+        w: &SnowWorld,
+        ids: &[SurfaceId],
+        tier: Tier,
+        camera: Camera,
+        size: (u32, u32),
+    ) -> Vec<u8> {
         let mut c = RenderConfig::new(size.0, size.1, tier);
         c.shadow_map_size = 256;
         c.snowflakes = 0;
@@ -289,7 +386,14 @@ mod render {
     fn save(name: &str, rgba: &[u8], size: (u32, u32)) {
         let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
         std::fs::create_dir_all(&dir).unwrap();
-        image::save_buffer(dir.join(name), rgba, size.0, size.1, image::ColorType::Rgba8).unwrap();
+        image::save_buffer(
+            dir.join(name),
+            rgba,
+            size.0,
+            size.1,
+            image::ColorType::Rgba8,
+        )
+        .unwrap();
     }
 
     /// The renderer's heightfield pass reads a wrapped level through the wrap: the walk on a level
@@ -298,8 +402,10 @@ mod render {
     #[test]
     fn a_wrapped_level_renders_as_the_same_surface_stored_plainly() {
         let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
-        let mut t = Terrain::new(&mut a, terrain("wrapped", &[([64, 48], 0.04)]), Vec3::ZERO).unwrap();
-        t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04)).unwrap();
+        let mut t =
+            Terrain::new(&mut a, terrain("wrapped", &[([64, 48], 0.04)]), Vec3::ZERO).unwrap();
+        t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04))
+            .unwrap();
         let level = t.surfaces()[0];
         let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
         let camera = Camera {
@@ -310,7 +416,10 @@ mod render {
         let size = (160, 90);
         let untouched = shoot(&a, &[level], Tier::Relief, camera, size);
         for d in walk() {
-            let d = Deformer { pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()), ..d };
+            let d = Deformer {
+                pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()),
+                ..d
+            };
             a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
             b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
         }
@@ -318,10 +427,20 @@ mod render {
             let wrapped = shoot(&a, &[level], tier, camera, size);
             let plainly = shoot(&b, &[plain], tier, camera, size);
             save(&format!("wrapped_{tier:?}.png"), &wrapped, size);
-            assert!(wrapped == plainly, "{tier:?}: the wrapped level renders differently");
+            assert!(
+                wrapped == plainly,
+                "{tier:?}: the wrapped level renders differently"
+            );
             if tier == Tier::Relief {
-                let changed = wrapped.iter().zip(&untouched).filter(|(x, y)| x != y).count();
-                assert!(changed > 2000, "the trail changed only {changed} bytes of the image");
+                let changed = wrapped
+                    .iter()
+                    .zip(&untouched)
+                    .filter(|(x, y)| x != y)
+                    .count();
+                assert!(
+                    changed > 2000,
+                    "the trail changed only {changed} bytes of the image"
+                );
             }
         }
     }
@@ -335,7 +454,12 @@ mod render {
         let levels = [([64, 64], 0.05), ([64, 64], 0.2)];
         let t = Terrain::new(&mut w, terrain("clip", &levels), Vec3::new(1.6, 0.0, 0.0)).unwrap();
         let [near, far] = [t.surfaces()[0], t.surfaces()[1]];
-        let hole = w.frame_view().surface(far).unwrap().hole.expect("the far level has a hole");
+        let hole = w
+            .frame_view()
+            .surface(far)
+            .unwrap()
+            .hole
+            .expect("the far level has a hole");
         // The near level's extent, inset by a quarter of its texel (the two overlap that much).
         let q = 0.25 * 0.05;
         for (h, e) in hole.iter().zip([-1.6 + q, -1.6 + q, 1.6 - q, 1.6 - q]) {
@@ -348,9 +472,17 @@ mod render {
         };
         let size = (320, 180);
         let mut alone = world(Precision::Bits16);
-        let only = Terrain::new(&mut alone, terrain("clip", &levels[1..]), Vec3::new(1.6, 0.0, 0.0)).unwrap();
+        let only = Terrain::new(
+            &mut alone,
+            terrain("clip", &levels[1..]),
+            Vec3::new(1.6, 0.0, 0.0),
+        )
+        .unwrap();
         let far_only = only.surfaces()[0];
-        assert_eq!(alone.surface(far_only).unwrap().center, w.surface(far).unwrap().center);
+        assert_eq!(
+            alone.surface(far_only).unwrap().center,
+            w.surface(far).unwrap().center
+        );
         for tier in [Tier::Relief, Tier::Tessellated] {
             let both = shoot(&w, &[near, far], tier, camera, size);
             let reference = shoot(&alone, &[far_only], tier, camera, size);
@@ -358,10 +490,21 @@ mod render {
             let differ: Vec<usize> = (0..both.len() / 4)
                 .filter(|&i| (0..3).any(|c| both[4 * i + c].abs_diff(reference[4 * i + c]) > 2))
                 .collect();
-            let at: Vec<(usize, usize)> = differ.iter().take(8).map(|i| (i % size.0 as usize, i / size.0 as usize)).collect();
-            println!("{tier:?}: untouched levels against the far level alone: {} pixels differ by more than 2 of 255, at {at:?}", differ.len());
+            let at: Vec<(usize, usize)> = differ
+                .iter()
+                .take(8)
+                .map(|i| (i % size.0 as usize, i / size.0 as usize))
+                .collect();
+            println!(
+                "{tier:?}: untouched levels against the far level alone: {} pixels differ by more than 2 of 255, at {at:?}",
+                differ.len()
+            );
             // A crack where the meshes meet is a pixel or two: none is allowed.
-            assert!(differ.is_empty(), "{tier:?}: {} pixels differ, at {at:?}", differ.len());
+            assert!(
+                differ.is_empty(),
+                "{tier:?}: {} pixels differ, at {at:?}",
+                differ.len()
+            );
         }
         for d in walk() {
             w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
@@ -390,22 +533,47 @@ fn scene_keys_make_a_terrain_and_refuse_bad_ones_with_their_line() {
     let t = &scene.terrains[0];
     assert_eq!((t.line, t.follow), (7, TerrainFollow::Player));
     assert_eq!(t.desc.name, "valley");
-    assert_eq!((t.desc.ground_height, t.desc.snow_depth, t.desc.replenish_rate), (12.5, 0.4, 0.01));
+    assert_eq!(
+        (
+            t.desc.ground_height,
+            t.desc.snow_depth,
+            t.desc.replenish_rate
+        ),
+        (12.5, 0.4, 0.01)
+    );
     assert_eq!(t.desc.material.look, Material::powder().look);
     assert_eq!(
         t.desc.levels,
         vec![
-            LevelDesc { texels: [1024, 1024], texel_size: 0.05 },
-            LevelDesc { texels: [512, 256], texel_size: 0.4 },
+            LevelDesc {
+                texels: [1024, 1024],
+                texel_size: 0.05
+            },
+            LevelDesc {
+                texels: [512, 256],
+                texel_size: 0.4
+            },
         ]
     );
     let refused = |extra: &str| {
-        Scene::parse(&format!("{text}{extra}"), path).unwrap_err().to_string()
+        Scene::parse(&format!("{text}{extra}"), path)
+            .unwrap_err()
+            .to_string()
     };
-    let twice = refused("\n[[surface]]\nname = \"valley\"\ncenter = [0, 0, 0]\nsize = [1, 1]\nsnow_depth = 0.3\n");
-    assert!(twice.starts_with("valley.toml:8: surface name \"valley\" is used twice"), "{twice}");
-    let size = refused("\n[[terrain]]\nname = \"b\"\nsnow_depth = 0.3\nlevels = [{ texels = [64, 64], texel_size = 0.01 }]\n");
-    assert!(size.starts_with("valley.toml:25: terrain \"b\"'s level 0 has texel_size 0.01"), "{size}");
+    let twice = refused(
+        "\n[[surface]]\nname = \"valley\"\ncenter = [0, 0, 0]\nsize = [1, 1]\nsnow_depth = 0.3\n",
+    );
+    assert!(
+        twice.starts_with("valley.toml:8: surface name \"valley\" is used twice"),
+        "{twice}"
+    );
+    let size = refused(
+        "\n[[terrain]]\nname = \"b\"\nsnow_depth = 0.3\nlevels = [{ texels = [64, 64], texel_size = 0.01 }]\n",
+    );
+    assert!(
+        size.starts_with("valley.toml:25: terrain \"b\"'s level 0 has texel_size 0.01"),
+        "{size}"
+    );
     let pool = refused("\n[budget]\npool_bytes = 4194304\n");
     assert!(pool.starts_with("valley.toml:14: terrain \"valley\"'s levels need 4718592 bytes of heightmap pool, and the pool has 4194304 left"), "{pool}");
 }

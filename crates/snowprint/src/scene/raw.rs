@@ -161,8 +161,7 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
     (
         "at the top level",
         &[
-            "version", "capture", "surface", "deformer", "budget", "camera", "material",
-            "terrain",
+            "version", "capture", "surface", "deformer", "budget", "camera", "material", "terrain",
         ],
     ),
     (

@@ -71,6 +71,8 @@ pub struct ScrollStats {
     pub texels_paged_in: u64,
     /// Compressed bytes the page store holds now.
     pub store_bytes: u64,
+    /// Chunks of 64 x 64 world texels the page store holds now.
+    pub store_chunks: u64,
     /// Pool bytes written folding finer levels' leaving strips into coarser levels.
     pub bytes_folded: u64,
 }
@@ -123,10 +125,14 @@ impl Terrain {
                 yaw_degrees: 0.0,
                 snow_depth: desc.snow_depth,
                 replenish_rate: desc.replenish_rate,
-                material: desc.material.clone(),
+                material: desc.material,
             };
             let added = world.add_level(surface, layout).and_then(|id| {
-                world.move_level(id, center_of(&desc, l, origin), plan::wrap_for(origin, l.texels))?;
+                world.move_level(
+                    id,
+                    center_of(&desc, l, origin),
+                    plan::wrap_for(origin, l.texels),
+                )?;
                 Ok(id)
             });
             match added {
@@ -195,6 +201,7 @@ impl Terrain {
     pub fn stats(&self) -> ScrollStats {
         ScrollStats {
             store_bytes: self.store.bytes(),
+            store_chunks: self.store.chunks() as u64,
             ..self.stats
         }
     }
@@ -218,7 +225,12 @@ impl Terrain {
         let (mut out_texels, mut in_texels) = (0u32, 0u32);
         for (i, level) in self.levels.iter().enumerate() {
             let l = level.desc;
-            let to = plan::origin_for([focus.x as f64, focus.z as f64], l.texel_size as f64, l.texels, unit);
+            let to = plan::origin_for(
+                [focus.x as f64, focus.z as f64],
+                l.texel_size as f64,
+                l.texels,
+                unit,
+            );
             if to == level.origin {
                 continue;
             }
@@ -243,7 +255,8 @@ impl Terrain {
                 out_texels += step.leaving.texels() as u32;
                 let e = step.entering;
                 let texels = self.store.get(i, e.world, e.columns, e.rows);
-                self.stats.texels_paged_in += texels.chunks_exact(2).filter(|p| p != &[0, 0]).count() as u64;
+                self.stats.texels_paged_in +=
+                    texels.chunks_exact(2).filter(|p| p != &[0, 0]).count() as u64;
                 incoming.extend(texels);
                 dispatches.push((Direction::In, params(&e, step.wrap, in_texels)));
                 in_texels += e.texels() as u32;
@@ -256,14 +269,22 @@ impl Terrain {
             return Ok(0);
         }
         let mut enc = world.device().create_command_encoder(&Default::default());
-        let read = self.strips.encode(world.device(), world.queue(), &mut enc, world.pool_buffer(), &dispatches, &incoming);
+        let read = self.strips.encode(
+            world.device(),
+            world.queue(),
+            &mut enc,
+            world.pool_buffer(),
+            &dispatches,
+            &incoming,
+        );
         world.queue().submit([enc.finish()]);
         let (pairs, written) = read.wait(world.device())?;
         let mut at = 0usize;
         let mut folds = Vec::new();
         for (i, s) in leaving {
             let n = 2 * s.texels() as usize;
-            self.store.put(i, s.world, s.columns, s.rows, &pairs[at..at + n]);
+            self.store
+                .put(i, s.world, s.columns, s.rows, &pairs[at..at + n]);
             if i + 1 < self.levels.len() {
                 folds.push((i, s, pairs[at..at + n].to_vec()));
             }
@@ -289,14 +310,19 @@ impl Terrain {
     /// Fold finer levels' leaving strips into the next coarser level (where that level's window
     /// holds them): each coarse texel takes, channel by channel, the larger of what it holds and
     /// the deepest fine texel whose centre lies in it.
-    fn fold(&mut self, world: &mut SnowWorld, folds: &[(usize, plan::Strip, Vec<u32>)]) -> Result<()> {
+    fn fold(
+        &mut self,
+        world: &mut SnowWorld,
+        folds: &[(usize, plan::Strip, Vec<u32>)],
+    ) -> Result<()> {
         let unit = world.pool_format().precision.unit_texels();
         let mut dispatches = Vec::new();
         let mut incoming = Vec::new();
         let mut first = 0u32;
         for (i, strip, pairs) in folds {
             let (fine, coarse) = (&self.levels[*i], &self.levels[*i + 1]);
-            let Some((rect, data)) = summary(fine.desc.texel_size, coarse, strip, pairs, unit) else {
+            let Some((rect, data)) = summary(fine.desc.texel_size, coarse, strip, pairs, unit)
+            else {
                 continue;
             };
             let (heights, layout, wrap) = world.level_slot(coarse.surface)?;
@@ -354,9 +380,15 @@ fn summary(
     let (ox, oz) = (coarse.origin[0], coarse.origin[1]);
     let clamp = |v: i64, n: i64| v.clamp(0, n);
     let x0 = clamp(to_coarse(strip.world[0]) - ox, w);
-    let x1 = clamp(to_coarse(strip.world[0] + strip.columns as i64 - 1) - ox + 1, w);
+    let x1 = clamp(
+        to_coarse(strip.world[0] + strip.columns as i64 - 1) - ox + 1,
+        w,
+    );
     let y0 = clamp(to_coarse(strip.world[1]) - oz, h);
-    let y1 = clamp(to_coarse(strip.world[1] + strip.rows as i64 - 1) - oz + 1, h);
+    let y1 = clamp(
+        to_coarse(strip.world[1] + strip.rows as i64 - 1) - oz + 1,
+        h,
+    );
     let u = unit as i64;
     let (x0, x1) = (x0 / u * u, (x1 + u - 1) / u * u);
     if x1 <= x0 || y1 <= y0 {
@@ -436,7 +468,11 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
         return bad("levels".into(), "empty".into(), "at least one level".into());
     }
     if !(desc.ground_height.is_finite()) {
-        return bad("ground_height".into(), desc.ground_height.to_string(), "finite".into());
+        return bad(
+            "ground_height".into(),
+            desc.ground_height.to_string(),
+            "finite".into(),
+        );
     }
     let format = world.pool_format();
     let side = world.config().atlas_side;
@@ -447,7 +483,9 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
             return bad(
                 format!("level {i}'s texels"),
                 format!("[{w}, {h}]"),
-                format!("between 1 and {side} a side (the capture atlas's side, WorldConfig.atlas_side)"),
+                format!(
+                    "between 1 and {side} a side (the capture atlas's side, WorldConfig.atlas_side)"
+                ),
             );
         }
         if format.precision.unit_texels() == 2 && w % 2 == 1 {
@@ -457,7 +495,10 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
                 "an even number of texels along x in an 8-bit pool".into(),
             );
         }
-        if !(l.texel_size.is_finite() && l.texel_size >= crate::MIN_TEXEL_SIZE && l.texel_size <= 100.0) {
+        if !(l.texel_size.is_finite()
+            && l.texel_size >= crate::MIN_TEXEL_SIZE
+            && l.texel_size <= 100.0)
+        {
             return bad(
                 format!("level {i}'s texel_size"),
                 l.texel_size.to_string(),
@@ -471,7 +512,9 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
         return bad(
             "the levels' heightmaps".into(),
             format!("{bytes} bytes"),
-            format!("at most the pool's {budget} bytes (WorldConfig.pool_bytes, or fewer or smaller levels)"),
+            format!(
+                "at most the pool's {budget} bytes (WorldConfig.pool_bytes, or fewer or smaller levels)"
+            ),
         );
     }
     Ok(())

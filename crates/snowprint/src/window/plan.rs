@@ -124,12 +124,21 @@ mod tests {
         if x < 0 || y < 0 || x >= size[0] as i64 || y >= size[1] as i64 {
             return None;
         }
-        Some(wrapped(wrap_for(origin, size), size[0], size[1], x as u32, y as u32))
+        Some(wrapped(
+            wrap_for(origin, size),
+            size[0],
+            size[1],
+            x as u32,
+            y as u32,
+        ))
     }
 
     #[test]
     fn origins_snap_to_texels_and_to_words_at_8_bits() {
-        assert_eq!(origin_for([10.02, -3.0], 0.05, [1024, 512], 1), [-312, -316]);
+        assert_eq!(
+            origin_for([10.02, -3.0], 0.05, [1024, 512], 1),
+            [-312, -316]
+        );
         assert_eq!(origin_for([10.07, 0.0], 0.05, [16, 16], 2), [192, -8]);
         assert_eq!(origin_for([10.12, 0.0], 0.05, [16, 16], 2), [194, -8]);
     }
@@ -139,16 +148,30 @@ mod tests {
     #[test]
     fn texels_that_stay_keep_their_storage_and_entering_ones_take_the_leaving_ones_places() {
         let size = [12u32, 8];
-        for (from, to) in [([0, 0], [3, 0]), ([5, -2], [1, 4]), ([0, 0], [-30, 2]), ([7, 7], [7, 5])] {
+        for (from, to) in [
+            ([0, 0], [3, 0]),
+            ([5, -2], [1, 4]),
+            ([0, 0], [-30, 2]),
+            ([7, 7], [7, 5]),
+        ] {
             let mut leaving = std::collections::HashSet::new();
             let mut entering = std::collections::HashSet::new();
             let mut at = from;
             for s in scroll(from, to, size) {
-                for (strip, origin, set) in [(s.leaving, at, &mut leaving), (s.entering, s.origin, &mut entering)] {
+                for (strip, origin, set) in [
+                    (s.leaving, at, &mut leaving),
+                    (s.entering, s.origin, &mut entering),
+                ] {
                     for y in strip.y0..strip.y0 + strip.rows {
                         for x in strip.x0..strip.x0 + strip.columns {
                             let (i, j) = (origin[0] + x as i64, origin[1] + y as i64);
-                            assert_eq!((strip.world[0] + (x - strip.x0) as i64, strip.world[1] + (y - strip.y0) as i64), (i, j));
+                            assert_eq!(
+                                (
+                                    strip.world[0] + (x - strip.x0) as i64,
+                                    strip.world[1] + (y - strip.y0) as i64
+                                ),
+                                (i, j)
+                            );
                             set.insert(wrapped(wrap_for(origin, size), size[0], size[1], x, y));
                         }
                     }
@@ -174,18 +197,31 @@ mod tests {
         assert_eq!(steps.len(), 1);
         let s = steps[0];
         assert_eq!((s.leaving.x0, s.leaving.columns, s.leaving.rows), (0, 3, 8));
-        assert_eq!((s.entering.x0, s.entering.columns, s.entering.rows), (13, 3, 8));
+        assert_eq!(
+            (s.entering.x0, s.entering.columns, s.entering.rows),
+            (13, 3, 8)
+        );
         assert_eq!(s.entering.world, [16, 0]);
         assert_eq!(s.wrap, 3);
         let back = scroll([3, 0], [1, -1], [16, 8]);
         assert_eq!(back.len(), 2);
         assert_eq!((back[0].leaving.x0, back[0].leaving.columns), (14, 2));
         assert_eq!((back[0].entering.x0, back[0].entering.world), (0, [1, 0]));
-        assert_eq!((back[1].entering.y0, back[1].entering.rows, back[1].entering.columns), (0, 1, 16));
+        assert_eq!(
+            (
+                back[1].entering.y0,
+                back[1].entering.rows,
+                back[1].entering.columns
+            ),
+            (0, 1, 16)
+        );
         assert_eq!(back[1].wrap, 1 | 7 << 16);
         assert!(scroll([4, 4], [4, 4], [16, 8]).is_empty());
         // A jump past the window rewrites it whole, once.
         let far = scroll([0, 0], [100, 0], [16, 8]);
-        assert_eq!((far[0].entering.columns, far[0].entering.world), (16, [100, 0]));
+        assert_eq!(
+            (far[0].entering.columns, far[0].entering.world),
+            (16, [100, 0])
+        );
     }
 }

@@ -94,18 +94,18 @@ impl StripStore {
     }
 
     /// Chunks held.
-    pub fn len(&self) -> usize {
+    pub fn chunks(&self) -> usize {
         self.pages.len()
-    }
-
-    /// Whether nothing was paged out.
-    pub fn is_empty(&self) -> bool {
-        self.pages.is_empty()
     }
 }
 
 /// The world texels of a rectangle grouped by chunk: `f(chunk, texels)` once a chunk.
-fn chunks_of(world: [i64; 2], columns: u32, rows: u32, f: &mut dyn FnMut([i64; 2], Vec<(i64, i64)>)) {
+fn chunks_of(
+    world: [i64; 2],
+    columns: u32,
+    rows: u32,
+    f: &mut dyn FnMut([i64; 2], Vec<(i64, i64)>),
+) {
     if columns == 0 || rows == 0 {
         return;
     }
@@ -114,7 +114,9 @@ fn chunks_of(world: [i64; 2], columns: u32, rows: u32, f: &mut dyn FnMut([i64; 2
         for cx in world[0].div_euclid(CHUNK)..=(x1 - 1).div_euclid(CHUNK) {
             let (c0, r0) = ((cx * CHUNK).max(world[0]), (cy * CHUNK).max(world[1]));
             let (c1, r1) = (((cx + 1) * CHUNK).min(x1), ((cy + 1) * CHUNK).min(y1));
-            let texels = (r0..r1).flat_map(|r| (c0..c1).map(move |c| (c, r))).collect();
+            let texels = (r0..r1)
+                .flat_map(|r| (c0..c1).map(move |c| (c, r)))
+                .collect();
             f([cx, cy], texels);
         }
     }
@@ -137,6 +139,6 @@ mod tests {
         assert_eq!(&beside[..6], &[0; 6]);
         assert_eq!(&beside[6..10], &[0; 4]);
         assert_eq!(&beside[10..12], &pairs[0..2]);
-        assert!(s.bytes() > 0 && s.len() == 2);
+        assert!(s.bytes() > 0 && s.chunks() == 2);
     }
 }

@@ -121,7 +121,12 @@ impl StripGpu {
             into: make("strip_in"),
             max: make("strip_max"),
             layout,
-            params: Growable::new(device, "strip params", U::UNIFORM | U::COPY_DST, UNIFORM_STRIDE * 8),
+            params: Growable::new(
+                device,
+                "strip params",
+                U::UNIFORM | U::COPY_DST,
+                UNIFORM_STRIDE * 8,
+            ),
             strip_out: Growable::new(device, "strip out", U::STORAGE | U::COPY_SRC, 4096),
             strip_in: Growable::new(device, "strip in", U::STORAGE | U::COPY_DST, 4096),
             written: device.create_buffer(&wgpu::BufferDescriptor {
@@ -166,13 +171,15 @@ impl StripGpu {
             texels(Direction::Out),
             texels(Direction::In) + texels(Direction::Max),
         );
-        self.params.ensure(device, dispatches.len().max(1) as u64 * UNIFORM_STRIDE);
+        self.params
+            .ensure(device, dispatches.len().max(1) as u64 * UNIFORM_STRIDE);
         self.strip_out.ensure(device, out_texels.max(1) * 8);
         self.strip_in.ensure(device, in_texels.max(1) * 8);
         let mut blocks = vec![0u8; dispatches.len() * UNIFORM_STRIDE as usize];
         for (i, (_, p)) in dispatches.iter().enumerate() {
             let at = i * UNIFORM_STRIDE as usize;
-            blocks[at..at + std::mem::size_of::<StripParams>()].copy_from_slice(bytemuck::bytes_of(p));
+            blocks[at..at + std::mem::size_of::<StripParams>()]
+                .copy_from_slice(bytemuck::bytes_of(p));
         }
         if !blocks.is_empty() {
             queue.write_buffer(&self.params.buffer, 0, &blocks);

@@ -11,7 +11,11 @@ impl SnowWorld {
     /// Add a window level: a surface of exactly `layout` (not derived from its size by the
     /// talk's rule), its slot cleared with the next submission. Refused, in one sentence, when
     /// the layout is larger than the capture atlas or than the pool.
-    pub(crate) fn add_level(&mut self, desc: SurfaceDesc, layout: SurfaceLayout) -> Result<SurfaceId> {
+    pub(crate) fn add_level(
+        &mut self,
+        desc: SurfaceDesc,
+        layout: SurfaceLayout,
+    ) -> Result<SurfaceId> {
         desc.validate()?;
         let side = self.config.atlas_side;
         if layout.width > side || layout.height > side || layout.texels() == 0 {
@@ -19,7 +23,9 @@ impl SnowWorld {
                 name: desc.name.clone(),
                 what: "a level's texels".into(),
                 value: format!("{} x {}", layout.width, layout.height),
-                expected: format!("between 1 and the capture atlas's {side} a side (WorldConfig.atlas_side)"),
+                expected: format!(
+                    "between 1 and the capture atlas's {side} a side (WorldConfig.atlas_side)"
+                ),
             });
         }
         let slot = self.reserve_slot(&desc.name, &layout, None)?;

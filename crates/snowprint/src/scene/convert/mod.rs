@@ -145,10 +145,10 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
     for t in raw.terrain {
         let used: u64 = surfaces_bytes
             + terrains
-            .iter()
-            .flat_map(|t: &super::SceneTerrain| &t.desc.levels)
-            .map(|l| pool.1.slot_bytes(l.texels[0], l.texels[1]))
-            .sum::<u64>();
+                .iter()
+                .flat_map(|t: &super::SceneTerrain| &t.desc.levels)
+                .map(|l| pool.1.slot_bytes(l.texels[0], l.texels[1]))
+                .sum::<u64>();
         terrains.push(terrain::terrain(
             src,
             t,

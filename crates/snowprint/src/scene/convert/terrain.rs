@@ -37,20 +37,51 @@ pub(super) fn terrain(
     if let Some(problem) = super::surface::file_name_problem(name.get_ref()) {
         return Err(src.error(
             &name.span(),
-            format!("terrain name {} cannot be used ({problem})", src.quote(&name.span())),
+            format!(
+                "terrain name {} cannot be used ({problem})",
+                src.quote(&name.span())
+            ),
             "use at most 250 letters, digits, \"_\", \"-\" and \".\"",
         ));
     }
     unique(src, names, &name, "surface")?;
     let who = format!("terrain {:?}", name.get_ref());
     let ground_height = match &t.ground_height {
-        Some(v) => number(src, v, &who, "ground_height", |_| true, "ground_height must be a finite number of metres")?,
+        Some(v) => number(
+            src,
+            v,
+            &who,
+            "ground_height",
+            |_| true,
+            "ground_height must be a finite number of metres",
+        )?,
         None => 0.0,
     };
-    let depth = required(src, &table, t.snow_depth, &who, "snow_depth", "add snow_depth = <metres of fresh snow>, such as snow_depth = 0.3")?;
-    let snow_depth = number(src, &depth, &who, "snow_depth", |x| x > 0.0, "snow_depth must be a finite number of metres above 0")?;
+    let depth = required(
+        src,
+        &table,
+        t.snow_depth,
+        &who,
+        "snow_depth",
+        "add snow_depth = <metres of fresh snow>, such as snow_depth = 0.3",
+    )?;
+    let snow_depth = number(
+        src,
+        &depth,
+        &who,
+        "snow_depth",
+        |x| x > 0.0,
+        "snow_depth must be a finite number of metres above 0",
+    )?;
     let replenish_rate = match &t.replenish_rate {
-        Some(v) => number(src, v, &who, "replenish_rate", |x| x >= 0.0, "replenish_rate must be a finite fraction of the snow depth per second, 0 or more")?,
+        Some(v) => number(
+            src,
+            v,
+            &who,
+            "replenish_rate",
+            |x| x >= 0.0,
+            "replenish_rate must be a finite fraction of the snow depth per second, 0 or more",
+        )?,
         None => 0.0,
     };
     let material = match &t.material {
@@ -71,7 +102,14 @@ pub(super) fn terrain(
             }
         },
     };
-    let levels = required(src, &table, t.levels, &who, "levels", "add levels = [{ texels = [1024, 1024], texel_size = 0.05 }, { texels = [512, 512], texel_size = 0.4 }], finest first")?;
+    let levels = required(
+        src,
+        &table,
+        t.levels,
+        &who,
+        "levels",
+        "add levels = [{ texels = [1024, 1024], texel_size = 0.05 }, { texels = [512, 512], texel_size = 0.4 }], finest first",
+    )?;
     let levels_span = levels.span();
     if levels.get_ref().is_empty() {
         return Err(src.error(&levels_span, format!("{who} has levels {}", src.quote(&levels_span)), "give at least one level, such as levels = [{ texels = [512, 512], texel_size = 0.05 }]"));
@@ -81,17 +119,31 @@ pub(super) fn terrain(
         let span = l.span();
         let l = l.into_inner();
         let lwho = format!("{who}'s level {i}");
-        let texels = required(src, &span, l.texels, &lwho, "texels", "add texels = [columns, rows], such as texels = [1024, 1024]")?;
+        let texels = required(
+            src,
+            &span,
+            l.texels,
+            &lwho,
+            "texels",
+            "add texels = [columns, rows], such as texels = [1024, 1024]",
+        )?;
         let texels: [f32; 2] = vector(
             src,
             &texels,
             &lwho,
             "texels",
             "[columns, rows]",
-            |x| x >= 1.0 && x <= MAX_LEVEL_TEXELS && x.fract() == 0.0,
+            |x| (1.0..=MAX_LEVEL_TEXELS).contains(&x) && x.fract() == 0.0,
             "a level's texels must be whole numbers from 1 to 2048 (a level of zero texels holds no snow)",
         )?;
-        let size = required(src, &span, l.texel_size, &lwho, "texel_size", "add texel_size = <metres>, such as texel_size = 0.05")?;
+        let size = required(
+            src,
+            &span,
+            l.texel_size,
+            &lwho,
+            "texel_size",
+            "add texel_size = <metres>, such as texel_size = 0.05",
+        )?;
         let texel_size = number(
             src,
             &size,
@@ -106,7 +158,10 @@ pub(super) fn terrain(
         });
     }
     let (budget, format) = pool;
-    let bytes: u64 = out.iter().map(|l| format.slot_bytes(l.texels[0], l.texels[1])).sum();
+    let bytes: u64 = out
+        .iter()
+        .map(|l| format.slot_bytes(l.texels[0], l.texels[1]))
+        .sum();
     if bytes > budget {
         return Err(src.error(
             &levels_span,
