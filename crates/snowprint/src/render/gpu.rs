@@ -131,8 +131,12 @@ pub struct SurfaceUniform {
     pub hole: [f32; 4],
     /// The heights' toroidal storage offsets, `ox | oy << 16` ([`crate::SurfaceView::wrap`]).
     pub wrap: u32,
+    /// Padding (three members, as in WGSL).
+    pub _pad0: u32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// `SurfaceUniform::hole` of a surface that draws all of itself.
@@ -230,7 +234,9 @@ impl SurfaceUniform {
             ],
             hole: surface.hole.unwrap_or(NO_HOLE),
             wrap: surface.wrap,
-            _pad: [0; 3],
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 
@@ -507,7 +513,10 @@ mod tests {
             grain,
             translucency,
             hole,
-            wrap
+            wrap,
+            _pad0,
+            _pad1,
+            _pad2
         );
         for (source, name) in [
             (&engine, "snowprint_Surface"),

@@ -15,7 +15,7 @@ fn snowprint_surface_of(s: SnowSurface) -> snowprint_Surface {
         s.local_to_world, s.world_to_local, s.half_size, s.snow_depth, s.texel, s.grid,
         s.ground, s.index, s.search, s.look, s.pattern,
         s.heights, s.row_words, s.bits, s.channel_max, s.width, s.height, s.texel_x, s.texel_z,
-        s.albedo, s.disturbed, s.grain, s.translucency,
+        s.albedo, s.disturbed, s.grain, s.translucency, s.hole, s.wrap, s._pad0, s._pad1, s._pad2,
     );
 }
 
