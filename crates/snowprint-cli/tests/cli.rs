@@ -123,15 +123,24 @@ fn a_terrain_window_follows_the_ball_and_dumps_its_levels() {
     // Column 100 (x = 1.8 m): the outbound trench at z = 0 (row 24) and the return at z = 2 (row
     // 64), untouched between them.
     let at = |x: u32, y: u32| near.depression[(y * 128 + x) as usize];
-    assert!(at(100, 24) > 32768 && at(100, 64) > 32768, "{} {}", at(100, 24), at(100, 64));
+    assert!(
+        at(100, 24) > 32768 && at(100, 64) > 32768,
+        "{} {}",
+        at(100, 24),
+        at(100, 64)
+    );
     assert_eq!(at(100, 44), 0);
     // The far level (40 cm, first texel (-64, -59)) holds the outbound trench at x = 6 m, which
     // the near window paged out long ago: column 79, row 59 (z = 0 .. 0.4).
     let far_meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("valley.1.json")).unwrap()).unwrap();
     let o = &far_meta["origin_texel"];
-    let (fx, fz) = ((15 - o[0].as_i64().unwrap()) as u32, (-o[1].as_i64().unwrap()) as u32);
-    let v = far.depression[(fz.saturating_sub(1) * 128 + fx) as usize].max(far.depression[(fz * 128 + fx) as usize]);
+    let (fx, fz) = (
+        (15 - o[0].as_i64().unwrap()) as u32,
+        (-o[1].as_i64().unwrap()) as u32,
+    );
+    let v = far.depression[(fz.saturating_sub(1) * 128 + fx) as usize]
+        .max(far.depression[(fz * 128 + fx) as usize]);
     assert!(v > 16384, "far level at x = 6 m: {v}");
     let _ = std::fs::remove_dir_all(&out);
 
@@ -147,7 +156,10 @@ fn a_terrain_window_follows_the_ball_and_dumps_its_levels() {
         .expect("run snowprint");
     assert!(!result.status.success());
     let err = String::from_utf8_lossy(&result.stderr);
-    assert!(err.contains("valley_window.toml:12: a [[terrain]] runs only without the surface manager"), "{err}");
+    assert!(
+        err.contains("valley_window.toml:12: a [[terrain]] runs only without the surface manager"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&managed);
 }
 

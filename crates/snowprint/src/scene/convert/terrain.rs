@@ -102,11 +102,45 @@ pub(super) fn terrain(
             }
         },
     };
+    let (levels_span, out) = levels(src, &table, t.levels, &who)?;
+    let (budget, format) = pool;
+    let bytes: u64 = out
+        .iter()
+        .map(|l| format.slot_bytes(l.texels[0], l.texels[1]))
+        .sum();
+    if bytes > budget {
+        return Err(src.error(
+            &levels_span,
+            format!("{who}'s levels need {bytes} bytes of heightmap pool, and the pool has {budget} left for them"),
+            "use fewer or smaller levels, or raise [budget] pool_bytes",
+        ));
+    }
+    Ok(SceneTerrain {
+        desc: TerrainDesc {
+            name: name.into_inner(),
+            ground_height,
+            snow_depth,
+            replenish_rate,
+            material,
+            levels: out,
+        },
+        follow,
+        line: src.line(table.start),
+    })
+}
+
+/// The levels of a terrain, finest first, each checked with its line; and the span of `levels`.
+fn levels(
+    src: &Source<'_>,
+    table: &std::ops::Range<usize>,
+    levels: Option<Spanned<Vec<Spanned<crate::scene::raw::RawLevel>>>>,
+    who: &str,
+) -> Result<(std::ops::Range<usize>, Vec<LevelDesc>)> {
     let levels = required(
         src,
-        &table,
-        t.levels,
-        &who,
+        table,
+        levels,
+        who,
         "levels",
         "add levels = [{ texels = [1024, 1024], texel_size = 0.05 }, { texels = [512, 512], texel_size = 0.4 }], finest first",
     )?;
@@ -157,28 +191,5 @@ pub(super) fn terrain(
             texel_size,
         });
     }
-    let (budget, format) = pool;
-    let bytes: u64 = out
-        .iter()
-        .map(|l| format.slot_bytes(l.texels[0], l.texels[1]))
-        .sum();
-    if bytes > budget {
-        return Err(src.error(
-            &levels_span,
-            format!("{who}'s levels need {bytes} bytes of heightmap pool, and the pool has {budget} left for them"),
-            "use fewer or smaller levels, or raise [budget] pool_bytes",
-        ));
-    }
-    Ok(SceneTerrain {
-        desc: TerrainDesc {
-            name: name.into_inner(),
-            ground_height,
-            snow_depth,
-            replenish_rate,
-            material,
-            levels: out,
-        },
-        follow,
-        line: src.line(table.start),
-    })
+    Ok((levels_span, out))
 }
