@@ -27,6 +27,7 @@ fn terrain() -> TerrainDesc {
     TerrainDesc {
         name: "valley".into(),
         ground_height: 0.0,
+        ground: None,
         snow_depth: 0.3,
         replenish_rate: 0.0,
         material: Material::snow(),

@@ -88,7 +88,7 @@ pub use spray::{
 };
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
-pub use window::{LevelDesc, ScrollStats, Terrain, TerrainDesc};
+pub use window::{LevelDesc, ScrollStats, Terrain, TerrainDesc, TerrainGround};
 pub use world::{
     CaptureConfig, CaptureMode, FrameStats, MemoryReport, MeshAnimation, PassMode, PendingFrame,
     SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,

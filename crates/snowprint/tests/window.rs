@@ -26,6 +26,7 @@ fn terrain(name: &str, levels: &[([u32; 2], f32)]) -> TerrainDesc {
     TerrainDesc {
         name: name.into(),
         ground_height: 1.0,
+        ground: None,
         snow_depth: DEPTH,
         replenish_rate: 0.0,
         material: Material::snow(),
@@ -576,4 +577,81 @@ fn scene_keys_make_a_terrain_and_refuse_bad_ones_with_their_line() {
     );
     let pool = refused("\n[budget]\npool_bytes = 4194304\n");
     assert!(pool.starts_with("valley.toml:14: terrain \"valley\"'s levels need 4718592 bytes of heightmap pool, and the pool has 4194304 left"), "{pool}");
+}
+
+/// A terrain on sine hills (a height grid over 20 m x 20 m of the world): after the window has
+/// scrolled (offsets (14, 7)) a walk leaves on the level what it leaves on a plain surface of the
+/// same rectangle laid on the same heights, bit for bit, and the prints follow the hills.
+#[test]
+fn a_terrain_on_hills_presses_as_a_surface_on_the_same_ground() {
+    use snowprint::{Ground, HeightGrid, SlopeRule, TerrainGround};
+    let hills = |x: f32, z: f32| 0.4 * (x * 0.9).sin() * (z * 0.7).cos();
+    let n = 101u32;
+    let grid = HeightGrid {
+        columns: n,
+        rows: n,
+        heights: (0..n * n)
+            .map(|i| hills(-10.0 + 0.2 * (i % n) as f32, -10.0 + 0.2 * (i / n) as f32))
+            .collect(),
+    };
+    let mut desc = terrain("hills", &[([64, 48], 0.04)]);
+    desc.ground = Some(TerrainGround {
+        grid,
+        origin: [-10.1, -10.1],
+        size: [20.2, 20.2],
+        slope: SlopeRule::default(),
+    });
+    let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
+    let mut t = Terrain::new(&mut a, desc, Vec3::new(-3.0, 0.0, 0.0)).unwrap();
+    t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04))
+        .unwrap();
+    let level = t.surfaces()[0];
+    assert_eq!(a.wrap(level).unwrap(), 14 | 7 << 16);
+    let field = a
+        .ground(level)
+        .unwrap()
+        .expect("the level lies on the hills")
+        .clone();
+    let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
+    let heights = HeightGrid {
+        columns: 64,
+        rows: 48,
+        heights: field.ground.clone(),
+    };
+    b.set_ground(plain, &Ground::Grid(heights), SlopeRule::default())
+        .unwrap();
+    assert_eq!(b.ground(plain).unwrap().unwrap(), &field);
+    // The field follows the hills at the texels' world centres.
+    let o = t.origin(0).unwrap();
+    for (c, r) in [(0u32, 0u32), (40, 20), (63, 47)] {
+        let (x, z) = (
+            (o[0] + c as i64) as f32 * 0.04 + 0.02,
+            (o[1] + r as i64) as f32 * 0.04 + 0.02,
+        );
+        let g = field.ground[(r * 64 + c) as usize];
+        assert!(
+            (g - hills(x, z)).abs() < 0.01,
+            "texel ({c}, {r}): {g} against {}",
+            hills(x, z)
+        );
+    }
+    for d in walk() {
+        let p = d.pose.position + Vec3::new(0.4, 0.0, 1.2);
+        let p = Vec3::new(p.x, p.y + hills(p.x, p.z), p.z);
+        let d = Deformer {
+            pose: Pose::at(p.to_array()),
+            ..d
+        };
+        a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    let (la, lb) = (
+        a.read_channels(level).unwrap(),
+        b.read_channels(plain).unwrap(),
+    );
+    assert!(
+        la.0.iter().filter(|&&v| v > 65535 / 4).count() > 100,
+        "the walk on the hills pressed little"
+    );
+    assert_eq!(la, lb, "the level on hills and the plain surface differ");
 }

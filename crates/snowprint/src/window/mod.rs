@@ -38,14 +38,34 @@ pub struct LevelDesc {
     pub texel_size: f32,
 }
 
-/// A terrain-wide snow layer: flat ground at `ground_height`, its snow and its levels, finest
-/// first (e.g. near 1024^2 at 5 cm, far 512^2 at 40 cm).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// The ground of a terrain that is not flat: heights over a world rectangle (metres above
+/// [`TerrainDesc::ground_height`]), sampled at each level's texel centres (clamped at the
+/// rectangle's edges), and how much snow its slopes hold.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TerrainGround {
+    /// The heights, `columns x rows` samples across the rectangle (row 0 at its smallest z).
+    pub grid: crate::ground::HeightGrid,
+    /// World x and z of the rectangle's smallest corner, metres.
+    pub origin: [f32; 2],
+    /// Its sides along world x and z, metres.
+    pub size: [f32; 2],
+    /// How much snow its slopes hold.
+    pub slope: crate::ground::SlopeRule,
+}
+
+/// A terrain-wide snow layer: its ground (flat at `ground_height`, or heights over the world
+/// with `ground`), its snow and its levels, finest first (e.g. near 1024^2 at 5 cm, far 512^2 at
+/// 40 cm).
+#[derive(Clone, Debug, PartialEq)]
 pub struct TerrainDesc {
     /// Name; level `i`'s surface is named `"{name}.{i}"`.
     pub name: String,
-    /// World height of the ground under the snow, metres.
+    /// World height of the ground under the snow, metres (of the flat ground, or the height the
+    /// `ground`'s heights are measured from).
     pub ground_height: f32,
+    /// The ground when it is not flat. Each level's ground field is laid again, whole, when the
+    /// level moves (not only its entering strips).
+    pub ground: Option<TerrainGround>,
     /// Depth of fresh snow, metres.
     pub snow_depth: f32,
     /// Fraction of the snow depth refilled per second while it snows.
@@ -158,7 +178,38 @@ impl Terrain {
             last_written: 0,
         };
         terrain.set_holes(world)?;
+        for i in 0..terrain.levels.len() {
+            terrain.lay_ground(world, i)?;
+        }
         Ok(terrain)
+    }
+
+    /// Lay level `i` on the terrain's ground where its window stands (nothing on flat ground):
+    /// the ground's heights sampled at the level's texel centres, its field built as a
+    /// surface's (`SnowWorld::set_ground`), in logical order, which the capture reads.
+    fn lay_ground(&self, world: &mut SnowWorld, i: usize) -> Result<()> {
+        let Some(g) = &self.desc.ground else {
+            return Ok(());
+        };
+        let l = &self.levels[i];
+        let [w, h] = l.desc.texels;
+        let s = l.desc.texel_size as f64;
+        let uv = |t: i64, k: usize| {
+            (((t as f64 + 0.5) * s - g.origin[k] as f64) / g.size[k] as f64).clamp(0.0, 1.0) as f32
+        };
+        let heights = (0..h as i64)
+            .flat_map(|r| (0..w as i64).map(move |c| (c, r)))
+            .map(|(c, r)| {
+                g.grid
+                    .sample(uv(l.origin[0] + c, 0), uv(l.origin[1] + r, 1))
+            })
+            .collect();
+        let grid = crate::ground::HeightGrid {
+            columns: w,
+            rows: h,
+            heights,
+        };
+        world.set_ground(l.surface, &crate::ground::Ground::Grid(grid), g.slope)
     }
 
     /// Leave each level's finer neighbour's extent to it: level `i > 0` does not draw the
@@ -290,12 +341,16 @@ impl Terrain {
             }
             at += n;
         }
+        let moved = moves.clone();
         for (i, to, wrap) in moves {
             let l = &mut self.levels[i];
             l.origin = to;
             world.move_level(l.surface, center_of(&self.desc, &l.desc, to), wrap)?;
         }
         self.set_holes(world)?;
+        for &(i, _, _) in &moved {
+            self.lay_ground(world, i)?;
+        }
         self.fold(world, &folds)?;
         self.stats.scrolls += 1;
         self.stats.texels_out += out_texels as u64;
@@ -473,6 +528,20 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
             desc.ground_height.to_string(),
             "finite".into(),
         );
+    }
+    if let Some(g) = &desc.ground {
+        g.grid.validate(&desc.name)?;
+        g.slope.validate(&desc.name)?;
+        let ok = |v: [f32; 2], positive: bool| {
+            v.iter().all(|x| x.is_finite() && (!positive || *x > 0.0))
+        };
+        if !ok(g.origin, false) || !ok(g.size, true) {
+            return bad(
+                "the ground's rectangle".into(),
+                format!("origin {:?}, size {:?}", g.origin, g.size),
+                "a finite origin and sides above 0 metres".into(),
+            );
+        }
     }
     let format = world.pool_format();
     let side = world.config().atlas_side;

@@ -119,6 +119,7 @@ pub(super) fn terrain(
         desc: TerrainDesc {
             name: name.into_inner(),
             ground_height,
+            ground: None,
             snow_depth,
             replenish_rate,
             material,
