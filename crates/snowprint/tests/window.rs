@@ -655,3 +655,36 @@ fn a_terrain_on_hills_presses_as_a_surface_on_the_same_ground() {
     );
     assert_eq!(la, lb, "the level on hills and the plain surface differ");
 }
+
+/// `[[terrain]]`'s ground keys: a raw f32 grid laid over `ground_rect`, with the slope rule.
+#[test]
+fn scene_keys_lay_a_terrain_on_a_grid() {
+    use snowprint::scene::Scene;
+    let dir = std::env::temp_dir().join(format!("snowprint-window-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let heights: Vec<f32> = (0..12).map(|i| i as f32 * 0.25).collect();
+    std::fs::write(dir.join("hills.f32"), bytemuck::cast_slice(&heights)).unwrap();
+    let text = "version = 1\n\n[[terrain]]\nname = \"hills\"\nsnow_depth = 0.3\n\
+                levels = [{ texels = [64, 64], texel_size = 0.05 }]\nground = \"hills.f32\"\n\
+                ground_grid = [4, 3]\nground_rect = [-8, -2, 12, 4]\nbare_slope_degrees = 70\n";
+    std::fs::write(dir.join("hills.toml"), text).unwrap();
+    let scene = Scene::load(&dir.join("hills.toml")).unwrap();
+    let g = scene.terrains[0].desc.ground.as_ref().expect("a ground");
+    assert_eq!(
+        (g.grid.columns, g.grid.rows, &g.grid.heights),
+        (4, 3, &heights)
+    );
+    assert_eq!((g.origin, g.size), ([-8.0, -2.0], [20.0, 6.0]));
+    assert_eq!((g.slope.full_degrees, g.slope.bare_degrees), (35.0, 70.0));
+    let bad = text.replace(
+        "ground_rect = [-8, -2, 12, 4]",
+        "ground_rect = [12, -2, -8, 4]",
+    );
+    std::fs::write(dir.join("bad.toml"), bad).unwrap();
+    let e = Scene::load(&dir.join("bad.toml")).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.toml:9: terrain \"hills\" has ground_rect [12, -2, -8, 4]"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

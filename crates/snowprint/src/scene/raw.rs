@@ -41,6 +41,12 @@ pub(super) struct RawTerrain {
     pub material: Option<Str>,
     pub follow: Option<Str>,
     pub levels: Option<Spanned<Vec<Spanned<RawLevel>>>>,
+    pub ground: Option<Str>,
+    pub ground_heights: Option<Nums>,
+    pub ground_grid: Option<Nums>,
+    pub ground_rect: Option<Nums>,
+    pub full_slope_degrees: Option<Num>,
+    pub bare_slope_degrees: Option<Num>,
 }
 
 /// One level of a `[[terrain]]`, inline (`levels = [{ ... }]`) or as `[[terrain.levels]]`.
@@ -174,6 +180,12 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
             "material",
             "follow",
             "levels",
+            "ground",
+            "ground_heights",
+            "ground_grid",
+            "ground_rect",
+            "full_slope_degrees",
+            "bare_slope_degrees",
         ],
     ),
     ("in a terrain level", &["texels", "texel_size"]),

@@ -155,6 +155,7 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
             &mut names_of_surfaces,
             &materials,
             (pool.0.saturating_sub(used), pool.1),
+            dir,
         )?);
     }
     let camera = raw

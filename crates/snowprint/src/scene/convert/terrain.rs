@@ -10,7 +10,7 @@ use crate::pool::PoolFormat;
 use crate::scene::diagnose::Source;
 use crate::scene::raw::RawTerrain;
 use crate::scene::{SceneTerrain, TerrainFollow};
-use crate::window::{LevelDesc, TerrainDesc};
+use crate::window::{LevelDesc, TerrainDesc, TerrainGround};
 
 use super::{number, required, unique, vector};
 
@@ -23,9 +23,12 @@ pub(super) fn terrain(
     names: &mut HashMap<String, usize>,
     materials: &HashMap<String, Material>,
     pool: (u64, PoolFormat),
+    dir: &std::path::Path,
 ) -> Result<SceneTerrain> {
     let table = t.span();
-    let t = t.into_inner();
+    let mut t = t.into_inner();
+    let keys = super::ground::GroundKeys::of_terrain(&mut t);
+    let rect = t.ground_rect.take();
     let name = required(
         src,
         &table,
@@ -102,6 +105,7 @@ pub(super) fn terrain(
             }
         },
     };
+    let ground = terrain_ground(src, keys, rect, &who, name.get_ref(), dir)?;
     let (levels_span, out) = levels(src, &table, t.levels, &who)?;
     let (budget, format) = pool;
     let bytes: u64 = out
@@ -119,7 +123,7 @@ pub(super) fn terrain(
         desc: TerrainDesc {
             name: name.into_inner(),
             ground_height,
-            ground: None,
+            ground,
             snow_depth,
             replenish_rate,
             material,
@@ -193,4 +197,65 @@ fn levels(
         });
     }
     Ok((levels_span, out))
+}
+
+/// A terrain's ground keys: a PNG heightmap or a raw grid (as a surface's, `ground.rs`) laid over
+/// the world rectangle `ground_rect`, or `None` (flat) without `ground`.
+fn terrain_ground(
+    src: &Source<'_>,
+    keys: super::ground::GroundKeys,
+    rect: Option<crate::scene::raw::Nums>,
+    who: &str,
+    name: &str,
+    dir: &std::path::Path,
+) -> Result<Option<TerrainGround>> {
+    let Some(g) = super::ground::ground_of(src, keys, who, name, glam::Mat4::IDENTITY, dir)? else {
+        if let Some(r) = &rect {
+            return Err(src.error(
+                &r.span(),
+                format!(
+                    "{who} has ground_rect {} but no ground",
+                    src.quote(&r.span())
+                ),
+                "add ground = \"<heightmap.png or grid.f32>\" or remove ground_rect",
+            ));
+        }
+        return Ok(None);
+    };
+    let crate::ground::Ground::Grid(grid) = g.ground else {
+        return Err(src.error_at_line(
+            g.line,
+            format!("{who} has a mesh as its ground"),
+            "give a terrain a 16-bit PNG heightmap or a raw f32 grid (a mesh ground is for [[surface]] tables)",
+        ));
+    };
+    let Some(r) = rect else {
+        return Err(src.error_at_line(
+            g.line,
+            format!("{who} has a ground but no ground_rect"),
+            "add ground_rect = [x0, z0, x1, z1], the world rectangle the heightmap covers, in metres",
+        ));
+    };
+    let [x0, z0, x1, z1]: [f32; 4] = vector(
+        src,
+        &r,
+        who,
+        "ground_rect",
+        "[x0, z0, x1, z1] in metres",
+        |_| true,
+        "ground_rect must be four finite numbers of metres, [x0, z0, x1, z1]",
+    )?;
+    if !(x1 > x0 && z1 > z0) {
+        return Err(src.error(
+            &r.span(),
+            format!("{who} has ground_rect {}", src.quote(&r.span())),
+            "give ground_rect = [x0, z0, x1, z1] with x1 above x0 and z1 above z0",
+        ));
+    }
+    Ok(Some(TerrainGround {
+        grid,
+        origin: [x0, z0],
+        size: [x1 - x0, z1 - z0],
+        slope: g.slope,
+    }))
 }
