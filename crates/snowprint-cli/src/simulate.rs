@@ -312,7 +312,7 @@ pub fn simulate(
     let dump_dir = outputs.dump.dir().to_owned();
     let mut set = outputs.dump;
     let written = windows
-        .dump(&world, scene, &mut set)
+        .dump(&mut world, scene, &mut set)
         .and_then(|()| {
             ids.iter()
                 .map(|&id| world.read_heightmap(id).map_err(|e| e.to_string()))

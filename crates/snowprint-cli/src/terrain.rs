@@ -64,13 +64,17 @@ impl Windows {
         Ok(())
     }
 
-    /// Write every level's heightmap and description into the dump.
+    /// Write every level's heightmap and description into the dump (after every scroll's
+    /// readback has landed).
     pub fn dump(
-        &self,
-        world: &SnowWorld,
+        &mut self,
+        world: &mut SnowWorld,
         scene: &Scene,
         set: &mut OutputSet,
     ) -> Result<(), String> {
+        for terrain in &mut self.terrains {
+            terrain.flush(world).map_err(|e| e.to_string())?;
+        }
         for (terrain, st) in self.terrains.iter().zip(&scene.terrains) {
             for ((i, id), name) in terrain
                 .surfaces()

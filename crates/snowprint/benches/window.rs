@@ -87,6 +87,7 @@ impl Walk {
             }
             self.world.step(DT, &[foot]).expect("step");
         }
+        self.terrain.flush(&mut self.world).expect("flush");
         let id = self.terrain.surfaces()[1];
         black_box(self.world.read_packed(id).expect("read"));
     }

@@ -97,6 +97,11 @@ fn a_walker_leaves_the_window_and_finds_its_trail_texel_for_texel() {
     }
     assert_eq!(never.stats().scrolls, 0);
     let reference = by_world(&big, &never, 0);
+    assert!(
+        t.scrolls_in_flight() <= 2,
+        "readbacks pile up: {}",
+        t.scrolls_in_flight()
+    );
     for x in [6.0f32, 12.0, 6.0, 1.5] {
         t.follow(&mut w, Vec3::new(x, 0.0, 0.0)).unwrap();
         w.step(1.0 / 60.0, &[]).unwrap();
@@ -153,13 +158,17 @@ fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
         for k in [2u32, 6] {
             let focus = Vec3::new(k as f32 * 0.05, 0.0, 0.0);
             let packed = w.read_packed(id).unwrap();
-            let written = t.follow(&mut w, focus).unwrap();
+            t.follow(&mut w, focus).unwrap();
+            // Nothing waited: the scroll's readback lands at the next call or at flush.
+            assert_eq!(t.scrolls_in_flight(), 1);
+            t.flush(&mut w).unwrap();
+            assert_eq!(t.scrolls_in_flight(), 0);
+            let written = t.last_bytes_written();
             assert_eq!(
                 written,
                 k as u64 * rows as u64 * texel_bytes,
                 "{p}: scroll by {k} columns"
             );
-            assert_eq!(t.last_bytes_written(), written);
             let after = w.read_packed(id).unwrap();
             let changed = packed.iter().zip(&after).filter(|(a, b)| a != b).count();
             // The pressed texels of the strip came back as fresh snow; nothing else moved.
@@ -169,8 +178,10 @@ fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
                 Precision::Bits32 => 2 * rows as usize,
             };
             assert_eq!(changed, k as usize * words_a_column, "{p}: {k}");
+            // Back at once: the strips that enter are those still on their way, so this waits.
             t.follow(&mut w, Vec3::ZERO).unwrap();
         }
+        t.flush(&mut w).unwrap();
         // Back where it started: the same storage, the same offsets, every texel as before.
         assert_eq!(w.wrap(id).unwrap(), wrap0);
         assert_eq!(w.read_packed(id).unwrap(), before, "{p}");
@@ -282,6 +293,7 @@ fn the_far_level_keeps_the_trails_broad_shape() {
         *e = (*e).max(v);
     }
     t.follow(&mut w, Vec3::new(6.5, 0.0, 0.0)).unwrap();
+    t.flush(&mut w).unwrap();
     let near = by_world(&w, &t, 0);
     assert!(
         near.values().all(|&v| v == 0),

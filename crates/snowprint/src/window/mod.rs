@@ -114,8 +114,17 @@ pub struct Terrain {
     store: store::StripStore,
     strips: StripGpu,
     stats: ScrollStats,
-    /// Pool bytes the last scroll wrote.
+    /// Pool bytes the last scroll whose readback arrived wrote.
     last_written: u64,
+    /// Scrolls and folds submitted whose readbacks have not been landed, oldest first.
+    in_flight: std::collections::VecDeque<InFlight>,
+}
+
+/// A submitted scroll (its leaving strips, in the order read back) or fold.
+struct InFlight {
+    read: strip::StripRead,
+    leaving: Vec<(usize, plan::Strip)>,
+    fold: bool,
 }
 
 impl Terrain {
@@ -176,6 +185,7 @@ impl Terrain {
             store: Default::default(),
             stats: Default::default(),
             last_written: 0,
+            in_flight: Default::default(),
         };
         terrain.set_holes(world)?;
         for i in 0..terrain.levels.len() {
@@ -257,37 +267,53 @@ impl Terrain {
         }
     }
 
-    /// Pool bytes the last [`Terrain::follow`] wrote (0 when no level moved).
+    /// Pool bytes written by the last scroll whose readback has arrived (all have after
+    /// [`Terrain::flush`]).
     pub fn last_bytes_written(&self) -> u64 {
         self.last_written
     }
 
     /// Centre every level on `focus` (world metres; y is ignored), scrolling those that move:
-    /// their leaving strips paged out, their entering strips written, their offsets moved. Waits
-    /// for the GPU when a level moved (the leaving texels are read back). Call it between frames,
-    /// not between `encode_step` and `submitted`.
-    pub fn follow(&mut self, world: &mut SnowWorld, focus: Vec3) -> Result<u64> {
+    /// their leaving strips gathered and read back to the page store, their entering strips
+    /// written, their offsets moved, in a submission of their own ahead of the world's next frame.
+    /// Nothing waits for the GPU unless a strip that enters was paged out by a scroll whose
+    /// readback has not arrived yet (the window turned back within a frame or two): pages and
+    /// statistics land as their readbacks arrive, at a later call or at [`Terrain::flush`]. Call
+    /// it between frames, not between `encode_step` and `submitted`.
+    pub fn follow(&mut self, world: &mut SnowWorld, focus: Vec3) -> Result<()> {
         check_focus(&self.desc.name, focus)?;
+        self.drain(world, false)?;
         let unit = world.pool_format().precision.unit_texels();
+        let moves: Vec<(usize, [i64; 2], Vec<plan::ScrollStep>)> = self
+            .levels
+            .iter()
+            .enumerate()
+            .filter_map(|(i, level)| {
+                let l = level.desc;
+                let focus = [focus.x as f64, focus.z as f64];
+                let to = plan::origin_for(focus, l.texel_size as f64, l.texels, unit);
+                (to != level.origin).then(|| (i, to, plan::scroll(level.origin, to, l.texels)))
+            })
+            .collect();
+        if moves.is_empty() {
+            return Ok(());
+        }
+        let returning = moves.iter().any(|(i, _, steps)| {
+            steps
+                .iter()
+                .any(|s| self.in_flight_overlaps(*i, &s.entering))
+        });
+        if returning {
+            self.flush(world)?;
+        }
         let mut dispatches = Vec::new();
-        let mut incoming = Vec::new();
-        let mut leaving = Vec::new();
-        let mut moves = Vec::new();
+        let (mut incoming, mut leaving) = (Vec::new(), Vec::new());
         let (mut out_texels, mut in_texels) = (0u32, 0u32);
-        for (i, level) in self.levels.iter().enumerate() {
-            let l = level.desc;
-            let to = plan::origin_for(
-                [focus.x as f64, focus.z as f64],
-                l.texel_size as f64,
-                l.texels,
-                unit,
-            );
-            if to == level.origin {
-                continue;
-            }
+        for (i, _, steps) in &moves {
+            let level = &self.levels[*i];
             let (heights, layout, _) = world.level_slot(level.surface)?;
-            let mut wrap = plan::wrap_for(level.origin, l.texels);
-            for step in plan::scroll(level.origin, to, l.texels) {
+            let mut wrap = plan::wrap_for(level.origin, level.desc.texels);
+            for step in steps {
                 let params = |s: &plan::Strip, wrap: u32, first: u32| StripParams {
                     heights,
                     width: layout.width,
@@ -302,10 +328,10 @@ impl Terrain {
                     _pad: [0; 2],
                 };
                 dispatches.push((Direction::Out, params(&step.leaving, wrap, out_texels)));
-                leaving.push((i, step.leaving));
+                leaving.push((*i, step.leaving));
                 out_texels += step.leaving.texels() as u32;
                 let e = step.entering;
-                let texels = self.store.get(i, e.world, e.columns, e.rows);
+                let texels = self.store.get(*i, e.world, e.columns, e.rows);
                 self.stats.texels_paged_in +=
                     texels.chunks_exact(2).filter(|p| p != &[0, 0]).count() as u64;
                 incoming.extend(texels);
@@ -313,11 +339,6 @@ impl Terrain {
                 in_texels += e.texels() as u32;
                 wrap = step.wrap;
             }
-            moves.push((i, to, wrap));
-        }
-        if moves.is_empty() {
-            self.last_written = 0;
-            return Ok(0);
         }
         let mut enc = world.device().create_command_encoder(&Default::default());
         let read = self.strips.encode(
@@ -329,35 +350,90 @@ impl Terrain {
             &incoming,
         );
         world.queue().submit([enc.finish()]);
-        let (pairs, written) = read.wait(world.device())?;
-        let mut at = 0usize;
-        let mut folds = Vec::new();
-        for (i, s) in leaving {
-            let n = 2 * s.texels() as usize;
-            self.store
-                .put(i, s.world, s.columns, s.rows, &pairs[at..at + n]);
-            if i + 1 < self.levels.len() {
-                folds.push((i, s, pairs[at..at + n].to_vec()));
-            }
-            at += n;
-        }
-        let moved = moves.clone();
-        for (i, to, wrap) in moves {
-            let l = &mut self.levels[i];
-            l.origin = to;
-            world.move_level(l.surface, center_of(&self.desc, &l.desc, to), wrap)?;
+        read.submitted();
+        self.in_flight.push_back(InFlight {
+            read,
+            leaving,
+            fold: false,
+        });
+        for (i, to, steps) in &moves {
+            let l = &mut self.levels[*i];
+            l.origin = *to;
+            let wrap = steps.last().map_or(0, |s| s.wrap);
+            world.move_level(l.surface, center_of(&self.desc, &l.desc, *to), wrap)?;
         }
         self.set_holes(world)?;
-        for &(i, _, _) in &moved {
-            self.lay_ground(world, i)?;
+        for (i, _, _) in &moves {
+            self.lay_ground(world, *i)?;
         }
-        self.fold(world, &folds)?;
         self.stats.scrolls += 1;
         self.stats.texels_out += out_texels as u64;
         self.stats.texels_in += in_texels as u64;
-        self.stats.bytes_written += written;
-        self.last_written = written;
-        Ok(written)
+        Ok(())
+    }
+
+    /// Wait for every scroll's readback and fold, and land them in the page store and the
+    /// statistics (the texels paged out are then all in the store).
+    pub fn flush(&mut self, world: &mut SnowWorld) -> Result<()> {
+        while !self.in_flight.is_empty() {
+            self.drain(world, true)?;
+        }
+        Ok(())
+    }
+
+    /// Scrolls whose readbacks are still on their way.
+    pub fn scrolls_in_flight(&self) -> usize {
+        self.in_flight.iter().filter(|f| !f.fold).count()
+    }
+
+    /// Whether a strip of level `level` still on its way overlaps world texels of `strip`.
+    fn in_flight_overlaps(&self, level: usize, strip: &plan::Strip) -> bool {
+        let span = |s: &plan::Strip| {
+            let (x0, z0) = (s.world[0], s.world[1]);
+            (x0, z0, x0 + s.columns as i64, z0 + s.rows as i64)
+        };
+        let (ax0, az0, ax1, az1) = span(strip);
+        self.in_flight
+            .iter()
+            .flat_map(|f| &f.leaving)
+            .any(|(l, s)| {
+                let (bx0, bz0, bx1, bz1) = span(s);
+                *l == level && ax0 < bx1 && bx0 < ax1 && az0 < bz1 && bz0 < az1
+            })
+    }
+
+    /// Land the readbacks that have arrived, in order (all of them, waiting, when `wait`): the
+    /// leaving strips into the page store and folded into coarser levels, the bytes into the
+    /// statistics.
+    fn drain(&mut self, world: &mut SnowWorld, wait: bool) -> Result<()> {
+        if !wait {
+            world.device().poll(wgpu::PollType::Poll)?;
+        }
+        let mut folds = Vec::new();
+        while let Some(f) = self.in_flight.front() {
+            if !wait && !f.read.is_ready() {
+                break;
+            }
+            let f = self.in_flight.pop_front().expect("checked above");
+            let (pairs, written) = f.read.wait(world.device())?;
+            if f.fold {
+                self.stats.bytes_folded += written;
+                continue;
+            }
+            self.stats.bytes_written += written;
+            self.last_written = written;
+            let mut at = 0usize;
+            for (i, s) in f.leaving {
+                let n = 2 * s.texels() as usize;
+                let texels = &pairs[at..at + n];
+                self.store.put(i, s.world, s.columns, s.rows, texels);
+                if i + 1 < self.levels.len() {
+                    folds.push((i, s, texels.to_vec()));
+                }
+                at += n;
+            }
+        }
+        self.fold(world, &folds)
     }
 }
 
@@ -413,7 +489,12 @@ impl Terrain {
             &incoming,
         );
         world.queue().submit([enc.finish()]);
-        self.stats.bytes_folded += read.wait(world.device())?.1;
+        read.submitted();
+        self.in_flight.push_back(InFlight {
+            read,
+            leaving: Vec::new(),
+            fold: true,
+        });
         Ok(())
     }
 }

@@ -69,6 +69,21 @@ pub struct StripRead {
 }
 
 impl StripRead {
+    /// The encoder was submitted: start mapping.
+    pub fn submitted(&self) {
+        for r in [&self.leaving, &self.written].into_iter().flatten() {
+            r.submitted();
+        }
+    }
+
+    /// Whether everything has arrived (the device must have been polled since submitting).
+    pub fn is_ready(&self) -> bool {
+        [&self.leaving, &self.written]
+            .into_iter()
+            .flatten()
+            .all(RangeRead::is_ready)
+    }
+
     /// `(leaving texels as (depression, displaced) word pairs, pool bytes written)`, waiting for
     /// the GPU (after the encoder was submitted).
     pub fn wait(self, device: &wgpu::Device) -> Result<(Vec<u32>, u64)> {
