@@ -9,7 +9,7 @@ mod common;
 use glam::Vec3;
 use snowprint::{
     Deformer, LevelDesc, Material, PoolFormat, Pose, Precision, Shape, SnowError, SnowWorld,
-    SurfaceDesc, Terrain, TerrainDesc, WorldConfig,
+    Terrain, TerrainDesc, WorldConfig,
 };
 
 const DEPTH: f32 = 0.3;
@@ -364,7 +364,27 @@ fn bad_terrains_and_foci_are_refused_in_one_sentence() {
         e.to_string().contains("the focus is [NaN, 0.0, 0.0]"),
         "{e}"
     );
-    let _ = SurfaceDesc::new("unused", [0.0; 3], [1.0, 1.0], DEPTH);
+    // Between encode_step and submitted the window cannot move: refused, nothing recorded.
+    let id = t.surfaces()[0];
+    let wrap = w.wrap(id).unwrap();
+    let mut enc = w.device().create_command_encoder(&Default::default());
+    let pending = w.encode_step(&mut enc, 1.0 / 60.0, &[]).unwrap();
+    let e = t
+        .follow(&mut w, Vec3::new(3.0, 0.0, 0.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("cannot scroll while a snow frame is encoded"),
+        "{e}"
+    );
+    assert_eq!(
+        (w.wrap(id).unwrap(), t.origin(0), t.scrolls_in_flight()),
+        (wrap, Some([-8, -8]), 0)
+    );
+    w.queue().submit([enc.finish()]);
+    w.submitted(pending).unwrap();
+    t.follow(&mut w, Vec3::new(3.0, 0.0, 0.0)).unwrap();
+    assert_eq!(t.origin(0), Some([52, -8]));
 }
 
 mod render {

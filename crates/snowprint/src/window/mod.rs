@@ -282,6 +282,12 @@ impl Terrain {
     /// it between frames, not between `encode_step` and `submitted`.
     pub fn follow(&mut self, world: &mut SnowWorld, focus: Vec3) -> Result<()> {
         check_focus(&self.desc.name, focus)?;
+        // Refused before anything is recorded, so that a refusal leaves the window as it was.
+        if world.frame_pending() {
+            return Err(SnowError::WindowBusy {
+                name: self.desc.name.clone(),
+            });
+        }
         self.drain(world, false)?;
         let unit = world.pool_format().precision.unit_texels();
         let moves: Vec<(usize, [i64; 2], Vec<plan::ScrollStep>)> = self

@@ -63,6 +63,11 @@ impl SnowWorld {
         Ok(())
     }
 
+    /// Whether a frame is encoded and not yet reported submitted (window levels cannot move).
+    pub(crate) fn frame_pending(&self) -> bool {
+        self.in_flight.is_some()
+    }
+
     /// Leave `hole` (local xz, `(x0, z0, x1, z1)`) of a window level undrawn: a finer level
     /// draws it.
     pub(crate) fn set_level_hole(&mut self, id: SurfaceId, hole: Option<[f32; 4]>) -> Result<()> {
