@@ -546,6 +546,18 @@ mod render {
         save("levels_trail.png", &trail, size);
         let trail_t = shoot(&w, &[near, far], Tier::Tessellated, camera, size);
         save("levels_trail_tessellated.png", &trail_t, size);
+        // The window moves 2 m on (-x): the trail's far end leaves the near level, and the far
+        // level draws it from what the near one folded into it (coarse, as it must be).
+        let mut t = t;
+        t.follow(&mut w, Vec3::new(-0.4, 0.0, 0.0)).unwrap();
+        t.flush(&mut w).unwrap();
+        w.step(1.0 / 60.0, &[]).unwrap();
+        let moved = shoot(&w, &[near, far], Tier::Relief, camera, size);
+        save("levels_trail_moved.png", &moved, size);
+        assert_ne!(
+            moved, trail,
+            "the window moved and nothing changed on screen"
+        );
     }
 }
 
