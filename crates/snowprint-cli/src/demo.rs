@@ -55,7 +55,7 @@ pub struct Args {
     pub size: Option<(u32, u32)>,
     /// Camera: flythrough, overview, closeup, run, fall, angel, slide or fight (the stand-in
     /// scene has flythrough, closeup, overview, street, angel, fall and slide; the shore
-    /// flythrough, overview, closeup and mud).
+    /// flythrough, overview, closeup and mud; the mountain follow, overview and closing).
     #[arg(long, default_value = "flythrough")]
     pub camera: String,
     /// Snow tier: relief (the talk's relief mapping), pom (parallax occlusion mapping) or
@@ -85,7 +85,9 @@ pub struct Args {
     /// Which demo: `rooftops` (the library's demo world, rendered), `skinned` (the rooftops with
     /// one person pressing the snow with its own skinned glTF mesh, rendered), `standin` (the
     /// renderer's small stand-in world, rendered), `shore` (wet and dry sand, a muddy track and a
-    /// snowy bank, people walking across, rendered) or `city` (several hundred surfaces under the
+    /// snowy bank, people walking across, rendered), `mountain` (a valley on real ground: hills, a
+    /// frozen lake, trees, a cabin with a pitched roof, a hiker walking a long loop; rendered) or
+    /// `city` (several hundred surfaces under the
     /// surface manager's budget: heightmaps, a report, a pool plot and a map; not rendered).
     #[arg(long, default_value = "rooftops")]
     pub scene: String,

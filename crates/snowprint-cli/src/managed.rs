@@ -7,7 +7,7 @@ use snowprint::manager::{
     CameraView, ManagedDeformer, ManagedId, ManagerConfig, SnowManager, ZoneId,
 };
 use snowprint::scene::Scene;
-use snowprint::{Deformer, GpuContext, GpuOptions, Heightmap, Shape};
+use snowprint::{Deformer, GpuContext, GpuOptions, Ground, Heightmap, Shape, SlopeRule};
 
 use crate::progress::Progress;
 use crate::simulate::{Done, Outputs};
@@ -63,6 +63,7 @@ fn start(
                     .map_err(|e| e.to_string())?,
             );
         }
+        lay_grounds(&mut snow, scene, &ids, None)?;
         return Ok((snow, ids));
     };
     let snow = SnowManager::load(ctx, path).map_err(|e| e.to_string())?;
@@ -100,7 +101,41 @@ fn start(
             ids.len()
         ));
     }
+    let mut snow = snow;
+    lay_grounds(&mut snow, scene, &ids, Some(path))?;
     Ok((snow, ids))
+}
+
+/// Lay the scene's surfaces on their grounds. After `--load`, the ground each surface was saved
+/// with must be the scene's: it is laid again from the scene and compared.
+fn lay_grounds(
+    snow: &mut SnowManager,
+    scene: &Scene,
+    ids: &[ManagedId],
+    loaded: Option<&Path>,
+) -> Result<(), String> {
+    for (i, &id) in ids.iter().enumerate() {
+        let ground = scene.grounds.get(i).and_then(Option::as_ref);
+        let saved = snow.ground(id).map_err(|e| e.to_string())?.cloned();
+        let (g, slope, line) = match ground {
+            Some(g) => (g.ground.clone(), g.slope, g.line),
+            None if saved.is_none() => continue,
+            None => (Ground::Flat, SlopeRule::default(), 0),
+        };
+        snow.set_ground(id, &g, slope)
+            .map_err(|e| format!("{}:{line}: {e}", scene.path.display()))?;
+        if let Some(path) = loaded
+            && snow.ground(id).map_err(|e| e.to_string())? != saved.as_ref()
+        {
+            return Err(format!(
+                "--load {}: the ground of surface {:?} differs between the save and {}; load it with the scene it was saved from",
+                path.display(),
+                scene.surfaces[i].name,
+                scene.path.display()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Run the scene through a [`SnowManager`] and dump what each surface holds at the end; stream

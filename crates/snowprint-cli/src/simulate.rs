@@ -57,13 +57,6 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             camera.line
         );
     }
-    if managed && let Some(g) = scene.grounds.iter().flatten().next() {
-        return Err(format!(
-            "{}:{}: a surface on ground that is not flat runs only without the surface manager for now; remove [budget], --report, --save and --load, or the ground key",
-            scene.path.display(),
-            g.line
-        ));
-    }
     if managed && let Some(t) = scene.terrains.first() {
         return Err(format!(
             "{}:{}: a [[terrain]] runs only without the surface manager for now; remove [budget], --report, --save and --load, or the terrain",

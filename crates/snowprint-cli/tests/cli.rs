@@ -621,21 +621,29 @@ fn the_shore_demo_renders_its_four_strips() {
 }
 
 /// The pitched roof: `simulate` lays the surface on its glTF roof and the trench runs over the
-/// ridge (the library's `tests/terrain.rs` checks its depths by hand); under the manager, ground
-/// that is not flat is refused with the line of its key.
+/// ridge (the library's `tests/terrain.rs` checks its depths by hand); under the manager the same
+/// run leaves the same heightmap, and a save taken half way and loaded goes on to it too.
 #[test]
-fn a_surface_on_a_roof_mesh_runs_and_is_refused_under_the_manager() {
+fn a_surface_on_a_roof_mesh_runs_alone_and_under_the_manager() {
     let _serial = serial();
     let out = scratch("roof");
-    let status = snowprint()
-        .args(["simulate", "--scene"])
-        .arg(repo().join("scenes/pitched_roof.toml"))
-        .args(["--frames", "240", "--dump"])
-        .arg(&out)
-        .status()
-        .expect("run snowprint");
-    assert!(status.success());
-    let map = snowprint::Heightmap::load_png(&out.join("roof.png")).expect("roof.png");
+    let run = |frames: &str, dump: &Path, extra: &[&std::ffi::OsStr]| {
+        let run = snowprint()
+            .args(["simulate", "--scene"])
+            .arg(repo().join("scenes/pitched_roof.toml"))
+            .args(["--frames", frames, "--dump"])
+            .arg(dump)
+            .args(extra)
+            .output()
+            .expect("run snowprint");
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        snowprint::Heightmap::load_png(&dump.join("roof.png")).expect("roof.png")
+    };
+    let map = run("240", &out.join("alone"), &[]);
     // Column 50 (x = -2) is pressed from row 5 (z = -2.8) to row 144 (z = 2.8), over the ridge.
     for row in [10, 40, 75, 110, 140] {
         assert!(
@@ -644,21 +652,24 @@ fn a_surface_on_a_roof_mesh_runs_and_is_refused_under_the_manager() {
             map.fraction(50, row)
         );
     }
-    let report = out.with_extension("json");
-    let run = snowprint()
-        .args(["simulate", "--scene"])
-        .arg(repo().join("scenes/pitched_roof.toml"))
-        .args(["--frames", "2", "--dump"])
-        .arg(out.join("managed"))
-        .arg("--report")
-        .arg(&report)
-        .output()
-        .expect("run snowprint");
-    assert!(!run.status.success());
-    let err = String::from_utf8_lossy(&run.stderr);
-    assert!(
-        err.contains("pitched_roof.toml:21:") && err.contains("without the surface manager"),
-        "{err}"
+    let report = out.join("report.json");
+    let save = out.join("half.snowsave");
+    let managed = run(
+        "240",
+        &out.join("managed"),
+        &["--report".as_ref(), report.as_os_str()],
     );
+    assert_eq!(managed.depression, map.depression, "managed run differs");
+    run(
+        "120",
+        &out.join("half"),
+        &["--save".as_ref(), save.as_os_str()],
+    );
+    let resumed = run(
+        "120",
+        &out.join("resumed"),
+        &["--load".as_ref(), save.as_os_str()],
+    );
+    assert_eq!(resumed.depression, map.depression, "the loaded run differs");
     let _ = std::fs::remove_dir_all(&out);
 }

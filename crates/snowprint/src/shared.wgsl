@@ -14,7 +14,7 @@ struct SurfaceRecord {
     atlas_y: u32,
     mode: u32,            // bit 0: mask capture (else depth); bit 1: MODE_MESHES; bit 2: MODE_GROUND
     replenish_units: u32, // channel units (1/channel_max(PRECISION) of the snow depth) refilled
-    batch: u32,           // capture batch; NO_CAPTURE when nothing touched the surface
+    batch: u32,           // capture batch; NO_CAPTURE when nothing touched the surface (0xfffffffe: the compute path)
     mask_fraction: f32,   // mask capture: fraction of the snow depth a covered texel is pressed
     snow_depth: f32,      // metres
     frustum_height: f32,  // metres: snow depth + ankle height

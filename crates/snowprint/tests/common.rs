@@ -15,3 +15,21 @@ pub fn gpu() -> &'static GpuContext {
         Err(e) => panic!("GPU tests need an adapter: {e}"),
     })
 }
+
+/// Bytes of a save with these sections, every length and checksum right (stored raw).
+pub fn assemble_save(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
+    let mut out = b"SNOWSAVE".to_vec();
+    out.extend_from_slice(&version.to_le_bytes());
+    out.extend_from_slice(&(sections.len() as u32).to_le_bytes());
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    for (tag, data) in sections {
+        out.extend_from_slice(tag);
+        out.extend_from_slice(&0u32.to_le_bytes());
+        out.extend_from_slice(&(data.len() as u64).to_le_bytes());
+        out.extend_from_slice(&(data.len() as u64).to_le_bytes());
+        out.extend_from_slice(&crc32fast::hash(data).to_le_bytes());
+        out.extend_from_slice(data);
+    }
+    out
+}

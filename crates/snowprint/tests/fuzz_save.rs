@@ -86,24 +86,6 @@ fn sections(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
         .collect()
 }
 
-/// Bytes of a save with these sections, every length and checksum right (stored raw).
-fn assemble(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
-    let mut out = b"SNOWSAVE".to_vec();
-    out.extend_from_slice(&version.to_le_bytes());
-    out.extend_from_slice(&(sections.len() as u32).to_le_bytes());
-    let crc = crc32fast::hash(&out);
-    out.extend_from_slice(&crc.to_le_bytes());
-    for (tag, data) in sections {
-        out.extend_from_slice(tag);
-        out.extend_from_slice(&0u32.to_le_bytes());
-        out.extend_from_slice(&(data.len() as u64).to_le_bytes());
-        out.extend_from_slice(&(data.len() as u64).to_le_bytes());
-        out.extend_from_slice(&crc32fast::hash(data).to_le_bytes());
-        out.extend_from_slice(data);
-    }
-    out
-}
-
 /// JSON fragments the text sections are mutated with.
 const TOKENS: &[&str] = &[
     "null",
@@ -215,7 +197,7 @@ fn apply(bytes: &[u8], muts: &[Mutation]) -> Vec<u8> {
             _ => raw.push(m),
         }
     }
-    let mut out = assemble(version, &secs);
+    let mut out = common::assemble_save(version, &secs);
     for m in raw {
         let n = out.len().max(1);
         match *m {
@@ -279,7 +261,7 @@ fn load_one(input: Vec<u8>) -> Result<(), String> {
 fn the_save_loader_answers_every_input() {
     let seed = seed();
     // The re-assembled seed is a valid save: the fix-up is right, so mutations go deep.
-    assert!(SaveFile::parse(&assemble(1, &sections(seed))).is_ok());
+    assert!(SaveFile::parse(&common::assemble_save(1, &sections(seed))).is_ok());
     let n = cases(2000);
     let start = Instant::now();
     let watchdog = Watchdog::new(load_one, LIMIT);

@@ -8,8 +8,8 @@ use std::time::Instant;
 use glam::Vec3;
 use serde::Serialize;
 use snowprint::{
-    Deformer, GpuContext, GpuOptions, PassMode, PoolFormat, Pose, Precision, Shape, SnowWorld,
-    StageTimes, SurfaceDesc, SurfaceUpdate, WorldConfig,
+    CapturePath, Deformer, GpuContext, GpuOptions, PassMode, PoolFormat, Pose, Precision, Shape,
+    SnowWorld, StageTimes, SurfaceDesc, SurfaceUpdate, WorldConfig,
 };
 
 mod baseline;
@@ -46,6 +46,9 @@ pub struct Row {
     pub resolution: u32,
     /// Deformers over each surface.
     pub deformers_per_surface: u32,
+    /// The capture's path for the spheres: what `Auto` takes on this adapter (`compute` on a GPU)
+    /// or `raster` (the sweep `raster_surf`, the same surfaces rendered in viewports).
+    pub capture_path: &'static str,
     /// Blur and merge fused in one pass (else separate passes).
     pub fused: bool,
     /// Bits a channel of the pool.
@@ -137,6 +140,7 @@ struct Config {
     passes: PassMode,
     precision: Precision,
     snowing: bool,
+    capture: CapturePath,
 }
 
 fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
@@ -152,6 +156,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             passes: c.passes,
             format,
             atlas_side: 8192.min(gpu.caps.max_texture_side),
+            capture_path: c.capture,
             ..Default::default()
         },
     )
@@ -264,6 +269,10 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         surfaces: c.surfaces,
         resolution: c.resolution,
         deformers_per_surface: c.deformers,
+        capture_path: match c.capture.resolved(gpu.info.device_type) {
+            CapturePath::Raster => "raster",
+            _ => "compute",
+        },
         fused: world.config().passes == PassMode::Fused,
         precision_bits: c.precision.bits(),
         snowing: c.snowing,
@@ -368,6 +377,7 @@ fn configs(quick: bool) -> Vec<Config> {
         passes,
         precision: Precision::Bits16,
         snowing: false,
+        capture: CapturePath::Auto,
     };
     let at = |precision, c: Config| Config { precision, ..c };
     let snowing = |c: Config| Config { snowing: true, ..c };
@@ -395,6 +405,18 @@ fn configs(quick: bool) -> Vec<Config> {
         counts
             .iter()
             .map(|&n| snowing(cfg("surfaces", n, 128, 10, auto))),
+    );
+    // The largest and a middle count again with the spheres rendered in viewports: the capture's
+    // compute path against the raster path in the same run.
+    let raster = |c: Config| Config {
+        capture: CapturePath::Raster,
+        ..c
+    };
+    let compared: &[u32] = if quick { &[16] } else { &[256, 4096] };
+    configs.extend(
+        compared
+            .iter()
+            .map(|&n| raster(snowing(cfg("raster_surf", n, 128, 10, auto)))),
     );
     configs.extend(
         resolutions

@@ -4,6 +4,7 @@
 //! lamps), [`standin`] (a small, self-contained second world) and [`shore`] (sand, mud and snow
 //! side by side, walked across by the stand-in's people).
 
+pub mod mountain;
 pub mod rooftops;
 pub mod shore;
 pub mod skinned;
@@ -51,8 +52,9 @@ pub fn build_scene(
         "standin" => Ok(Box::new(standin::StandIn::new(world, renderer)?)),
         "skinned" => Ok(Box::new(skinned::SkinnedDemo::new(world, renderer)?)),
         "shore" => Ok(Box::new(shore::Shore::new(world, renderer)?)),
+        "mountain" => Ok(Box::new(mountain::Mountain::new(world, renderer)?)),
         _ => Err(format!(
-            "unknown scene {name:?}; use rooftops, skinned, standin, shore or city"
+            "unknown scene {name:?}; use rooftops, skinned, standin, shore, mountain or city"
         )),
     }
 }

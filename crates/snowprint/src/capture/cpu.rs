@@ -1,4 +1,4 @@
-//! CPU reference of the capture: the same maths as `capture.wgsl`, evaluated at every texel centre.
+//! CPU reference of the capture: the same maths as `write.wgsl` (both capture paths), evaluated at every texel centre.
 //! Depth 0 is the ground, 1 the top of the frustum; 1 also means "nothing captured" (the clear value).
 
 use glam::{Vec2, Vec3, Vec3Swizzles};

@@ -43,6 +43,8 @@ pub struct CapturedSurface {
     pub prims: Range<u32>,
     /// The surface's mesh draws in [`CapturePlan::draws`].
     pub draws: Range<u32>,
+    /// Whether the compute path captures it (its view's `prims` and `rect`; no viewport).
+    pub compute: bool,
 }
 
 /// What a frame's capture draws: one [`CapturedSurface`] and one [`CaptureView`] per captured
@@ -64,6 +66,9 @@ pub struct CapturePlan {
     pub atlas_side: u32,
     /// Render passes over the atlas.
     pub batches: u32,
+    /// The compute path's work: `[view, tile y << 16 | tile x]` for every tile a surface's
+    /// primitives reach (empty: no surface takes the compute path).
+    pub work: Vec<[u32; 2]>,
     /// Texels of the capture buffer (every captured surface, one after the other).
     pub texels: u32,
     /// Tile flags of the captured surfaces.
@@ -84,6 +89,7 @@ impl CapturePlan {
         self.draw_meshes.clear();
         self.atlas_side = 0;
         self.batches = 0;
+        self.work.clear();
         self.texels = 0;
         self.tile_flags = 0;
         self.ground_copies.clear();
@@ -104,7 +110,8 @@ impl CapturePlan {
 /// viewports it draws into.
 #[derive(Clone, Copy, Debug)]
 pub struct CaptureBuffers<'a> {
-    /// [`CaptureView`]s, one uniform block (256 bytes) each.
+    /// [`CaptureView`]s, one uniform block (256 bytes) each, then (when the compute path has
+    /// work) [`CapturePlan::work`] and its first word and length ([`work_table`]).
     pub views: &'a wgpu::Buffer,
     /// [`GpuPrimitive`]s.
     pub prims: &'a wgpu::Buffer,
@@ -181,6 +188,9 @@ pub fn encode(
     }
     enc.clear_buffer(buffers.tiles, 0, Some(plan.tile_flags.max(1) as u64 * 4));
     enc.clear_buffer(buffers.tile_list, 0, Some(TILE_LIST_HEADER * 4));
+    if !plan.work.is_empty() {
+        encode_compute(device, enc, pipes, plan, buffers, queries);
+    }
     for batch in 0..plan.batches {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("capture"),
@@ -199,7 +209,7 @@ pub fn encode(
             multiview_mask: None,
         });
         for (k, s) in plan.surfaces.iter().enumerate() {
-            if s.batch != batch {
+            if s.compute || s.batch != batch {
                 continue;
             }
             pass.set_viewport(
@@ -230,4 +240,55 @@ pub fn encode(
             }
         }
     }
+}
+
+/// Workgroups a dispatch's x covers; y counts the groups of them.
+const ENTRIES_PER_X: u32 = 65535;
+
+/// The words that follow the view blocks in the views buffer for the compute path: the work
+/// list, then its first word and its length. Returns them with the bytes the binding spans.
+pub fn work_table(plan: &CapturePlan) -> (Vec<u32>, u64) {
+    let first = plan.views.len() as u64 * UNIFORM_STRIDE / 4;
+    let mut words: Vec<u32> = plan.work.iter().flatten().copied().collect();
+    words.push(first as u32);
+    words.push(plan.work.len() as u32);
+    let bytes = first * 4 + words.len() as u64 * 4;
+    (words, bytes)
+}
+
+/// The compute path: a workgroup an entry of the work list.
+fn encode_compute(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    pipes: &CapturePipelines,
+    plan: &CapturePlan,
+    buffers: &CaptureBuffers<'_>,
+    queries: &mut StageQueries<'_>,
+) {
+    let (_, bytes) = work_table(plan);
+    let bg = bind_group(
+        device,
+        "capture compute",
+        &pipes.compute_layout,
+        &[
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: buffers.views,
+                offset: 0,
+                size: std::num::NonZeroU64::new(bytes),
+            }),
+            buffers.prims.as_entire_binding(),
+            buffers.capture.as_entire_binding(),
+            buffers.tiles.as_entire_binding(),
+            buffers.tile_list.as_entire_binding(),
+            buffers.ground.as_entire_binding(),
+        ],
+    );
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some("capture compute"),
+        timestamp_writes: queries.compute("capture"),
+    });
+    pass.set_pipeline(&pipes.compute);
+    pass.set_bind_group(0, &bg, &[]);
+    let n = plan.work.len() as u32;
+    pass.dispatch_workgroups(n.min(ENTRIES_PER_X), n.div_ceil(ENTRIES_PER_X), 1);
 }

@@ -17,7 +17,7 @@
 pub(crate) mod cpu;
 mod encode;
 
-pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode};
+pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode, work_table};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -84,7 +84,8 @@ pub const MAX_SUBSTEPS: u32 = 32;
 /// `record` of a [`CaptureView`] whose flagged tiles are not listed (the update runs its grid).
 pub const NO_LIST: u32 = crate::wgsl::consts::NO_LIST;
 
-/// Uniform block of one surface's capture. Must match `CaptureView` in `capture.wgsl`.
+/// One surface's capture view: a uniform block in `capture.wgsl`, 256-byte storage blocks in
+/// `prims.wgsl`. Must match `CaptureView` in `write.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct CaptureView {
@@ -107,12 +108,111 @@ pub struct CaptureView {
     /// First texel of the surface's ground field in the capture's ground buffer, or [`NO_GROUND`]
     /// on flat ground.
     pub ground: u32,
+    /// Compute path: its primitives (first, count); count 0 on the raster path.
+    pub prims: [u32; 2],
+}
+
+/// A primitive's footprint on its surface: the corners of its bounding rectangle, local `(x, z)`.
+/// Must match `prim_footprint` in `write.wgsl`.
+pub fn footprint(p: &GpuPrimitive) -> [f32; 4] {
+    if p.kind[0] == PRIM_CAPSULE {
+        let r = p.p0[3];
+        return [
+            p.p0[0].min(p.p1[0]) - r,
+            p.p0[2].min(p.p1[2]) - r,
+            p.p0[0].max(p.p1[0]) + r,
+            p.p0[2].max(p.p1[2]) + r,
+        ];
+    }
+    let e = |k: usize| p.p1[k].abs() * p.p1[3] + p.p2[k].abs() * p.p2[3] + p.p3[k].abs() * p.p3[3];
+    let (ex, ez) = (e(0), e(2));
+    [p.p0[0] - ex, p.p0[2] - ez, p.p0[0] + ex, p.p0[2] + ez]
+}
+
+/// Append to `work` an entry `[view, tile y << 16 | tile x]` for every 16 x 16 tile of a
+/// `width` x `height` surface of half sides `half` that a footprint of `prims` reaches (a texel
+/// of margin around each, so that rounding never leaves out a texel the ray cast would hit);
+/// `seen` is scratch.
+pub fn tiles_reached(
+    prims: &[GpuPrimitive],
+    (width, height): (u32, u32),
+    half: glam::Vec2,
+    view: u32,
+    seen: &mut Vec<bool>,
+    work: &mut Vec<[u32; 2]>,
+) {
+    let tile = crate::pool::TILE_SIDE;
+    let (tx, ty) = (width.div_ceil(tile), height.div_ceil(tile));
+    seen.clear();
+    seen.resize((tx * ty) as usize, false);
+    let texel = half * 2.0 / glam::Vec2::new(width as f32, height as f32);
+    let to_cell = |v: f32, h: f32, t: f32, n: u32| {
+        (((v + h) / t).floor() as i64).clamp(0, n as i64 - 1) as u32
+    };
+    for p in prims {
+        let [x0, z0, x1, z1] = footprint(p);
+        if x1 < -half.x || z1 < -half.y || x0 > half.x || z0 > half.y {
+            continue;
+        }
+        let (c0, c1) = (
+            to_cell(x0 - texel.x, half.x, texel.x, width),
+            to_cell(x1 + texel.x, half.x, texel.x, width),
+        );
+        let (r0, r1) = (
+            to_cell(z0 - texel.y, half.y, texel.y, height),
+            to_cell(z1 + texel.y, half.y, texel.y, height),
+        );
+        for r in r0 / tile..=r1 / tile {
+            for c in c0 / tile..=c1 / tile {
+                let i = (r * tx + c) as usize;
+                if !seen[i] {
+                    seen[i] = true;
+                    work.push([view, r << 16 | c]);
+                }
+            }
+        }
+    }
+}
+
+/// `batch` of a surface record captured by the compute path (no pass over the atlas; anything but
+/// `NO_CAPTURE` tells the update that the capture holds its texels).
+pub const COMPUTED: u32 = 0xffff_fffe;
+
+/// Most analytic primitives a surface may have and still be captured by the compute path (each
+/// texel of its reach tests every one of them; past this the raster path, which draws each
+/// primitive's rectangle alone, does less work).
+pub const COMPUTE_PRIMS_MAX: u32 = 256;
+
+/// Which path captures analytic deformers. Both write the same bits (`tests/capture_paths.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CapturePath {
+    /// [`CapturePath::Compute`] on a GPU, [`CapturePath::Raster`] on a software adapter (where
+    /// llvmpipe ran the compute path up to three times slower: `docs/PERFORMANCE.md`).
+    #[default]
+    Auto,
+    /// Compute, one dispatch for every surface that only analytic deformers press (up to
+    /// [`COMPUTE_PRIMS_MAX`] primitives): no viewport and no draw per surface, a workgroup per tile
+    /// the primitives reach. Surfaces that meshes press are rendered.
+    Compute,
+    /// Every surface rendered in its viewport of the atlas, primitives as rectangles.
+    Raster,
+}
+
+impl CapturePath {
+    /// The path `Auto` stands for on an adapter of `device_type`.
+    pub fn resolved(self, device_type: wgpu::DeviceType) -> Self {
+        match (self, device_type) {
+            (Self::Auto, wgpu::DeviceType::Cpu) => Self::Raster,
+            (Self::Auto, _) => Self::Compute,
+            (path, _) => path,
+        }
+    }
 }
 
 /// `ground` of a [`CaptureView`] on flat ground.
 pub const NO_GROUND: u32 = crate::wgsl::consts::NO_GROUND;
 
-/// An analytic deformer in surface-local coordinates. Must match `Primitive` in `capture.wgsl`.
+/// An analytic deformer in surface-local coordinates. Must match `Primitive` in `write.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuPrimitive {
@@ -345,6 +445,10 @@ pub struct CapturePipelines {
     pub view_layout: wgpu::BindGroupLayout,
     /// Group 1: mesh draw (dynamic uniform).
     pub draw_layout: wgpu::BindGroupLayout,
+    /// The compute path for analytic deformers (`prims.wgsl`).
+    pub compute: wgpu::ComputePipeline,
+    /// Its group 0: views, primitives and ground (storage, read), capture, tiles and tile list.
+    pub compute_layout: wgpu::BindGroupLayout,
 }
 
 impl CapturePipelines {
@@ -426,11 +530,32 @@ impl CapturePipelines {
             multiview_mask: None,
             cache: None,
         });
+        let compute_layout =
+            crate::wgsl::CAPTURE_PRIMS.bind_group_layout(device, "capture compute", 0);
+        let compute_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("prims.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(crate::wgsl::CAPTURE_PRIMS.source.into()),
+        });
+        let compute_pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("capture compute"),
+            bind_group_layouts: &[Some(&compute_layout)],
+            immediate_size: 0,
+        });
+        let compute = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("capture compute"),
+            layout: Some(&compute_pl),
+            module: &compute_module,
+            entry_point: Some("capture_prims"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
         Self {
             primitives,
             meshes,
             view_layout,
             draw_layout,
+            compute,
+            compute_layout,
         }
     }
 }
@@ -501,6 +626,26 @@ pub fn pack_atlas_compact(rects: &[(u32, u32)], max_side: u32) -> (Vec<AtlasPlac
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The view and the primitive have the Rust side's sizes (`prims.wgsl` reads the view word by
+    /// word, in its fields' order; `tests/capture_paths.rs` holds it to the raster path).
+    #[test]
+    fn layouts_match_wgsl() {
+        let module = naga::front::wgsl::parse_str(crate::wgsl::CAPTURE_PRIMS.source).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        for (name, size) in [
+            ("CaptureView", std::mem::size_of::<CaptureView>()),
+            ("Primitive", std::mem::size_of::<GpuPrimitive>()),
+        ] {
+            let (handle, _) = module
+                .types
+                .iter()
+                .find(|(_, t)| t.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("{name} not in prims.wgsl"));
+            assert_eq!(layouter[handle].size as usize, size, "{name}");
+        }
+    }
 
     #[test]
     fn compact_packing_stays_near_the_area() {

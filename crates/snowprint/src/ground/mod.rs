@@ -14,7 +14,7 @@
 //! [`SlopeRule::bare_degrees`]; its column is lowered to the base `ground - (1 - k) D`, of which the
 //! lowest `(1 - k) D` is rock. So the snow top is `ground + k D`, a depression is still a fraction of
 //! `D` measured from that top, and the capture's depth clamp holds at the ground itself (the bare
-//! depth above the base): a foot never digs below the terrain. Capture: `capture/capture.wgsl`.
+//! depth above the base): a foot never digs below the terrain. Capture: `capture/write.wgsl`.
 
 pub(crate) mod cpu;
 pub(crate) mod raster;

@@ -2,6 +2,7 @@
 //! evictions and admissions in the plan's order), then the planned updates as catch-up layers.
 
 use super::frame::PageRead;
+use super::ground::ManagedGround;
 use super::pages::PageStore;
 use super::{CatchUp, ManagedId, PlannedUpdate, Planner, ResidencyChange};
 use crate::deformer::Deformer;
@@ -28,6 +29,7 @@ pub(super) fn apply_changes(
     world: &mut SnowWorld,
     pages: &mut PageStore,
     world_ids: &mut [Option<SurfaceId>],
+    grounds: &[Option<ManagedGround>],
     planner: &Planner,
     enc: &mut wgpu::CommandEncoder,
 ) -> Result<Applied> {
@@ -61,7 +63,16 @@ pub(super) fn apply_changes(
                 }
             }
             ResidencyChange::Admit(id) => {
-                admit(world, pages, world_ids, planner, enc, id, &mut applied)?
+                let ground = grounds.get(id.0 as usize).and_then(Option::as_ref);
+                admit(
+                    world,
+                    pages,
+                    world_ids,
+                    (planner, ground),
+                    enc,
+                    id,
+                    &mut applied,
+                )?
             }
         }
     }
@@ -69,12 +80,13 @@ pub(super) fn apply_changes(
     Ok(applied)
 }
 
-/// Give surface `id` its slot in the world: from its page when it has one, else untouched.
+/// Give surface `id` its slot in the world: from its page when it has one, else untouched; laid on
+/// its ground when it has one.
 fn admit(
     world: &mut SnowWorld,
     pages: &mut PageStore,
     world_ids: &mut [Option<SurfaceId>],
-    planner: &Planner,
+    (planner, ground): (&Planner, Option<&ManagedGround>),
     enc: &mut wgpu::CommandEncoder,
     id: ManagedId,
     applied: &mut Applied,
@@ -90,6 +102,9 @@ fn admit(
     };
     match result {
         Ok(w) => {
+            if let Some(g) = ground {
+                world.set_ground_field(w, Some(g.field.clone()))?;
+            }
             pages.take(id.0);
             world_ids[id.0 as usize] = Some(w);
         }

@@ -75,6 +75,7 @@ impl SnowManager {
             &mut self.world,
             &mut self.pages,
             &mut self.world_ids,
+            &self.grounds,
             &self.planner,
             encoder,
         )?;

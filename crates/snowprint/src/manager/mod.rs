@@ -44,6 +44,7 @@ mod apply;
 mod camera;
 mod config;
 mod frame;
+mod ground;
 mod probe;
 mod skinned;
 mod stats;
@@ -57,7 +58,7 @@ pub use camera::{CameraView, Frustum};
 pub use config::{CatchUp, ManagerConfig, UNLIMITED};
 pub use frame::PendingTick;
 pub use probe::{ManagedProbeStatus, ManagedProbeTicket, ManagedSample};
-pub use save::{SaveFile, SavedSurface, Section};
+pub use save::{SaveFile, SavedGround, SavedSurface, Section};
 pub use stats::TickStats;
 
 use crate::deformer::Deformer;
@@ -139,6 +140,8 @@ pub struct SnowManager {
     world_ids: Vec<Option<SurfaceId>>,
     /// Heightmaps of surfaces without a slot that had one.
     pages: PageStore,
+    /// Per managed surface: its ground when it is not flat (`ground.rs`).
+    grounds: Vec<Option<ground::ManagedGround>>,
     /// Mesh deformers by the manager's [`MeshId`].
     meshes: Vec<ManagedMesh>,
     /// World meshes of earlier posings that queued imprints may still name, and their vertices
@@ -215,6 +218,7 @@ impl SnowManager {
             planner,
             world_ids: Vec::new(),
             pages: PageStore::default(),
+            grounds: Vec::new(),
             meshes: Vec::new(),
             retired: Vec::new(),
             retired_mesh: Default::default(),
@@ -233,6 +237,7 @@ impl SnowManager {
     pub fn add_surface(&mut self, desc: SurfaceDesc, zone: ZoneId) -> Result<ManagedId> {
         let id = self.planner.add_surface(&desc, zone)?;
         self.world_ids.push(None);
+        self.grounds.push(None);
         Ok(id)
     }
 
@@ -240,6 +245,7 @@ impl SnowManager {
     pub fn remove_surface(&mut self, id: ManagedId) -> Result<()> {
         self.planner.remove_surface(id)?;
         self.pages.take(id.0);
+        self.grounds[id.0 as usize] = None;
         if let Some(w) = self.world_ids.get_mut(id.0 as usize).and_then(Option::take) {
             self.world.remove_surface(w)?;
         }

@@ -228,11 +228,11 @@ impl SnowManager {
                         &c.layout,
                         c.precision,
                         (&c.depression, &c.displaced),
-                        None,
+                        (None, self.ground_field(id)),
                         point,
                     )
                 }
-                None => cpu::untouched(desc, point),
+                None => cpu::untouched_on(desc, self.ground_field(id), point),
             };
             r.samples[k] = Some(ManagedSample {
                 surface: Some(id),
@@ -249,7 +249,7 @@ impl SnowManager {
             let Ok(desc) = self.planner.surface(id) else {
                 continue;
             };
-            match cpu::over(desc, point) {
+            match cpu::over_on(desc, self.ground_field(id), point) {
                 Some(ground) if best.is_none_or(|b| b.0 < ground) => best = Some((ground, id)),
                 _ => {}
             }

@@ -1,7 +1,7 @@
 //! A world's settings and what it reports: pass settings, frame statistics, memory (the capture
 //! settings live with the capture: [`crate::capture::CaptureConfig`]).
 
-use crate::capture::CaptureConfig;
+use crate::capture::{CaptureConfig, CapturePath};
 use crate::deformer::Deformer;
 use crate::pool::PoolFormat;
 use crate::surface::SurfaceId;
@@ -32,6 +32,11 @@ pub struct WorldConfig {
     pub list_tiles_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
+    /// Which path captures analytic deformers: `Compute` ray-casts them in one dispatch for every
+    /// surface that meshes do not press, `Raster` renders every surface in its viewport, and
+    /// [`CapturePath::Auto`] (the default) takes `Compute` on a GPU and `Raster` on a software
+    /// adapter. Both write the same bits.
+    pub capture_path: CapturePath,
     /// Kicked-up snow: particles spawned where an update deepens a print fast (`spray/`). `None`
     /// (the default): no spray pass, the update exactly as without it.
     pub spray: Option<crate::spray::SprayConfig>,
@@ -62,6 +67,7 @@ impl Default for WorldConfig {
             passes: PassMode::Auto,
             list_tiles_from: 16384,
             format: PoolFormat::default(),
+            capture_path: CapturePath::Auto,
             spray: None,
         }
     }

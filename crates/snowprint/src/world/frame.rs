@@ -390,6 +390,11 @@ impl SnowWorld {
         let c = &plan.capture;
         let blocks = &mut self.scratch_cpu.blocks;
         uniform_blocks(blocks, &c.views, 1);
+        if !c.work.is_empty() {
+            // The compute path's work list and its place, after the blocks (`prims.wgsl`).
+            blocks.truncate(c.views.len() * UNIFORM_STRIDE as usize);
+            blocks.extend_from_slice(bytemuck::cast_slice(&capture::work_table(c).0));
+        }
         self.views.ensure(device, sizes.views);
         write(&self.views.buffer, blocks);
         if !c.prims.is_empty() {

@@ -43,6 +43,21 @@ impl SnowWorld {
             let s = self.state(id)?;
             (s.desc.clone(), s.layout)
         };
+        let field = self.resolve_ground(&desc, layout, ground, slope)?;
+        self.set_ground_field(id, field)
+    }
+
+    /// The field of `ground` under a surface of `desc` at `layout` (`None` on flat ground),
+    /// checked as [`SnowWorld::set_ground`] checks it; a mesh is rasterised on the GPU, waiting
+    /// for it. The manager resolves a surface's ground once with it and lays the field again at
+    /// each admission.
+    pub(crate) fn resolve_ground(
+        &mut self,
+        desc: &crate::SurfaceDesc,
+        layout: crate::surface::SurfaceLayout,
+        ground: &Ground,
+        slope: SlopeRule,
+    ) -> Result<Option<GroundField>> {
         slope.validate(&desc.name)?;
         let heights = match ground {
             Ground::Flat => None,
@@ -77,8 +92,31 @@ impl SnowWorld {
                 Some(texels.into_iter().map(|h| h.unwrap_or(0.0)).collect())
             }
         };
-        let field =
-            heights.map(|g| GroundField::build(layout, desc.size, g, desc.snow_depth, slope));
+        Ok(heights.map(|g| GroundField::build(layout, desc.size, g, desc.snow_depth, slope)))
+    }
+
+    /// Lay a surface on a field resolved for its layout (`None`: flat ground). Refused while an
+    /// encoded frame is not submitted.
+    pub(crate) fn set_ground_field(
+        &mut self,
+        id: SurfaceId,
+        field: Option<GroundField>,
+    ) -> Result<()> {
+        if self.in_flight.is_some() {
+            return Err(SnowError::FramePending);
+        }
+        let layout = self.state(id)?.layout;
+        if let Some(f) = &field
+            && (f.width, f.height) != (layout.width, layout.height)
+        {
+            return Err(SnowError::InvalidGround {
+                name: self.state(id)?.desc.name.clone(),
+                reason: format!(
+                    "the ground field is {} x {} texels and the surface {} x {}",
+                    f.width, f.height, layout.width, layout.height
+                ),
+            });
+        }
         self.surfaces[id.0 as usize]
             .as_mut()
             .expect("checked live above")

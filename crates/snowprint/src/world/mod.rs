@@ -28,7 +28,7 @@ mod skinned;
 mod snapshot;
 mod spray;
 
-pub use crate::capture::{CaptureConfig, CaptureMode};
+pub use crate::capture::{CaptureConfig, CaptureMode, CapturePath};
 pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
 pub use footstep::Footstep;
 pub use frame::PendingFrame;
@@ -175,6 +175,7 @@ impl SnowWorld {
         crate::gpu::check_device(&gpu.device)?;
         let device = gpu.device.clone();
         let mut config = config;
+        config.capture_path = config.capture_path.resolved(gpu.info.device_type);
         let c = config.capture;
         if !(c.ankle_height.is_finite() && c.ankle_height > 0.0) {
             return Err(SnowError::Config {
@@ -249,7 +250,7 @@ impl SnowWorld {
             views: Growable::new(
                 &device,
                 "capture views",
-                U::UNIFORM | U::COPY_DST,
+                U::UNIFORM | U::STORAGE | U::COPY_DST,
                 UNIFORM_STRIDE * 16,
             ),
             prims: Growable::new(

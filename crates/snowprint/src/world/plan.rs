@@ -42,6 +42,8 @@ pub struct PlanSettings {
     pub list_tiles_from: u32,
     /// Largest side of the capture atlas, texels.
     pub atlas_side: u32,
+    /// Which path captures analytic deformers.
+    pub capture_path: capture::CapturePath,
 }
 
 impl PlanSettings {
@@ -53,6 +55,7 @@ impl PlanSettings {
             passes: config.passes,
             list_tiles_from: config.list_tiles_from,
             atlas_side: config.atlas_side,
+            capture_path: config.capture_path,
         }
     }
 
@@ -148,6 +151,8 @@ struct Job {
     ground_offset: u32,
     prims: Range<u32>,
     draws: Range<u32>,
+    /// Whether the compute path captures it.
+    compute: bool,
     /// Relaxation steps this update (0: none), the material's repose angle (degrees) and the
     /// rectangle that relaxes.
     relax: (u32, f32, Rect),
@@ -174,6 +179,8 @@ pub struct FramePlan {
     pub sizes: BufferSizes,
     jobs: Vec<Job>,
     rects: Vec<(u32, u32)>,
+    /// Scratch of the compute path's tiles, a flag a tile of one surface.
+    seen: Vec<bool>,
 }
 
 impl FramePlan {
@@ -355,6 +362,7 @@ impl FramePlan {
             ground_offset: s.ground.map_or(capture::NO_GROUND, |g| g.offset),
             prims: p0..p1,
             draws: d0..d1,
+            compute: computed(settings, p1 - p0, d1 > d0),
             relax: if relaxes && !rect.is_empty() {
                 (steps, material.repose_degrees.unwrap_or(90.0), rect)
             } else {
@@ -363,12 +371,14 @@ impl FramePlan {
         });
     }
 
-    /// Place captured surfaces in the atlas, the capture buffer and the tile flags.
+    /// Place captured surfaces in the atlas (those the raster path captures), the capture buffer
+    /// and the tile flags.
     fn pack_atlas(&mut self, settings: &PlanSettings) {
+        let rendered = |j: &Job| j.surface.captured && !j.compute;
         self.rects.extend(
             self.jobs
                 .iter()
-                .filter(|j| j.surface.captured)
+                .filter(|j| rendered(j))
                 .map(|j| (j.record.width, j.record.height)),
         );
         // The atlas is cleared whole every pass, so keep it as small as the frame allows: the
@@ -378,12 +388,16 @@ impl FramePlan {
         let c = &mut self.capture;
         c.atlas_side = atlas_side;
         c.batches = placements.iter().map(|p| p.batch + 1).max().unwrap_or(0);
-        let captured = self.jobs.iter_mut().filter(|j| j.surface.captured);
-        for (job, p) in captured.zip(&placements) {
+        let mut placed = placements.iter();
+        for job in self.jobs.iter_mut().filter(|j| j.surface.captured) {
             let r = &mut job.record;
-            r.atlas_x = p.x;
-            r.atlas_y = p.y;
-            r.batch = p.batch;
+            if job.compute {
+                r.batch = capture::COMPUTED;
+            } else if let Some(p) = placed.next() {
+                r.atlas_x = p.x;
+                r.atlas_y = p.y;
+                r.batch = p.batch;
+            }
             r.scratch = c.texels;
             c.texels += r.width * r.height;
             if r.mode & MODE_GROUND != 0 {
@@ -437,7 +451,21 @@ impl FramePlan {
                 height: r.height,
                 prims: job.prims.clone(),
                 draws: job.draws.clone(),
+                compute: job.compute,
             });
+            if job.compute {
+                let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
+                let view = c.views.len() as u32;
+                let size = (r.width, r.height);
+                capture::tiles_reached(
+                    prims,
+                    size,
+                    job.half_size,
+                    view,
+                    &mut self.seen,
+                    &mut c.work,
+                );
+            }
             c.views.push(CaptureView {
                 half_size: job.half_size.to_array(),
                 frustum_height: r.frustum_height,
@@ -448,6 +476,11 @@ impl FramePlan {
                 tiles_x: r.width.div_ceil(TILE_SIDE),
                 record: if listed { j as u32 } else { capture::NO_LIST },
                 ground: job.ground_offset,
+                prims: if job.compute {
+                    [job.prims.start, job.prims.len() as u32]
+                } else {
+                    [0, 0]
+                },
             });
         }
         if self.jobs.is_empty() {
@@ -480,7 +513,12 @@ impl FramePlan {
         let texels = c.texels.max(1) as u64 * 4;
         self.sizes = BufferSizes {
             records: (a.records.len() * std::mem::size_of::<SurfaceRecord>()) as u64,
-            views: c.views.len().max(1) as u64 * UNIFORM_STRIDE,
+            views: c.views.len().max(1) as u64 * UNIFORM_STRIDE
+                + if c.work.is_empty() {
+                    0
+                } else {
+                    capture::work_table(c).1 - c.views.len() as u64 * UNIFORM_STRIDE
+                },
             prims: std::mem::size_of_val(c.prims.as_slice()) as u64,
             draws: c.draws.len() as u64 * UNIFORM_STRIDE,
             // The blurred capture goes through memory only when blur and merge are separate.
@@ -535,6 +573,16 @@ fn pressed_rect(
         x1: clamp(b.x.ceil(), w),
         y1: clamp(b.y.ceil(), h),
     }
+}
+
+/// Whether the compute path captures a surface with `prims` primitives (and mesh draws when
+/// `meshes`): not when meshes press it, when it has no primitives or too many, or when the world
+/// asks for the raster path.
+fn computed(settings: &PlanSettings, prims: u32, meshes: bool) -> bool {
+    settings.capture_path != capture::CapturePath::Raster
+        && !meshes
+        && prims > 0
+        && prims <= capture::COMPUTE_PRIMS_MAX
 }
 
 /// Add a surface's replenishment over `elapsed` seconds to its carry: `(new carry, whole units

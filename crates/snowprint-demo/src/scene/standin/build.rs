@@ -34,7 +34,7 @@ pub(in crate::scene) fn cylinder(radius: f32, height: f32, segments: u32) -> Mes
 }
 
 /// A cone along +Y from a base of `radius` at y = 0 to the apex at `height`.
-pub(super) fn cone(radius: f32, height: f32, segments: u32) -> Mesh {
+pub(in crate::scene) fn cone(radius: f32, height: f32, segments: u32) -> Mesh {
     let mut positions = vec![Vec3::ZERO, Vec3::new(0.0, height, 0.0)];
     for s in 0..segments {
         let a = TAU * s as f32 / segments as f32;

@@ -35,7 +35,7 @@ use surface::{Managed, Rank, Status, TouchVolume};
 
 use std::collections::{HashMap, VecDeque};
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use super::quadtree::{Aabb, SurfaceIndex};
 use super::queue::Imprint;
@@ -262,6 +262,25 @@ impl Planner {
         self.zone_members[zone].push(index);
         self.index_dirty = true;
         Ok(ManagedId(index))
+    }
+
+    /// Lay a surface's touch volume and bounds on its ground: `range` is the lowest and the
+    /// highest base of its ground field (local metres, [`crate::GroundField::range`]; `(0, 0)`
+    /// flat), so the volume runs from the lowest base to the highest base plus the frustum.
+    pub fn set_ground_range(&mut self, id: ManagedId, range: (f32, f32)) -> Result<()> {
+        let desc = self.get(id)?.desc.clone();
+        let i = id.0 as usize;
+        let (lo, hi) = range;
+        let top = desc.snow_depth + self.config.capture.ankle_height;
+        let zone = self.volumes[i].zone;
+        // The volume's test starts at local y = 0: shift the frame down to the lowest base.
+        let to_local = Mat4::from_translation(Vec3::new(0.0, -lo, 0.0)) * desc.world_to_local();
+        self.volumes[i] = TouchVolume::new(to_local, desc.size * 0.5, hi - lo + top, zone);
+        let b = &mut self.status[i].bounds;
+        b.min.y = desc.center.y + lo;
+        b.max.y = desc.center.y + hi + top;
+        self.index_dirty = true;
+        Ok(())
     }
 
     fn get(&self, id: ManagedId) -> Result<&Managed> {

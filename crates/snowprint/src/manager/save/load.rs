@@ -6,6 +6,8 @@ use super::SaveFile;
 use super::parse::one_line;
 use crate::error::{Result, SnowError};
 use crate::gpu::GpuContext;
+use crate::ground::GroundField;
+use crate::manager::ground::ManagedGround;
 use crate::manager::pages::Page;
 use crate::manager::planner::Planner;
 use crate::manager::{ManagedMesh, SnowManager};
@@ -151,6 +153,31 @@ impl SnowManager {
                     "surface {i} holds a heightmap but the save has none for it"
                 )));
             }
+        }
+        m.grounds = vec![None; m.planner.len()];
+        for g in file.grounds {
+            let id = crate::manager::ManagedId(g.index);
+            let desc = m.planner.surface(id)?.clone();
+            if m.grounds[g.index as usize].is_some() {
+                return Err(SnowError::SaveContent(format!(
+                    "surface {:?} has two grounds",
+                    desc.name
+                )));
+            }
+            let field = GroundField::build(
+                desc.layout(),
+                desc.size,
+                g.heights,
+                desc.snow_depth,
+                g.slope,
+            );
+            m.lay_ground(
+                id,
+                Some(ManagedGround {
+                    field,
+                    slope: g.slope,
+                }),
+            )?;
         }
         Ok(m)
     }

@@ -10,7 +10,10 @@
 //! (the planner's state: every surface's description, zone, queue, clocks and slot; JSON), `MESH`
 //! (the manager's meshes and the world meshes queued imprints name; binary), then one `SURF` per
 //! surface that holds a heightmap, resident or paged (binary: the slot's words and the
-//! replenishment carry). Reading checks everything before anything is built: a corrupt,
+//! replenishment carry), then (from version 2) one `GRND` per surface on ground that is not flat
+//! (binary: its ground height at every texel and its slope rule; the field is rebuilt from them
+//! as [`crate::GroundField::build`] built it). Version 1 files, which have no `GRND`, still read.
+//! Reading checks everything before anything is built: a corrupt,
 //! truncated, foreign or newer file is one
 //! [`SnowError::SaveFile`](crate::SnowError::SaveFile) sentence.
 
@@ -28,7 +31,7 @@ mod write;
 /// The first eight bytes of every save.
 pub(crate) const MAGIC: [u8; 8] = *b"SNOWSAVE";
 /// The format version this build writes and the newest it reads.
-pub(crate) const VERSION: u32 = 1;
+pub(crate) const VERSION: u32 = 2;
 /// Most sections a save may have (a section per surface, plus three).
 pub(crate) const MAX_SECTIONS: u32 = 1 << 20;
 /// Most bytes a section may expand to (a 512^2 surface at 32 bits with normals is 3 MiB; the
@@ -66,6 +69,19 @@ pub struct SaveFile {
     pub(crate) meshes: SavedMeshes,
     /// The heightmaps held, by managed surface index.
     pub surfaces: Vec<SavedSurface>,
+    /// The grounds that are not flat, by managed surface index.
+    pub grounds: Vec<SavedGround>,
+}
+
+/// One surface's ground in a save: its height at every texel and the slope rule.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SavedGround {
+    /// Managed surface index.
+    pub index: u32,
+    /// The ground's height at each texel centre of the surface's heightmap, row after row.
+    pub heights: Vec<f32>,
+    /// How much snow its slopes hold.
+    pub slope: crate::SlopeRule,
 }
 
 /// One surface's heightmap in a save.

@@ -4,7 +4,7 @@ use super::bytes::{Reader, read_mesh, read_string};
 use super::config::SavedConfig;
 use super::{
     CODEC_LZ4, CODEC_RAW, HEADER, MAGIC, MAX_SECTION_BYTES, MAX_SECTIONS, SECTION_HEADER, SaveFile,
-    SavedMeshes, SavedSurface, Section, VERSION,
+    SavedGround, SavedMeshes, SavedSurface, Section, VERSION,
 };
 use crate::manager::ManagerConfig;
 use crate::manager::planner::PlannerState;
@@ -103,12 +103,17 @@ impl SaveFile {
         }
         r.done("the file")?;
         let tags: Vec<&[u8; 4]> = sections.iter().map(|s| &s.tag).collect();
+        let heightmaps = 3 + tags[3..].iter().take_while(|t| **t == b"SURF").count();
         if tags[0] != b"CONF"
             || tags[1] != b"PLAN"
             || tags[2] != b"MESH"
-            || tags[3..].iter().any(|t| *t != b"SURF")
+            || tags[heightmaps..].iter().any(|t| *t != b"GRND")
+            || (version < 2 && heightmaps < tags.len())
         {
-            return Err("its sections are not CONF, PLAN, MESH and SURF in that order".into());
+            return Err(
+                "its sections are not CONF, PLAN, MESH, SURF and (from version 2) GRND in that order"
+                    .into(),
+            );
         }
         let saved: SavedConfig = serde_json::from_slice(&sections[0].data)
             .map_err(|e| format!("its settings (CONF) do not read: {e}"))?;
@@ -120,11 +125,15 @@ impl SaveFile {
         let meshes =
             read_meshes(&sections[2].data).map_err(|e| format!("its meshes (MESH): {e}"))?;
         let mut surfaces = Vec::new();
-        for s in &sections[3..] {
+        for s in &sections[3..heightmaps] {
             surfaces.push(
                 read_surface(&s.data, &config, &plan)
                     .map_err(|e| format!("a heightmap (SURF): {e}"))?,
             );
+        }
+        let mut grounds = Vec::new();
+        for s in &sections[heightmaps..] {
+            grounds.push(read_ground(&s.data, &plan).map_err(|e| format!("a ground (GRND): {e}"))?);
         }
         Ok(Self {
             version,
@@ -133,6 +142,7 @@ impl SaveFile {
             plan,
             meshes,
             surfaces,
+            grounds,
         })
     }
 
@@ -239,6 +249,59 @@ pub(super) fn read_surface(
             carry,
             words,
         },
+    })
+}
+
+/// A `GRND` section: checked against its surface's heightmap size, its heights finite, its rule
+/// valid.
+pub(super) fn read_ground(
+    data: &[u8],
+    plan: &PlannerState,
+) -> std::result::Result<SavedGround, String> {
+    let mut r = Reader::new(data);
+    let index = r.u32("its surface index")?;
+    let width = r.u32("its width")?;
+    let height = r.u32("its height")?;
+    let slope = crate::SlopeRule {
+        full_degrees: r.f32("its slope rule")?,
+        bare_degrees: r.f32("its slope rule")?,
+    };
+    let n = r.count(4, "its heights")?;
+    let heights: Vec<f32> = r
+        .take(n * 4, "its heights")?
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    r.done("a ground")?;
+    let desc = &plan
+        .surfaces
+        .get(index as usize)
+        .ok_or_else(|| {
+            format!(
+                "it names surface {index}, the save has {}",
+                plan.surfaces.len()
+            )
+        })?
+        .desc;
+    let layout = desc.layout();
+    if (width, height) != (layout.width, layout.height) || n as u64 != width as u64 * height as u64
+    {
+        return Err(format!(
+            "surface {:?}'s ground is {width} x {height} texels with {n} heights, its heightmap {} x {}",
+            desc.name, layout.width, layout.height
+        ));
+    }
+    if heights.iter().any(|h| !h.is_finite()) {
+        return Err(format!(
+            "surface {:?}'s ground has a height that is not finite",
+            desc.name
+        ));
+    }
+    slope.validate(&desc.name).map_err(|e| e.to_string())?;
+    Ok(SavedGround {
+        index,
+        heights,
+        slope,
     })
 }
 

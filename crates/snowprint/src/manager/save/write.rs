@@ -64,7 +64,13 @@ impl SnowManager {
         let mut out = Vec::new();
         out.extend_from_slice(&MAGIC);
         put_u32(&mut out, VERSION);
-        put_u32(&mut out, 3 + surfaces.len() as u32);
+        let grounds: Vec<(usize, &crate::manager::ground::ManagedGround)> = self
+            .grounds
+            .iter()
+            .enumerate()
+            .filter_map(|(i, g)| g.as_ref().map(|g| (i, g)))
+            .collect();
+        put_u32(&mut out, (3 + surfaces.len() + grounds.len()) as u32);
         let crc = crc32fast::hash(&out[..16]);
         put_u32(&mut out, crc);
         section(&mut out, b"CONF", &conf);
@@ -80,6 +86,17 @@ impl SnowManager {
             put_u64(&mut b, s.words.len() as u64);
             b.extend_from_slice(bytemuck::cast_slice(&s.words));
             section(&mut out, b"SURF", &b);
+        }
+        for (i, g) in grounds {
+            let mut b = Vec::with_capacity(28 + g.field.ground.len() * 4);
+            put_u32(&mut b, i as u32);
+            put_u32(&mut b, g.field.width);
+            put_u32(&mut b, g.field.height);
+            b.extend_from_slice(&g.slope.full_degrees.to_le_bytes());
+            b.extend_from_slice(&g.slope.bare_degrees.to_le_bytes());
+            put_u64(&mut b, g.field.ground.len() as u64);
+            b.extend_from_slice(bytemuck::cast_slice(&g.field.ground));
+            section(&mut out, b"GRND", &b);
         }
         Ok(out)
     }

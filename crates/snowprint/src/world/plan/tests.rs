@@ -206,11 +206,14 @@ proptest! {
     }
 
     /// Captured surfaces are placed inside the atlas, in its batches, never overlapping, each
-    /// exactly once, with the capture buffer and tile flags laid out one after the other.
+    /// exactly once, with the capture buffer and tile flags laid out one after the other. On the
+    /// compute path (spheres alone) none takes a place in the atlas, and each view's rectangle of
+    /// tiles lies inside its surface.
     #[test]
     fn atlas_batches_never_overlap_and_cover_every_captured_surface(
         sizes in prop::collection::vec((1.0f32..20.0, 1.0f32..20.0, any::<bool>()), 1..24),
         atlas_side in prop::sample::select(vec![64u32, 256, 512, 1024]),
+        raster in any::<bool>(),
     ) {
         let descs: Vec<SurfaceDesc> = sizes
             .iter()
@@ -230,6 +233,9 @@ proptest! {
             .collect();
         let mut s = settings();
         s.atlas_side = atlas_side;
+        if raster {
+            s.capture_path = capture::CapturePath::Raster;
+        }
         // The world caps heightmaps at the atlas side.
         let mut input = inputs(&descs, &deformers, 0.1);
         for p in &mut input {
@@ -243,7 +249,32 @@ proptest! {
         prop_assert_eq!(seen, touched);
         prop_assert!(c.atlas_side <= atlas_side.max(64));
         let (mut texels, mut flags) = (0, 0);
+        prop_assert_eq!(c.batches == 0, !raster || c.surfaces.is_empty());
         for (k, a) in c.surfaces.iter().enumerate() {
+            let r = &plan.accumulate.records[a.record as usize];
+            prop_assert_eq!(a.compute, !raster);
+            if a.compute {
+                let v = &c.views[k];
+                prop_assert_eq!(r.batch, capture::COMPUTED);
+                prop_assert!(v.prims[1] > 0);
+                // Its work: at least the tile under the sphere's centre, each tile inside it
+                // and listed once.
+                let mine: Vec<u32> =
+                    c.work.iter().filter(|e| e[0] == k as u32).map(|e| e[1]).collect();
+                prop_assert!(!mine.is_empty());
+                let mut unique = mine.clone();
+                unique.sort();
+                unique.dedup();
+                prop_assert_eq!(unique.len(), mine.len());
+                for t in mine {
+                    prop_assert!((t & 0xffff) < v.tiles_x);
+                    prop_assert!((t >> 16) * TILE_SIDE < a.height);
+                }
+                prop_assert_eq!((r.scratch, r.tiles), (texels, flags));
+                texels += r.width * r.height;
+                flags += r.tile_count();
+                continue;
+            }
             prop_assert!(a.batch < c.batches);
             prop_assert!(a.x + a.width <= c.atlas_side && a.y + a.height <= c.atlas_side);
             let r = &plan.accumulate.records[a.record as usize];

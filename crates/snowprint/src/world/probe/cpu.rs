@@ -10,12 +10,8 @@ use crate::pool::Precision;
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 
 /// Whether a point is over a surface: inside its rectangle and not below its ground (1 cm of
-/// slack). Returns the surface's ground height.
-pub(crate) fn over(desc: &SurfaceDesc, point: Vec3) -> Option<f32> {
-    over_on(desc, None, point)
-}
-
-/// [`over`] on a surface that may lie on a ground field: its ground under the point's texel.
+/// slack): the surface's centre height, or on a ground field its ground under the point's texel.
+/// Returns that ground height.
 pub(crate) fn over_on(desc: &SurfaceDesc, field: Option<&GroundField>, point: Vec3) -> Option<f32> {
     let ground = match field {
         None => desc.center.y,
@@ -96,16 +92,16 @@ pub(super) fn query(
 
 /// The sample `probe.wgsl` gives for a point over a surface whose channels (depression, then
 /// displaced, row-major, at `precision`) are given: the same texel, the same central differences,
-/// in the same f32 arithmetic. `surface` is what the sample names.
+/// in the same f32 arithmetic. `surface` is what the sample names; `field` the surface's ground.
 pub(crate) fn sample(
     desc: &SurfaceDesc,
     layout: &SurfaceLayout,
     precision: Precision,
     channels: (&[u32], &[u32]),
-    surface: Option<SurfaceId>,
+    (surface, field): (Option<SurfaceId>, Option<&GroundField>),
     point: Vec3,
 ) -> ProbeSample {
-    let (q, info) = query(desc, layout, precision, 0, surface, None, point);
+    let (q, info) = query(desc, layout, precision, 0, surface, field, point);
     let (w, h) = (q.width, q.height);
     let (x, y) = (q.texel & 0xffff, q.texel >> 16);
     let at = |x: u32, y: u32| (y * w + x) as usize;
@@ -163,6 +159,25 @@ pub(crate) fn untouched(desc: &SurfaceDesc, point: Vec3) -> ProbeSample {
         displaced_m: 0.0,
         normal: desc.rotation() * Vec3::Y,
     }
+}
+
+/// [`untouched`] on a surface that may lie on a ground field: what the probe pass reads over
+/// texels that were never pressed (the ground's bare depth and slope included).
+pub(crate) fn untouched_on(
+    desc: &SurfaceDesc,
+    field: Option<&GroundField>,
+    point: Vec3,
+) -> ProbeSample {
+    let Some(f) = field else {
+        return untouched(desc, point);
+    };
+    let layout = SurfaceLayout {
+        width: f.width,
+        height: f.height,
+    };
+    // The channels' maximum does not matter: both are 0.
+    let (_, info) = query(desc, &layout, Precision::Bits16, 0, None, field, point);
+    decode_over(&info, [0, 0, 0f32.to_bits(), 0f32.to_bits()])
 }
 
 /// The sample of a point over no surface.
