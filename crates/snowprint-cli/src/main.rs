@@ -14,6 +14,7 @@ mod play;
 mod progress;
 mod report;
 mod simulate;
+mod terrain;
 
 use std::process::ExitCode;
 

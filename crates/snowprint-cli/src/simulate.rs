@@ -57,6 +57,13 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             camera.line
         );
     }
+    if managed && let Some(t) = scene.terrains.first() {
+        return Err(format!(
+            "{}:{}: a [[terrain]] runs only without the surface manager for now; remove [budget], --report, --save and --load, or the terrain",
+            scene.path.display(),
+            t.line
+        ));
+    }
     let outputs = Outputs::prepare(&scene, &args.dump, args.report.as_deref())?;
     if let Some(save) = &args.save {
         crate::output::check_file_target(save, "--save")?;
@@ -88,6 +95,7 @@ impl Outputs {
                 set.check_name(&format!("{}.{ext}", s.name))?;
             }
         }
+        crate::terrain::check_names(scene, &set)?;
         let report = match report {
             None => None,
             Some(path) => {
@@ -229,7 +237,8 @@ pub fn simulate(
             let l = s.layout();
             snowprint::PoolFormat::default().slot_bytes(l.width, l.height)
         })
-        .sum();
+        .sum::<u64>()
+        + crate::terrain::pool_bytes(scene, snowprint::PoolFormat::default());
     let mut world = SnowWorld::new(
         &ctx,
         WorldConfig {
@@ -249,6 +258,7 @@ pub fn simulate(
         }
         ids.push(id);
     }
+    let mut windows = crate::terrain::Windows::new(&mut world, scene)?;
     let shapes = scene_shapes(scene, |d, mesh| match &d.animation {
         Some(a) => world.add_skinned_mesh(&d.name, &a.skinned),
         None => world.add_mesh(&d.name, mesh),
@@ -274,8 +284,9 @@ pub fn simulate(
                 _ => None,
             })
             .collect();
-        let stepped = world
-            .animate_meshes(&animations)
+        let stepped = windows
+            .follow(&mut world, scene, t)
+            .and_then(|()| world.animate_meshes(&animations))
             .and_then(|()| world.step(dt, &deformers));
         if let Err(e) = stepped {
             failure = Some(frame_error(scene, f, dt, &e));
@@ -292,11 +303,15 @@ pub fn simulate(
         dt,
     };
     let dump_dir = outputs.dump.dir().to_owned();
-    let written = ids
-        .iter()
-        .map(|&id| world.read_heightmap(id).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()
-        .and_then(|maps| write_dump(scene, &maps, &done, outputs.dump));
+    let mut set = outputs.dump;
+    let written = windows
+        .dump(&mut world, scene, &mut set)
+        .and_then(|()| {
+            ids.iter()
+                .map(|&id| world.read_heightmap(id).map_err(|e| e.to_string()))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .and_then(|maps| write_dump(scene, &maps, &done, set));
     match failure {
         None => written,
         Some(f) => Err(f + &partial_note(&done, &dump_dir, written)),

@@ -97,6 +97,72 @@ fn walker_leaves_one_print_per_step() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// `scenes/valley_window.toml`: a ball ploughs 12 m out of the terrain's near window and back; the
+/// near level's dump holds both trenches (the outbound one paged out and back in), the far level's
+/// the loop; a terrain under the manager is refused in one sentence.
+#[test]
+fn a_terrain_window_follows_the_ball_and_dumps_its_levels() {
+    let _serial = serial();
+    let out = scratch("valley");
+    let status = snowprint()
+        .args(["simulate", "--scene"])
+        .arg(repo().join("scenes/valley_window.toml"))
+        .args(["--frames", "540", "--dump"])
+        .arg(&out)
+        .status()
+        .expect("run snowprint");
+    assert!(status.success());
+    let near = snowprint::Heightmap::load_png(&out.join("valley.0.png")).expect("valley.0.png");
+    let far = snowprint::Heightmap::load_png(&out.join("valley.1.png")).expect("valley.1.png");
+    assert_eq!((near.width, far.width), (128, 128));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("valley.0.json")).unwrap()).unwrap();
+    // Back at x = 0, z = 2: the near window's first texel is (-64, -24) of 5 cm.
+    assert_eq!(meta["origin_texel"], serde_json::json!([-64, -24]));
+    assert!(meta["scroll"]["texels_paged_in"].as_u64().unwrap() > 0);
+    // Column 100 (x = 1.8 m): the outbound trench at z = 0 (row 24) and the return at z = 2 (row
+    // 64), untouched between them.
+    let at = |x: u32, y: u32| near.depression[(y * 128 + x) as usize];
+    assert!(
+        at(100, 24) > 32768 && at(100, 64) > 32768,
+        "{} {}",
+        at(100, 24),
+        at(100, 64)
+    );
+    assert_eq!(at(100, 44), 0);
+    // The far level (40 cm, first texel (-64, -59)) holds the outbound trench at x = 6 m, which
+    // the near window paged out long ago: column 79, row 59 (z = 0 .. 0.4).
+    let far_meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("valley.1.json")).unwrap()).unwrap();
+    let o = &far_meta["origin_texel"];
+    let (fx, fz) = (
+        (15 - o[0].as_i64().unwrap()) as u32,
+        (-o[1].as_i64().unwrap()) as u32,
+    );
+    let v = far.depression[(fz.saturating_sub(1) * 128 + fx) as usize]
+        .max(far.depression[(fz * 128 + fx) as usize]);
+    assert!(v > 16384, "far level at x = 6 m: {v}");
+    let _ = std::fs::remove_dir_all(&out);
+
+    let managed = scratch("valley-managed");
+    let result = snowprint()
+        .args(["simulate", "--scene"])
+        .arg(repo().join("scenes/valley_window.toml"))
+        .args(["--frames", "2", "--report"])
+        .arg(managed.join("r.json"))
+        .args(["--dump"])
+        .arg(&managed)
+        .output()
+        .expect("run snowprint");
+    assert!(!result.status.success());
+    let err = String::from_utf8_lossy(&result.stderr);
+    assert!(
+        err.contains("valley_window.toml:12: a [[terrain]] runs only without the surface manager"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&managed);
+}
+
 #[test]
 fn bad_scene_is_one_sentence_and_leaves_no_output() {
     let _serial = serial();

@@ -79,6 +79,26 @@ pub enum SnowError {
         /// What would be accepted.
         expected: &'static str,
     },
+    /// A terrain window's description or focus is not usable (`crate::Terrain`).
+    #[error("terrain {name:?}: {what} is {value}, but it must be {expected}")]
+    InvalidTerrain {
+        /// Name of the terrain.
+        name: String,
+        /// Which field (a level's names its index).
+        what: String,
+        /// The offending value, printed.
+        value: String,
+        /// What would be accepted.
+        expected: String,
+    },
+    /// A window level was moved while a frame was encoded and not yet reported submitted.
+    #[error(
+        "terrain {name:?} cannot scroll while a snow frame is encoded and not reported submitted: call SnowWorld::submitted first"
+    )]
+    WindowBusy {
+        /// Name of the terrain.
+        name: String,
+    },
     /// A deformer description is not usable.
     #[error("deformer {name:?}: {what} is {value}, but it must be {expected}")]
     InvalidDeformer {

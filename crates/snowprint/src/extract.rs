@@ -29,6 +29,13 @@ pub struct SurfaceView<'a> {
     /// Lowest base of its snow columns and highest ground, local metres ((0, 0) on flat ground):
     /// the snow lies between the first and the second plus the snow depth.
     pub ground_range: (f32, f32),
+    /// Its toroidal storage offsets (`ox | oy << 16`, 0 for an ordinary surface): logical texel
+    /// (x, y) lives at ((x + ox) mod width, (y + oy) mod height) (`pool/texel.wgsl`).
+    pub wrap: u32,
+    /// A rectangle of its local xz `(x0, z0, x1, z1)` that a finer level of the same terrain
+    /// window draws instead (`crate::Terrain`); renderers leave it out. `None` for any other
+    /// surface.
+    pub hole: Option<[f32; 4]>,
 }
 
 /// Everything of a world a frame reads: the pool buffer, its format, every live surface with its
@@ -82,6 +89,8 @@ impl SnowWorld {
                     precision: pool_format.precision,
                     ground,
                     ground_range: (low, high),
+                    wrap: self.wrap(id).ok()?,
+                    hole: self.hole(id).ok()?,
                 })
             })
             .collect();

@@ -60,6 +60,7 @@ mod spray;
 mod surface;
 mod view;
 pub mod wgsl;
+mod window;
 mod world;
 
 pub use glam;
@@ -87,6 +88,7 @@ pub use spray::{
 };
 pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, SurfaceLayout};
 pub use view::{Camera, GroundMaterial};
+pub use window::{LevelDesc, ScrollStats, Terrain, TerrainDesc, TerrainGround};
 pub use world::{
     CaptureConfig, CaptureMode, CapturePath, FrameStats, MemoryReport, MeshAnimation, PassMode,
     PendingFrame, SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,

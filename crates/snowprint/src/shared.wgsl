@@ -21,6 +21,7 @@ struct SurfaceRecord {
     texel_x: f32,         // metres
     texel_z: f32,         // metres
     tiles: u32,           // first of the surface's 16x16 tile flags (set where the capture wrote)
+    wrap: u32,            // toroidal storage offsets, ox | oy << 16 (pool/texel.wgsl); 0: none
 }
 
 // Bits a channel of the pool's heightmaps (8, 16 or 32): set when the world compiles its passes.

@@ -110,6 +110,8 @@ fn heightfield_case(slope: Option<Vec2>) {
         texel_z: texel.y,
         // The field starts 3 texels into the ground buffer, as a world's second surface might.
         ground: slope.map_or(snowprint::low_level::ground::NO_GROUND, |_| 3),
+        wrap: 0,
+        _pad: [0; 3],
         light: [light.x, light.y, light.z, 0.0],
     };
     let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {

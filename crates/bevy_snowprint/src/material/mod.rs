@@ -67,7 +67,7 @@ pub(crate) fn build(app: &mut App) {
 /// The buffers a surface's material reads, kept on its entity for the render world.
 #[derive(Component, Clone, Debug)]
 pub struct SnowSurfaceBuffers {
-    /// `SurfaceUniform` (320 bytes).
+    /// `SurfaceUniform` (336 bytes).
     pub surface: Handle<ShaderBuffer>,
     /// The heights region, as many bytes as the surface can take at any precision.
     pub heights: Handle<ShaderBuffer>,

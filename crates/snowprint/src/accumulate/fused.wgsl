@@ -108,10 +108,10 @@ fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, lid: u
     if per == 2u && x + 1u < rec.width {
         b = merged(rec, has_capture, x + 1u, y, blurred[uy * u32(SIDE) + ux + 1u]);
     }
-    pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, x, y, a, b);
+    pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y, a, b);
 }
 
 fn merged(rec: SurfaceRecord, has_capture: bool, x: u32, y: u32, b: f32) -> vec2<u32> {
-    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, x, y);
+    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y);
     return merge_channels(old, b, has_capture, rec.replenish_units);
 }

@@ -21,7 +21,7 @@ fn merged(rec: SurfaceRecord, x: u32, y: u32) -> vec2<u32> {
     if has_capture {
         blurred = scratch[rec.scratch + y * rec.width + x];
     }
-    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, x, y);
+    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y);
     return merge_channels(old, blurred, has_capture, rec.replenish_units);
 }
 
@@ -37,5 +37,5 @@ fn merge(@builtin(global_invocation_id) gid: vec3<u32>) {
     if unit_texels(PRECISION) == 2u {
         b = merged(rec, x + 1u, gid.y);
     }
-    pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, x, gid.y, a, b);
+    pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, gid.y, a, b);
 }

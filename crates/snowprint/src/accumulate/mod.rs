@@ -170,6 +170,7 @@ mod tests {
             "texel_x",
             "texel_z",
             "tiles",
+            "wrap",
         ];
         for (i, (name, offset)) in names.iter().enumerate() {
             assert_eq!(name, expect[i]);

@@ -13,7 +13,7 @@
 fn height_at(rec: SurfaceRecord, x: i32, y: i32) -> f32 {
     let cx = u32(clamp(x, 0, i32(rec.width) - 1));
     let cy = u32(clamp(y, 0, i32(rec.height) - 1));
-    return snow_height(rec, pool_texel(PRECISION, rec.heights, rec.width, rec.height, cx, cy).x);
+    return snow_height(rec, pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, cx, cy).x);
 }
 
 @compute @workgroup_size(WORKGROUP, WORKGROUP, 1)
@@ -24,7 +24,9 @@ fn normals(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = i32(gid.x);
     let y = i32(gid.y);
-    pool[rec.normals + gid.y * rec.width + gid.x] = packed_normal(
+    // The normals region is stored wrapped like the heights (pool/texel.wgsl).
+    let p = pool_wrapped(rec.wrap, rec.width, rec.height, gid.x, gid.y);
+    pool[rec.normals + p.y * rec.width + p.x] = packed_normal(
         rec,
         height_at(rec, x - 1, y),
         height_at(rec, x + 1, y),

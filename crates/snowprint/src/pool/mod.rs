@@ -261,6 +261,8 @@ pub struct SurfaceRecord {
     pub texel_z: f32,
     /// First of the surface's tile flags written by the capture (see `capture.wgsl`).
     pub tiles: u32,
+    /// Toroidal storage offsets, `ox | oy << 16` ([`wrapped`]); 0 for an ordinary surface.
+    pub wrap: u32,
 }
 
 impl SurfaceRecord {
@@ -268,6 +270,35 @@ impl SurfaceRecord {
     pub fn tile_count(&self) -> u32 {
         self.width.div_ceil(TILE_SIDE) * self.height.div_ceil(TILE_SIDE)
     }
+}
+
+/// Toroidal storage offsets `(ox, oy)` packed as the records carry them: `ox | oy << 16`.
+pub fn pack_wrap(ox: u32, oy: u32) -> u32 {
+    (ox & 0xffff) | (oy << 16)
+}
+
+/// Where logical texel `(x, y)` of a `width x height` heightmap stored with the packed offsets
+/// `wrap` ([`pack_wrap`]) lives in its slot: `((x + ox) mod width, (y + oy) mod height)`. The CPU
+/// side of `pool_wrapped` in `pool/texel.wgsl`, written independently of it (an ordinary surface
+/// has `wrap` 0: the identity).
+pub fn wrapped(wrap: u32, width: u32, height: u32, x: u32, y: u32) -> (u32, u32) {
+    let (ox, oy) = (wrap & 0xffff, wrap >> 16);
+    ((x + ox) % width, (y + oy) % height)
+}
+
+/// Channels stored wrapped (physical, row-major) put back in logical order (see [`wrapped`]).
+pub fn unwrap_channel(wrap: u32, width: u32, height: u32, stored: &[u32]) -> Vec<u32> {
+    if wrap == 0 {
+        return stored.to_vec();
+    }
+    let mut out = Vec::with_capacity(stored.len());
+    for y in 0..height {
+        for x in 0..width {
+            let (px, py) = wrapped(wrap, width, height, x, y);
+            out.push(stored[(py * width + px) as usize]);
+        }
+    }
+    out
 }
 
 /// `batch` of a record whose surface had nothing to capture this update.
@@ -414,8 +445,8 @@ mod tests {
     use proptest::prelude::*;
 
     #[test]
-    fn record_is_64_bytes() {
-        assert_eq!(std::mem::size_of::<SurfaceRecord>(), 64);
+    fn record_is_68_bytes() {
+        assert_eq!(std::mem::size_of::<SurfaceRecord>(), 68);
     }
 
     #[test]

@@ -5,12 +5,29 @@
 //            (depression in the low byte, displaced in the high byte), the even texel low.
 //   16 bits: a word a texel, depression low 16 bits, displaced high 16.
 //   32 bits: two planes of width x height words: depressions, then displaced.
+// Toroidal storage (a terrain window's levels, `window/`): logical texel (x, y), the space every
+// pass computes in, lives at ((x + ox) mod width, (y + oy) mod height) of the region, `wrap` =
+// ox | oy << 16 (both below the sides; 0 for every ordinary surface, where the mapping is the
+// identity). This file is the ONE place the mapping is made on the GPU: every reader and writer of
+// the pool goes through `pool_texel`/`pool_store_unit`. At 8 bits ox is even (a unit's two texels
+// stay in one word). CPU reference: pool::wrapped.
 // CPU reference: pool::PoolFormat::{encode, decode}.
 
 // import channels
 
-// (depression, displaced) of texel (x, y) of the heights region at word `base`.
-fn pool_texel(bits: u32, base: u32, width: u32, height: u32, x: u32, y: u32) -> vec2<u32> {
+// Where logical texel (x, y) is stored: see above.
+fn pool_wrapped(wrap: u32, width: u32, height: u32, x: u32, y: u32) -> vec2<u32> {
+    if wrap == 0u {
+        return vec2<u32>(x, y);
+    }
+    return vec2<u32>((x + (wrap & 0xffffu)) % width, (y + (wrap >> 16u)) % height);
+}
+
+// (depression, displaced) of logical texel (lx, ly) of the heights region at word `base`.
+fn pool_texel(bits: u32, base: u32, width: u32, height: u32, wrap: u32, lx: u32, ly: u32) -> vec2<u32> {
+    let p = pool_wrapped(wrap, width, height, lx, ly);
+    let x = p.x;
+    let y = p.y;
     if bits == 8u {
         let word = pool[base + y * ((width + 1u) / 2u) + x / 2u];
         let v = (word >> (16u * (x & 1u))) & 0xffffu;
@@ -25,6 +42,6 @@ fn pool_texel(bits: u32, base: u32, width: u32, height: u32, x: u32, y: u32) -> 
 }
 
 // Channels as fractions of the snow depth.
-fn pool_fractions(bits: u32, base: u32, width: u32, height: u32, x: u32, y: u32) -> vec2<f32> {
-    return vec2<f32>(pool_texel(bits, base, width, height, x, y)) / f32(channel_max(bits));
+fn pool_fractions(bits: u32, base: u32, width: u32, height: u32, wrap: u32, x: u32, y: u32) -> vec2<f32> {
+    return vec2<f32>(pool_texel(bits, base, width, height, wrap, x, y)) / f32(channel_max(bits));
 }

@@ -42,6 +42,8 @@ pub struct RelaxRecord {
     pub dispatch_steps: u32,
     /// First word of the surface's tile flags ([`RelaxPlan::tile_words`]).
     pub tiles: u32,
+    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    pub wrap: u32,
 }
 
 /// Where a surface of a slumping material may still move, kept by the world between updates.

@@ -42,6 +42,7 @@ struct RelaxRecord {
     rect_height: u32,
     dispatch_steps: u32, // steps each dispatch of `relax_from_pool` and `relax_to_pool` takes
     tiles: u32,       // first word of the record's tile flags in `relax_tiles`
+    wrap: u32,        // toroidal storage offsets (pool/texel.wgsl)
 }
 
 @group(0) @binding(0) var<storage, read> relax_records: array<RelaxRecord>;
@@ -107,7 +108,7 @@ fn scratch_index(r: RelaxRecord, p: vec2<i32>) -> u32 {
 }
 
 fn top_in_pool(r: RelaxRecord, p: vec2<i32>) -> u32 {
-    return channel_max(PRECISION) - pool_texel(PRECISION, r.heights, r.width, r.height, u32(p.x), u32(p.y)).x;
+    return channel_max(PRECISION) - pool_texel(PRECISION, r.heights, r.width, r.height, r.wrap, u32(p.x), u32(p.y)).x;
 }
 
 // The workgroup's first texel: its tile's corner (at 8 bits, on an even column, so that the
@@ -162,7 +163,7 @@ fn settled(r: RelaxRecord, origin: vec2<i32>, at: u32, p: vec2<i32>) -> vec2<u32
     if p.x >= i32(r.width) {
         return vec2<u32>(0u); // the padding texel of an odd 8-bit row
     }
-    let old = pool_texel(PRECISION, r.heights, r.width, r.height, u32(p.x), u32(p.y));
+    let old = pool_texel(PRECISION, r.heights, r.width, r.height, r.wrap, u32(p.x), u32(p.y));
     if !in_rect(r, p) {
         return old;
     }
@@ -236,7 +237,7 @@ fn relax_tile(wg: vec3<u32>, lid: u32, from_scratch: bool, to_pool: bool, steps:
             if unit == 2u {
                 b = settled(r, origin, at, p + vec2<i32>(1, 0));
             }
-            pool_store_unit(PRECISION, r.heights, r.width, r.height, u32(p.x), u32(p.y), a, b);
+            pool_store_unit(PRECISION, r.heights, r.width, r.height, r.wrap, u32(p.x), u32(p.y), a, b);
         }
     } else {
         for (var c = lid; c < RELAX_TILE * RELAX_TILE; c += RELAX_THREADS) {

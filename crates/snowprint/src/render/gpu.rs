@@ -134,9 +134,15 @@ pub struct SurfaceUniform {
     /// Highest untouched snow top, local metres (the snow depth on flat ground): the slab's top
     /// below the room for rims.
     pub terrain_top: f32,
-    /// Padding.
-    pub terrain_pad: f32,
+    /// The heights' toroidal storage offsets, `ox | oy << 16` ([`crate::SurfaceView::wrap`]).
+    pub wrap: u32,
+    /// A rectangle of the surface's local xz `(x0, z0, x1, z1)` it does not draw, because a finer
+    /// level of the same terrain window draws it (`crate::Terrain`); empty (`x1 < x0`) otherwise.
+    pub hole: [f32; 4],
 }
+
+/// `SurfaceUniform::hole` of a surface that draws all of itself.
+pub const NO_HOLE: [f32; 4] = [1.0, 1.0, -1.0, -1.0];
 
 /// Room for rims above the snow top that the relief and POM tiers raise their slab by, metres:
 /// the material's share of the pushed volume times the snow depth (a rim a whole depth high needs
@@ -231,7 +237,8 @@ impl SurfaceUniform {
             terrain: surface.ground,
             terrain_low: surface.ground_range.0,
             terrain_top: surface.ground_range.1 + desc.snow_depth,
-            terrain_pad: 0.0,
+            wrap: surface.wrap,
+            hole: surface.hole.unwrap_or(NO_HOLE),
         }
     }
 
@@ -276,8 +283,10 @@ pub struct ClassifyRecord {
     /// 1 when the surface lies on ground that is not flat (always the deformable material: the
     /// basic one draws a flat top), else 0.
     pub terrain: u32,
+    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    pub wrap: u32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
@@ -301,6 +310,10 @@ pub struct HeightfieldParams {
     /// First texel of the surface's ground field ([`crate::FrameView::ground_buffer`]), or
     /// [`crate::low_level::ground::NO_GROUND`] on flat ground.
     pub ground: u32,
+    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    pub wrap: u32,
+    /// Padding (three members, as in WGSL).
+    pub _pad: [u32; 3],
     /// Unit direction towards the moon in the surface's local frame; w unused.
     pub light: [f32; 4],
 }
@@ -492,6 +505,8 @@ mod tests {
                 "translucency",
                 std::mem::offset_of!(SurfaceUniform, translucency),
             ),
+            ("hole", std::mem::offset_of!(SurfaceUniform, hole)),
+            ("wrap", std::mem::offset_of!(SurfaceUniform, wrap)),
         ];
         for (name, offset) in offsets {
             let m = members
@@ -538,7 +553,8 @@ mod tests {
             terrain,
             terrain_low,
             terrain_top,
-            terrain_pad
+            wrap,
+            hole
         );
         for (source, name) in [
             (&engine, "snowprint_Surface"),

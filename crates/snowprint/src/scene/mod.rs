@@ -66,6 +66,47 @@ pub struct Scene {
     /// The ground of each surface (`ground` and the slope keys), in the order of `surfaces`; `None`
     /// on flat ground.
     pub grounds: Vec<Option<SceneGround>>,
+    /// The terrains whose window follows a focus (`[[terrain]]`), in file order.
+    pub terrains: Vec<SceneTerrain>,
+}
+
+/// A `[[terrain]]` of a scene: see `docs/SCENES.md`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneTerrain {
+    /// The terrain and its levels.
+    pub desc: crate::window::TerrainDesc,
+    /// What its window follows.
+    pub follow: TerrainFollow,
+    /// Line of its table in the scene file (for messages).
+    pub line: usize,
+}
+
+impl SceneTerrain {
+    /// Where its window is centred at time `t` of `scene`: the player deformer's position (else
+    /// the first deformer's, else the camera's target) or the camera's eye, else the origin.
+    pub fn focus(&self, scene: &Scene, t: f32) -> Vec3 {
+        let camera = scene.camera.as_ref();
+        match self.follow {
+            TerrainFollow::Player => scene
+                .deformers
+                .iter()
+                .find(|d| d.player)
+                .or(scene.deformers.first())
+                .map(|d| d.pose_at(t).position)
+                .or(camera.map(|c| c.target))
+                .unwrap_or(Vec3::ZERO),
+            TerrainFollow::Camera => camera.map_or(Vec3::ZERO, |c| c.at(t).eye),
+        }
+    }
+}
+
+/// What a scene's terrain window is centred on each frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TerrainFollow {
+    /// The deformer with `player = true` (else the first deformer; else the camera's target).
+    Player,
+    /// The camera's eye (else the origin).
+    Camera,
 }
 
 /// The ground a scene lays a surface on: see `docs/SCENES.md`.
@@ -443,6 +484,7 @@ mod tests {
             budget: None,
             camera: None,
             grounds: vec![],
+            terrains: vec![],
         };
         assert_eq!(scene.duration(), 0.0);
         let empty = deformer(vec![]);

@@ -26,6 +26,35 @@ pub(super) struct RawScene {
     pub camera: Option<Spanned<RawCamera>>,
     #[serde(default)]
     pub material: Vec<Spanned<RawMaterial>>,
+    #[serde(default)]
+    pub terrain: Vec<Spanned<RawTerrain>>,
+}
+
+/// One `[[terrain]]`: a snow layer whose window follows a focus (`crate::Terrain`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTerrain {
+    pub name: Option<Str>,
+    pub ground_height: Option<Num>,
+    pub snow_depth: Option<Num>,
+    pub replenish_rate: Option<Num>,
+    pub material: Option<Str>,
+    pub follow: Option<Str>,
+    pub levels: Option<Spanned<Vec<Spanned<RawLevel>>>>,
+    pub ground: Option<Str>,
+    pub ground_heights: Option<Nums>,
+    pub ground_grid: Option<Nums>,
+    pub ground_rect: Option<Nums>,
+    pub full_slope_degrees: Option<Num>,
+    pub bare_slope_degrees: Option<Num>,
+}
+
+/// One level of a `[[terrain]]`, inline (`levels = [{ ... }]`) or as `[[terrain.levels]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawLevel {
+    pub texels: Option<Nums>,
+    pub texel_size: Option<Num>,
 }
 
 /// One `[[material]]`: a preset with some keys changed.
@@ -138,9 +167,28 @@ pub(super) const TABLES: &[(&str, &[&str])] = &[
     (
         "at the top level",
         &[
-            "version", "capture", "surface", "deformer", "budget", "camera", "material",
+            "version", "capture", "surface", "deformer", "budget", "camera", "material", "terrain",
         ],
     ),
+    (
+        "in a [[terrain]] table",
+        &[
+            "name",
+            "ground_height",
+            "snow_depth",
+            "replenish_rate",
+            "material",
+            "follow",
+            "levels",
+            "ground",
+            "ground_heights",
+            "ground_grid",
+            "ground_rect",
+            "full_slope_degrees",
+            "bare_slope_degrees",
+        ],
+    ),
+    ("in a terrain level", &["texels", "texel_size"]),
     ("in [capture]", &["mode", "ankle_height", "mask_depth"]),
     (
         "in a [[material]] table",

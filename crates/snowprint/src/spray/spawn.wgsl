@@ -52,7 +52,7 @@ fn spawn(@builtin(global_invocation_id) gid: vec3<u32>) {
         l, depression(rec, ix, iy), r,
         depression(rec, ix - 1, iy + 1), f, depression(rec, ix + 1, iy + 1),
     );
-    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, x, y).x;
+    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y).x;
     let rep = rec.replenish_units;
     let depressed = max(old, rep) - rep;
     let captured = to_units(blurred);

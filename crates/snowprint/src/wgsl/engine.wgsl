@@ -42,7 +42,8 @@ struct snowprint_Surface {
     terrain: u32,           // first texel of the ground field (the renderer's), or 0xffffffff on flat ground
     terrain_low: f32,       // lowest base of the snow columns (0 on flat ground)
     terrain_top: f32,       // highest untouched snow top (the snow depth on flat ground)
-    terrain_pad: f32,
+    wrap: u32,              // toroidal storage offsets of the heights, ox | oy << 16 (0: none)
+    hole: vec4<f32>,        // local (x0, z0, x1, z1) a finer terrain window level draws instead
 }
 
 @group(0) @binding(0) var<storage, read> snowprint_pool: array<u32>;
@@ -51,8 +52,14 @@ struct snowprint_Surface {
 // src/pool/mod.rs: 8 bits two texels a word (16 bits each, depression low byte), 16 bits a word a
 // texel (depression low half), 32 bits two planes (depressions, then displaced).
 fn snowprint_texel_raw(s: snowprint_Surface, texel: vec2<u32>) -> vec2<u32> {
-    let x = min(texel.x, s.width - 1u);
-    let y = min(texel.y, s.height - 1u);
+    // A terrain window's level is stored wrapped: logical (x, y) at ((x + ox) mod width,
+    // (y + oy) mod height), as pool/texel.wgsl maps it (this module stands alone).
+    var x = min(texel.x, s.width - 1u);
+    var y = min(texel.y, s.height - 1u);
+    if s.wrap != 0u {
+        x = (x + (s.wrap & 0xffffu)) % s.width;
+        y = (y + (s.wrap >> 16u)) % s.height;
+    }
     if s.bits == 8u {
         let word = snowprint_pool[s.heights + y * s.row_words + x / 2u];
         let v = (word >> (16u * (x & 1u))) & 0xffffu;

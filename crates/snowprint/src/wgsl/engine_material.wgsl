@@ -16,7 +16,7 @@ fn snowprint_surface_of(s: SnowSurface) -> snowprint_Surface {
         s.ground, s.index, s.search, s.look, s.pattern,
         s.heights, s.row_words, s.bits, s.channel_max, s.width, s.height, s.texel_x, s.texel_z,
         s.albedo, s.disturbed, s.grain, s.translucency,
-        s.terrain, s.terrain_low, s.terrain_top, s.terrain_pad,
+        s.terrain, s.terrain_low, s.terrain_top, s.wrap, s.hole,
     );
 }
 

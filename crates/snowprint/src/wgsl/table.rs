@@ -37,6 +37,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("ground_raster", "ground/raster.wgsl", true),
     // Reading a surface's ground field (the capture and the renderer).
     ("ground_texel", "ground/texel.wgsl", false),
+    // A terrain's sliding window: strips paged between the pool and the CPU (`window/`).
+    ("window_strip", "window/strip.wgsl", true),
     // Gameplay probes: the pool under chosen points.
     ("probe", "world/probe/probe.wgsl", true),
     // The renderer.

@@ -354,6 +354,7 @@ impl SnowWorld {
                 desc: &s.desc,
                 layout: s.layout,
                 heights_word: s.slot.heights_word(),
+                wrap: s.wrap,
                 normals_word: s
                     .slot
                     .normals_word(&format, s.layout.width, s.layout.height),

@@ -19,6 +19,7 @@ mod config;
 mod footstep;
 mod frame;
 mod ground;
+mod levels;
 mod meshes;
 pub(crate) mod plan;
 pub(crate) mod probe;
@@ -59,6 +60,11 @@ struct SurfaceState {
     /// Its ground field and where it lies in the capture's ground buffer, when it is not flat
     /// (`ground.rs`).
     ground: Option<ground::SurfaceGround>,
+    /// Toroidal storage offsets of its slot, `ox | oy << 16` (a terrain window's level,
+    /// `crate::window`); 0 for every other surface.
+    wrap: u32,
+    /// The local rectangle a finer window level draws instead (`crate::window`).
+    hole: Option<[f32; 4]>,
 }
 
 /// What the last frame did, for debug readbacks.
@@ -363,6 +369,8 @@ impl SnowWorld {
             carry: 0.0,
             settle: Default::default(),
             ground: None,
+            wrap: 0,
+            hole: None,
         }))
     }
 
@@ -509,6 +517,18 @@ impl SnowWorld {
             s.slot
                 .normals_word(&self.config.format, s.layout.width, s.layout.height),
         ))
+    }
+
+    /// A surface's toroidal storage offsets, `ox | oy << 16` ([`crate::pool::wrapped`]): 0 for
+    /// every surface but a terrain window's levels (`crate::Terrain`).
+    pub fn wrap(&self, id: SurfaceId) -> Result<u32> {
+        Ok(self.state(id)?.wrap)
+    }
+
+    /// The rectangle of a surface's local xz that a finer level of its terrain window draws
+    /// instead (see [`crate::SurfaceView::hole`]).
+    pub fn hole(&self, id: SurfaceId) -> Result<Option<[f32; 4]>> {
+        Ok(self.state(id)?.hole)
     }
 
     /// How the pool stores heightmaps.

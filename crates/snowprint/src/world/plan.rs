@@ -78,6 +78,8 @@ pub struct PlanSurface<'a> {
     pub heights_word: u32,
     /// Word offset of its normals, when the pool keeps them.
     pub normals_word: Option<u32>,
+    /// Its toroidal storage offsets ([`crate::pool::wrapped`]; 0 for an ordinary surface).
+    pub wrap: u32,
     /// Replenishment carried from earlier updates, units (a fraction in `[0, 1)`).
     pub carry: f64,
     /// Seconds since its last update.
@@ -354,6 +356,7 @@ impl FramePlan {
                 texel_x: texel.x,
                 texel_z: texel.y,
                 tiles: 0,
+                wrap: s.wrap,
             },
             half_size: volume.half_size,
             ground_offset: s.ground.map_or(capture::NO_GROUND, |g| g.offset),
@@ -500,6 +503,7 @@ impl FramePlan {
                     rect: [rect.x0, rect.y0, rw, rh],
                     dispatch_steps: 0,
                     tiles: 0,
+                    wrap: r.wrap,
                 },
                 steps,
                 settings.format.precision.unit_texels(),

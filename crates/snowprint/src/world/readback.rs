@@ -36,9 +36,13 @@ impl SnowWorld {
     pub fn read_channels(&self, id: SurfaceId) -> Result<(Vec<u32>, Vec<u32>)> {
         let s = self.state(id)?;
         let words = self.read_packed(id)?;
-        self.config
-            .format
-            .decode(s.layout.width, s.layout.height, &words)
+        let (w, h) = (s.layout.width, s.layout.height);
+        let (depression, displaced) = self.config.format.decode(w, h, &words)?;
+        // Logical order, whatever the storage's toroidal offsets.
+        Ok((
+            crate::pool::unwrap_channel(s.wrap, w, h, &depression),
+            crate::pool::unwrap_channel(s.wrap, w, h, &displaced),
+        ))
     }
 
     /// Read a surface's current heightmap back to the CPU (waits for the GPU), in 16-bit units
@@ -68,7 +72,13 @@ impl SnowWorld {
             ));
         };
         let bytes = self.download(&self.pool, word as u64 * 4, s.layout.texels() * 4)?;
-        Ok(bytemuck::cast_slice(&bytes).to_vec())
+        let (w, h) = (s.layout.width, s.layout.height);
+        Ok(crate::pool::unwrap_channel(
+            s.wrap,
+            w,
+            h,
+            bytemuck::cast_slice(&bytes),
+        ))
     }
 
     /// Read a surface's normals in its local frame.

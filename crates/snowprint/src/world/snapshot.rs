@@ -22,8 +22,8 @@ pub struct SurfaceSnapshot {
     pub format: PoolFormat,
     /// Replenishment not yet applied, units at the format's precision (a fraction in `[0, 1)`).
     pub carry: f64,
-    /// The slot's words as stored: the heights region, then the normals when the format keeps
-    /// them.
+    /// The slot's words: the heights region, then the normals when the format keeps them, in
+    /// logical order (a terrain level stored wrapped is unwrapped: [`crate::pool::wrapped`]).
     pub words: Vec<u32>,
 }
 
@@ -58,6 +58,8 @@ impl SurfaceSnapshot {
 pub struct SnapshotRead {
     metas: Vec<SurfaceSnapshot>,
     sizes: Vec<u64>,
+    /// Each surface's toroidal storage offsets, undone as the words arrive.
+    wraps: Vec<u32>,
     read: Option<readback::RangeRead>,
 }
 
@@ -120,14 +122,36 @@ impl SnapshotRead {
         let mut at = 0usize;
         metas
             .into_iter()
-            .zip(&self.sizes)
-            .map(|(meta, &size)| {
+            .zip(self.sizes.iter().zip(&self.wraps))
+            .map(|(meta, (&size, &wrap))| {
                 let words = bytemuck::cast_slice(&bytes[at..at + size as usize]).to_vec();
                 at += size as usize;
+                let words = logical_words(&meta, wrap, words);
                 SurfaceSnapshot { words, ..meta }
             })
             .collect()
     }
+}
+
+/// A slot's words as stored with toroidal offsets `wrap`, put in logical order (heights and
+/// normals), so that snapshots, pages and saves never depend on where a window stood.
+fn logical_words(meta: &SurfaceSnapshot, wrap: u32, words: Vec<u32>) -> Vec<u32> {
+    if wrap == 0 {
+        return words;
+    }
+    let (w, h, f) = (meta.width, meta.height, meta.format);
+    let n = (f.heights_bytes(w, h) / 4) as usize;
+    let Ok((dep, disp)) = f.decode(w, h, &words[..n]) else {
+        return words;
+    };
+    let unwrap = |c: &[u32]| crate::pool::unwrap_channel(wrap, w, h, c);
+    let Ok(mut out) = f.encode(w, h, &unwrap(&dep), &unwrap(&disp)) else {
+        return words;
+    };
+    if words.len() > n {
+        out.extend(unwrap(&words[n..]));
+    }
+    out
 }
 
 impl SnowWorld {
@@ -153,8 +177,10 @@ impl SnowWorld {
     ) -> Result<SnapshotRead> {
         let mut metas = Vec::with_capacity(ids.len());
         let mut ranges = Vec::with_capacity(ids.len());
+        let mut wraps = Vec::with_capacity(ids.len());
         for &id in ids {
             let s = self.state(id)?;
+            wraps.push(s.wrap);
             let bytes = self.payload_bytes(&s.layout);
             ranges.push((s.slot.offset, bytes));
             metas.push(SurfaceSnapshot {
@@ -170,6 +196,7 @@ impl SnowWorld {
         Ok(SnapshotRead {
             metas,
             sizes: ranges.iter().map(|r| r.1).collect(),
+            wraps,
             read,
         })
     }
@@ -289,6 +316,8 @@ impl SnowWorld {
             carry: snapshot.carry,
             settle: Default::default(),
             ground: None,
+            wrap: 0,
+            hole: None,
         }))
     }
 }

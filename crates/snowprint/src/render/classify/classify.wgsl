@@ -16,8 +16,8 @@ struct ClassifyRecord {
     box_vertices: u32,
     bits: u32,        // bits a channel (pool/texel.wgsl)
     terrain: u32,     // 1 on ground that is not flat
-    _pad1: u32,
-    _pad2: u32,
+    wrap: u32,        // toroidal storage offsets (pool/texel.wgsl)
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
@@ -36,7 +36,7 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
     let count = rec.width * rec.height;
     var local_max = 0u;
     for (var i = li; i < count; i += 256u) {
-        let t = pool_texel(rec.bits, rec.heights, rec.width, rec.height, i % rec.width, i / rec.width);
+        let t = pool_texel(rec.bits, rec.heights, rec.width, rec.height, rec.wrap, i % rec.width, i / rec.width);
         local_max = max(local_max, t.x);
     }
     atomicMax(&deepest, local_max);

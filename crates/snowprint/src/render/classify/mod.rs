@@ -65,7 +65,8 @@ impl ClassifyPass {
                 box_vertices: BOX_VERTICES,
                 bits: s.view.precision.bits(),
                 terrain: u32::from(s.view.ground != crate::capture::NO_GROUND),
-                _pad: [0; 2],
+                wrap: s.view.wrap,
+                _pad: 0,
             })
             .collect();
         if n > 0 {

@@ -23,6 +23,10 @@ struct HeightfieldParams {
     texel_x: f32,
     texel_z: f32,
     ground: u32,        // first texel of the ground field (ground_texel), or NO_GROUND
+    wrap: u32,          // toroidal storage offsets (pool/texel.wgsl)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     light: vec4<f32>,   // xyz: unit direction towards the moon in the surface's local frame
 }
 
@@ -39,7 +43,7 @@ const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
 fn depression(c: i32, r: i32) -> f32 {
     let x = u32(clamp(c, 0, i32(params.width) - 1));
     let y = u32(clamp(r, 0, i32(params.height) - 1));
-    return pool_fractions(params.bits, params.heights, params.width, params.height, x, y).x;
+    return pool_fractions(params.bits, params.heights, params.width, params.height, params.wrap, x, y).x;
 }
 
 // The displaced snow at a texel (the talk's projected-displacement channel: what the captures
@@ -47,7 +51,7 @@ fn depression(c: i32, r: i32) -> f32 {
 fn displaced(c: i32, r: i32) -> f32 {
     let x = u32(clamp(c, 0, i32(params.width) - 1));
     let y = u32(clamp(r, 0, i32(params.height) - 1));
-    return pool_fractions(params.bits, params.heights, params.width, params.height, x, y).y;
+    return pool_fractions(params.bits, params.heights, params.width, params.height, params.wrap, x, y).y;
 }
 
 // Snow height (metres above the ground) at the texel nearest to a metric offset.

@@ -128,6 +128,8 @@ impl HeightfieldPass {
                 texel_x: desc.size.x / layout.width as f32,
                 texel_z: desc.size.y / layout.height as f32,
                 ground: surface.view.ground,
+                wrap: surface.view.wrap,
+                _pad: [0; 3],
                 light: {
                     let l = local_to_world
                         .inverse()

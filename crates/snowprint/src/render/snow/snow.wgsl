@@ -78,7 +78,14 @@ struct SnowSurface {
     terrain: u32,           // first texel of the ground field, or SNOW_NO_GROUND on flat ground
     terrain_low: f32,       // lowest base of the snow columns, local y (0 on flat ground)
     terrain_top: f32,       // highest untouched snow top, local y (the snow depth on flat ground)
-    terrain_pad: f32,
+    wrap: u32,              // the heights' toroidal storage offsets (engine.wgsl, pool/texel.wgsl)
+    hole: vec4<f32>,        // local (x0, z0, x1, z1) a finer terrain window level draws instead (empty: x1 < x0)
+}
+
+// Whether local xz lies in the surface's hole: a coarser terrain window level leaves the extent
+// of the finer one to it, so that the two never draw over each other (no seam, no fight).
+fn snow_in_hole(s: SnowSurface, xz: vec2<f32>) -> bool {
+    return all(xz >= s.hole.xy) && all(xz < s.hole.zw);
 }
 
 const SNOW_GROUND_TILES: u32 = 0u;

@@ -260,7 +260,8 @@ fn fs_deformable(in: SurfaceVarying) -> SnowOut {
     let d = normalize(in.local - eye);
     let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
     let hit = snow_trace(surface, in.local, d, frame.options.z, moon);
-    if hit.found == 0u {
+    // Where a finer terrain window level draws, this one does not (`SnowSurface::hole`).
+    if hit.found == 0u || snow_in_hole(surface, hit.position.xz) {
         discard;
     }
     let uv = snow_uv(surface, hit.position.xz);
@@ -352,6 +353,9 @@ fn deformable_view(shaded: vec3<f32>, m: SnowSample, depression: f32, taps: f32)
 @fragment
 fn fs_basic(in: SurfaceVarying) -> @location(0) vec4<f32> {
     let pixel = length(fwidth(in.local));
+    if snow_in_hole(surface, in.local.xz) {
+        discard;
+    }
     let m = snow_basic(surface, in.local, in.face, sky_tint(), pixel);
     var c = shade(m, in.local, 1.0, pixel);
     switch frame.options.x {

@@ -26,6 +26,17 @@ pub(super) struct GroundKeys {
 }
 
 impl GroundKeys {
+    /// The ground keys of a `[[terrain]]`.
+    pub(super) fn of_terrain(t: &mut crate::scene::raw::RawTerrain) -> Self {
+        Self {
+            ground: t.ground.take(),
+            heights: t.ground_heights.take(),
+            grid: t.ground_grid.take(),
+            full: t.full_slope_degrees.take(),
+            bare: t.bare_slope_degrees.take(),
+        }
+    }
+
     /// Split the ground keys from the rest of the surface's table.
     pub(super) fn take(mut s: RawSurface) -> (Self, RawSurface) {
         let keys = Self {
@@ -47,6 +58,20 @@ pub(super) fn ground(
     dir: &Path,
 ) -> Result<Option<SceneGround>> {
     let who = format!("surface {:?}", desc.name);
+    ground_of(src, k, &who, &desc.name, desc.local_to_world(), dir)
+}
+
+/// The ground of `who` (named `name`; a mesh's vertices taken to the world by `to_world`), or
+/// `None` when it has no `ground` key.
+pub(super) fn ground_of(
+    src: &Source<'_>,
+    k: GroundKeys,
+    who: &str,
+    name: &str,
+    to_world: glam::Mat4,
+    dir: &Path,
+) -> Result<Option<SceneGround>> {
+    let who = who.to_owned();
     let slope = slope_rule(src, &k, &who)?;
     let Some(path) = &k.ground else {
         if let Some(v) = k.heights.as_ref().or(k.grid.as_ref()) {
@@ -60,7 +85,7 @@ pub(super) fn ground(
     };
     let span = path.span();
     // The mesh loader's messages name the key as "path".
-    let whose = format!("the ground of surface {:?}", desc.name);
+    let whose = format!("the ground of {who}");
     let (resolved, root) = resolve(src, path, &whose, dir)?;
     let lower = resolved.to_string_lossy().to_ascii_lowercase();
     let bad = |reason: String, todo: &str| {
@@ -79,7 +104,6 @@ pub(super) fn ground(
                 "export the terrain or roof with at least one face",
             ));
         }
-        let to_world = desc.local_to_world();
         let v = |i: u32| to_world.transform_point3(mesh.positions[i as usize]);
         Ground::Mesh(GroundMesh {
             triangles: mesh
@@ -140,7 +164,7 @@ pub(super) fn ground(
                 )
             })?
         };
-        grid.validate(&desc.name)
+        grid.validate(name)
             .map_err(|e| bad(e.to_string(), "fix the heightmap"))?;
         Ground::Grid(grid)
     };

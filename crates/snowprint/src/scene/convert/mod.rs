@@ -20,6 +20,7 @@ mod ground;
 mod material;
 mod mesh;
 mod surface;
+mod terrain;
 mod values;
 
 use camera::camera;
@@ -74,14 +75,15 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
         surfaces.push(desc);
         zones.push(zone);
     }
-    if surfaces.is_empty() {
+    if surfaces.is_empty() && raw.terrain.is_empty() {
         return Err(src.error_at_line(
             1,
-            "the scene has no [[surface]] table, so there is no snow to press",
+            "the scene has no [[surface]] or [[terrain]] table, so there is no snow to press",
             "add at least one [[surface]] with name, center, size and snow_depth",
         ));
     }
 
+    let mut names_of_surfaces = names;
     let mut names = HashMap::new();
     let mut first_player: Option<usize> = None;
     let mut deformers = Vec::new();
@@ -126,6 +128,36 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
             pool_span.unwrap_or(table),
         )?;
     }
+    let pool = (
+        budget
+            .and_then(|b| b.pool_bytes)
+            .unwrap_or(crate::WorldConfig::default().pool_bytes),
+        crate::pool::PoolFormat::new(budget.and_then(|b| b.precision).unwrap_or_default()),
+    );
+    let mut terrains = Vec::new();
+    let surfaces_bytes: u64 = surfaces
+        .iter()
+        .map(|s| {
+            let l = s.layout();
+            pool.1.slot_bytes(l.width, l.height)
+        })
+        .sum();
+    for t in raw.terrain {
+        let used: u64 = surfaces_bytes
+            + terrains
+                .iter()
+                .flat_map(|t: &super::SceneTerrain| &t.desc.levels)
+                .map(|l| pool.1.slot_bytes(l.texels[0], l.texels[1]))
+                .sum::<u64>();
+        terrains.push(terrain::terrain(
+            src,
+            t,
+            &mut names_of_surfaces,
+            &materials,
+            (pool.0.saturating_sub(used), pool.1),
+            dir,
+        )?);
+    }
     let camera = raw
         .camera
         .map(|c| camera(src, c.span(), c.into_inner()))
@@ -140,6 +172,7 @@ pub(super) fn convert(raw: RawScene, src: &Source<'_>, dir: &Path, path: &Path) 
         budget,
         camera,
         grounds,
+        terrains,
     })
 }
 

@@ -30,6 +30,7 @@ fn inputs<'a>(
                 layout,
                 heights_word: word,
                 normals_word: None,
+                wrap: 0,
                 carry: 0.0,
                 elapsed,
                 deformers,

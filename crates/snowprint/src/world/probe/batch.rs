@@ -11,6 +11,9 @@ use super::{
 use crate::surface::SurfaceId;
 use crate::world::SnowWorld;
 
+/// Bytes of one `ProbeQuery`.
+const QUERY_BYTES: u64 = std::mem::size_of::<ProbeQuery>() as u64;
+
 impl SnowWorld {
     /// The surface under a point (see [`super::ProbeSample::surface`]): the topmost whose
     /// rectangle holds it and whose ground is not above it; its query and what decodes it.
@@ -28,7 +31,7 @@ impl SnowWorld {
         let i = best?.1;
         let s = self.surfaces[i].as_ref()?;
         let id = SurfaceId(i as u32, self.generations[i]);
-        Some(cpu::query(
+        let (mut query, info) = cpu::query(
             &s.desc,
             &s.layout,
             precision,
@@ -36,7 +39,9 @@ impl SnowWorld {
             Some(id),
             s.ground.as_ref().map(|g| &g.field),
             point,
-        ))
+        );
+        query.wrap = s.wrap;
+        Some((query, info))
     }
 
     /// Record the queued probes as one batch into a free ring slot (the slot was kept free when
@@ -115,10 +120,10 @@ impl SnowWorld {
         let n = queries.len().max(1) as u64;
         let (device, queue) = (&self.device, &self.queue);
         let p = &mut self.probes;
-        p.queries.ensure(device, n * 32);
+        p.queries.ensure(device, n * QUERY_BYTES);
         p.results.ensure(device, n * 16);
         if queries.is_empty() {
-            queue.write_buffer(&p.queries.buffer, 0, &[0; 32]);
+            queue.write_buffer(&p.queries.buffer, 0, &[0; QUERY_BYTES as usize]);
         } else {
             queue.write_buffer(&p.queries.buffer, 0, bytemuck::cast_slice(queries));
         }
@@ -139,7 +144,7 @@ impl SnowWorld {
                     binding: 0,
                     resource: self.pool.as_entire_binding(),
                 },
-                sized(1, &p.queries.buffer, n * 32),
+                sized(1, &p.queries.buffer, n * QUERY_BYTES),
                 sized(2, &p.results.buffer, n * 16),
             ],
         });

@@ -76,6 +76,7 @@ pub(super) fn query(
         texel_x: texel.x,
         texel_z: texel.y,
         snow_depth: desc.snow_depth,
+        wrap: 0,
     };
     let info = PointInfo {
         point,

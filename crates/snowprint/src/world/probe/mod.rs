@@ -100,7 +100,7 @@ pub enum ProbeStatus {
     Ready(Vec<ProbeSample>),
 }
 
-/// One point's query, as `ProbeQuery` in probe.wgsl (32 bytes).
+/// One point's query, as `ProbeQuery` in probe.wgsl (36 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 struct ProbeQuery {
@@ -112,6 +112,7 @@ struct ProbeQuery {
     texel_x: f32,
     texel_z: f32,
     snow_depth: f32,
+    wrap: u32,
 }
 
 /// What the CPU keeps of a point to turn its raw result into a sample.
@@ -215,7 +216,7 @@ impl Probes {
         Self {
             pipeline,
             layout,
-            queries: Growable::new(device, "probe queries", U::STORAGE | U::COPY_DST, 32 * 64),
+            queries: Growable::new(device, "probe queries", U::STORAGE | U::COPY_DST, 36 * 64),
             results: Growable::new(device, "probe results", U::STORAGE | U::COPY_SRC, 16 * 64),
             ring: (0..PROBE_RING)
                 .map(|_| RingSlot {

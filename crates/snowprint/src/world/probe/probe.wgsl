@@ -22,6 +22,8 @@ struct ProbeQuery {
     texel_z: f32,
     // Fresh snow depth of the surface, metres.
     snow_depth: f32,
+    // Toroidal storage offsets of the heights region (pool/texel.wgsl).
+    wrap: u32,
 }
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
@@ -30,7 +32,7 @@ struct ProbeQuery {
 
 // Height of the snow top above the ground at texel (x, y), metres.
 fn probe_top(q: ProbeQuery, x: u32, y: u32) -> f32 {
-    let f = pool_fractions(q.bits, q.base, q.width, q.height, x, y);
+    let f = pool_fractions(q.bits, q.base, q.width, q.height, q.wrap, x, y);
     return q.snow_depth * (1.0 - f.x);
 }
 
@@ -47,7 +49,7 @@ fn probe_points(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let x = q.texel & 0xffffu;
     let y = q.texel >> 16u;
-    let c = pool_texel(q.bits, q.base, q.width, q.height, x, y);
+    let c = pool_texel(q.bits, q.base, q.width, q.height, q.wrap, x, y);
     let x0 = select(x - 1u, 0u, x == 0u);
     let x1 = min(x + 1u, q.width - 1u);
     let y0 = select(y - 1u, 0u, y == 0u);

@@ -32,6 +32,7 @@ fn query_layout_matches_wgsl() {
         "texel_x",
         "texel_z",
         "snow_depth",
+        "wrap",
     ];
     assert_eq!(names, expect);
     for (i, m) in members.iter().enumerate() {

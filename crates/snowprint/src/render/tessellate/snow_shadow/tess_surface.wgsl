@@ -106,6 +106,9 @@ fn vs_tess_shadow(v: TessVertex) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
     let pixel = length(fwidth(in.local));
+    if snow_in_hole(surface, in.local.xz) {
+        discard;
+    }
     var m: SnowSample;
     var hf = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     if in.outward.w > 0.5 {

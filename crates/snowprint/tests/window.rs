@@ -1,0 +1,734 @@
+//! A terrain's sliding window (`Terrain`, `window/`): a walker leaves the near level's window and
+//! comes back to find its trail as a window that never scrolled keeps it; a scroll by k columns
+//! writes exactly the entering strip's bytes and nothing else in the pool; wrapped and unwrapped
+//! storage give the same logical heightmap; the far level keeps the trail's broad shape after the
+//! near one paged it out; refusals in one sentence.
+
+mod common;
+
+use glam::Vec3;
+use snowprint::{
+    Deformer, LevelDesc, Material, PoolFormat, Pose, Precision, Shape, SnowError, SnowWorld,
+    Terrain, TerrainDesc, WorldConfig,
+};
+
+const DEPTH: f32 = 0.3;
+
+fn world(precision: Precision) -> SnowWorld {
+    let config = WorldConfig {
+        format: PoolFormat::new(precision),
+        ..WorldConfig::default()
+    };
+    SnowWorld::new(common::gpu(), config).expect("world")
+}
+
+fn terrain(name: &str, levels: &[([u32; 2], f32)]) -> TerrainDesc {
+    TerrainDesc {
+        name: name.into(),
+        ground_height: 1.0,
+        ground: None,
+        snow_depth: DEPTH,
+        replenish_rate: 0.0,
+        material: Material::snow(),
+        levels: levels
+            .iter()
+            .map(|&(texels, texel_size)| LevelDesc { texels, texel_size })
+            .collect(),
+    }
+}
+
+/// A foot: a 6 cm ball pressed 15 cm into the snow at world (x, z).
+fn foot(x: f32, z: f32) -> Deformer {
+    Deformer::new(
+        Shape::Sphere { radius: 0.06 },
+        Pose::at([x, 1.0 + DEPTH - 0.15 + 0.06, z]),
+    )
+}
+
+/// The walker's prints: left and right of a line along x, one a frame.
+fn walk() -> Vec<Deformer> {
+    (0..40)
+        .map(|i| foot(0.3 + i as f32 * 0.07, if i % 2 == 0 { 0.1 } else { -0.1 }))
+        .collect()
+}
+
+/// Depression channel of a level, logical order, by world texel.
+fn by_world(
+    w: &SnowWorld,
+    t: &Terrain,
+    level: usize,
+) -> std::collections::HashMap<(i64, i64), u32> {
+    let id = t.surfaces()[level];
+    let l = w.layout(id).unwrap();
+    let (dep, _) = w.read_channels(id).unwrap();
+    let o = t.origin(level).unwrap();
+    let mut m = std::collections::HashMap::new();
+    for y in 0..l.height {
+        for x in 0..l.width {
+            m.insert(
+                (o[0] + x as i64, o[1] + y as i64),
+                dep[(y * l.width + x) as usize],
+            );
+        }
+    }
+    m
+}
+
+/// The walker prints its trail while a camera a little behind it is the near window's focus; the
+/// camera then goes 12 m away (the near window pages the trail out and rewrites itself twice
+/// over) and comes back. The trail it finds is texel for texel the trail of a window large enough
+/// never to scroll, and without the page store it would be gone.
+#[test]
+fn a_walker_leaves_the_window_and_finds_its_trail_texel_for_texel() {
+    let (mut w, mut big) = (world(Precision::Bits16), world(Precision::Bits16));
+    let near = [([64, 48], 0.05)];
+    let mut t = Terrain::new(&mut w, terrain("valley", &near), Vec3::ZERO).unwrap();
+    let never = Terrain::new(
+        &mut big,
+        terrain("valley", &[([256, 64], 0.05)]),
+        Vec3::new(2.0, 0.0, 0.0),
+    )
+    .unwrap();
+    for d in walk() {
+        let camera = d.pose.position - Vec3::new(0.3, 0.0, 0.0);
+        t.follow(&mut w, camera).unwrap();
+        w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        big.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    assert_eq!(never.stats().scrolls, 0);
+    let reference = by_world(&big, &never, 0);
+    assert!(
+        t.scrolls_in_flight() <= 2,
+        "readbacks pile up: {}",
+        t.scrolls_in_flight()
+    );
+    for x in [6.0f32, 12.0, 6.0, 1.5] {
+        t.follow(&mut w, Vec3::new(x, 0.0, 0.0)).unwrap();
+        w.step(1.0 / 60.0, &[]).unwrap();
+    }
+    let back = by_world(&w, &t, 0);
+    let (mut compared, mut pressed) = (0, 0);
+    for (texel, &v) in &back {
+        let r = reference[texel];
+        assert_eq!(
+            v, r,
+            "world texel {texel:?}: {v} after the walk out and back, {r} in the window that never scrolled"
+        );
+        compared += 1;
+        pressed += (r > 0) as u32;
+    }
+    assert_eq!(compared, 64 * 48);
+    assert!(
+        pressed > 200,
+        "only {pressed} texels of the trail were compared"
+    );
+    let s = t.stats();
+    assert!(s.texels_paged_in >= pressed as u64, "{s:?}");
+    println!("walk out and back: {compared} texels compared, {pressed} pressed, {s:?}");
+}
+
+/// A scroll by k columns writes k x rows texels' bytes, counted by the GPU as it stores them, at
+/// every precision; in the pool, only the entering strip's storage changed.
+#[test]
+fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
+    for (p, texel_bytes) in [
+        (Precision::Bits8, 2u64),
+        (Precision::Bits16, 4),
+        (Precision::Bits32, 8),
+    ] {
+        let mut w = world(p);
+        let (cols, rows) = (64u32, 48u32);
+        let mut t = Terrain::new(
+            &mut w,
+            terrain("strip", &[([cols, rows], 0.05)]),
+            Vec3::ZERO,
+        )
+        .unwrap();
+        let id = t.surfaces()[0];
+        // Press the whole window so that fresh snow entering shows.
+        let slab = Deformer::new(
+            Shape::Box {
+                half_extents: Vec3::new(2.0, 0.1, 2.0),
+            },
+            Pose::at([0.0, 1.2, 0.0]),
+        );
+        w.step(1.0 / 60.0, &[slab]).unwrap();
+        let before = w.read_packed(id).unwrap();
+        let wrap0 = w.wrap(id).unwrap();
+        for k in [2u32, 6] {
+            let focus = Vec3::new(k as f32 * 0.05, 0.0, 0.0);
+            let packed = w.read_packed(id).unwrap();
+            t.follow(&mut w, focus).unwrap();
+            // Nothing waited: the scroll's readback lands at the next call or at flush.
+            assert_eq!(t.scrolls_in_flight(), 1);
+            t.flush(&mut w).unwrap();
+            assert_eq!(t.scrolls_in_flight(), 0);
+            let written = t.last_bytes_written();
+            assert_eq!(
+                written,
+                k as u64 * rows as u64 * texel_bytes,
+                "{p}: scroll by {k} columns"
+            );
+            let after = w.read_packed(id).unwrap();
+            let changed = packed.iter().zip(&after).filter(|(a, b)| a != b).count();
+            // The pressed texels of the strip came back as fresh snow; nothing else moved.
+            let words_a_column = match p {
+                Precision::Bits8 => rows as usize / 2,
+                Precision::Bits16 => rows as usize,
+                Precision::Bits32 => 2 * rows as usize,
+            };
+            assert_eq!(changed, k as usize * words_a_column, "{p}: {k}");
+            // Back at once: the strips that enter are those still on their way, so this waits.
+            t.follow(&mut w, Vec3::ZERO).unwrap();
+        }
+        t.flush(&mut w).unwrap();
+        // Back where it started: the same storage, the same offsets, every texel as before.
+        assert_eq!(w.wrap(id).unwrap(), wrap0);
+        assert_eq!(w.read_packed(id).unwrap(), before, "{p}");
+        let s = t.stats();
+        assert_eq!(s.bytes_written, s.texels_in * texel_bytes, "{p}: {s:?}");
+    }
+}
+
+/// The same walk on a level stored wrapped (offsets (13, 7) after a scroll) and on an ordinary
+/// surface of the same rectangle and layout: the same logical heightmap bit for bit, and the
+/// level's storage is the surface's rotated by the offsets.
+#[test]
+fn wrapped_and_unwrapped_storage_give_the_same_logical_heightmap() {
+    for p in [Precision::Bits8, Precision::Bits16, Precision::Bits32] {
+        let (mut a, mut b) = (world(p), world(p));
+        let desc = terrain("wrapped", &[([64, 48], 0.04)]);
+        let mut t = Terrain::new(&mut a, desc, Vec3::new(-5.0, 0.0, 3.0)).unwrap();
+        // A window whose first world texel is (14, 7): stored with offsets (14, 7).
+        let focus = Vec3::new((14.0 + 32.0) * 0.04, 0.0, (7.0 + 24.0) * 0.04);
+        t.follow(&mut a, focus).unwrap();
+        let level = t.surfaces()[0];
+        assert_eq!(a.wrap(level).unwrap(), 14 | 7 << 16, "{p}");
+        let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
+        assert_eq!(b.layout(plain).unwrap(), a.layout(level).unwrap());
+        assert_eq!(b.wrap(plain).unwrap(), 0);
+        for d in walk() {
+            let d = Deformer {
+                pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()),
+                ..d
+            };
+            a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+            b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        }
+        let (la, lb) = (
+            a.read_channels(level).unwrap(),
+            b.read_channels(plain).unwrap(),
+        );
+        assert!(
+            la.0.iter().filter(|&&v| v > 0).count() > 200,
+            "{p}: the walk pressed nothing"
+        );
+        assert_eq!(la, lb, "{p}: wrapped and unwrapped heightmaps differ");
+        assert_ne!(
+            a.read_packed(level).unwrap(),
+            b.read_packed(plain).unwrap(),
+            "{p}: not stored wrapped"
+        );
+        // Snapshots are in logical order too.
+        let sa = a.snapshot_surfaces(&[level]).unwrap();
+        let sb = b.snapshot_surfaces(&[plain]).unwrap();
+        assert_eq!(sa[0].words, sb[0].words, "{p}");
+        // Probes read through the wrap: the same answers at the prints.
+        let points: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new(0.7 + 0.07 * i as f32, 1.0, 1.3))
+            .collect();
+        let (pa, pb) = (probe(&mut a, &points), probe(&mut b, &points));
+        assert!(
+            pa.iter().any(|x| x.depression_m > 0.01),
+            "{p}: the probes missed the prints"
+        );
+        for (x, y) in pa.iter().zip(&pb) {
+            assert_eq!(
+                (x.depression_m, x.normal),
+                (y.depression_m, y.normal),
+                "{p}"
+            );
+        }
+    }
+}
+
+fn probe(w: &mut SnowWorld, points: &[Vec3]) -> Vec<snowprint::ProbeSample> {
+    let ticket = w.probe(points).unwrap();
+    for _ in 0..4 {
+        w.step(1.0 / 60.0, &[]).unwrap();
+        if let snowprint::ProbeStatus::Ready(s) = w.probe_result(ticket).unwrap() {
+            return s;
+        }
+    }
+    panic!("probes not answered in 4 frames");
+}
+
+/// Two levels: the near one (5 cm) pages the trail out when the focus walks 5 m away; the far one
+/// (40 cm) covers it, and its own coarse capture missed the 6 cm balls (its texel centres lie
+/// 20 cm either side of the line); the near level's leaving strips folded into it give it the
+/// trail's broad shape: pressed along the line, untouched beside it.
+#[test]
+fn the_far_level_keeps_the_trails_broad_shape() {
+    let mut w = world(Precision::Bits16);
+    let levels = [([80, 48], 0.05), ([64, 64], 0.4)];
+    let mut t = Terrain::new(&mut w, terrain("clip", &levels), Vec3::new(1.5, 0.0, 0.0)).unwrap();
+    for d in walk() {
+        w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    // World texels of 40 cm: the trail runs along z = 0 (rows -1 and 0) from x = 0.3 to 3.0 m.
+    let line = |far: &std::collections::HashMap<(i64, i64), u32>| -> Vec<u32> {
+        (1..8).map(|i| far[&(i, -1)].max(far[&(i, 0)])).collect()
+    };
+    assert!(
+        line(&by_world(&w, &t, 1)).iter().all(|&v| v == 0),
+        "the far level captured the balls itself"
+    );
+    // The fold's reference: the deepest near texel whose centre lies in each 40 cm texel (8 x 8
+    // near texels of 5 cm), from the near level before it scrolls.
+    let mut expected = std::collections::HashMap::<(i64, i64), u32>::new();
+    for (&(x, z), &v) in &by_world(&w, &t, 0) {
+        let e = expected
+            .entry((x.div_euclid(8), z.div_euclid(8)))
+            .or_default();
+        *e = (*e).max(v);
+    }
+    t.follow(&mut w, Vec3::new(6.5, 0.0, 0.0)).unwrap();
+    t.flush(&mut w).unwrap();
+    let near = by_world(&w, &t, 0);
+    assert!(
+        near.values().all(|&v| v == 0),
+        "the near level still holds the trail"
+    );
+    let far = by_world(&w, &t, 1);
+    let on_trail = line(&far);
+    let beside: Vec<u32> = (1..8).flat_map(|i| [far[&(i, -3)], far[&(i, 2)]]).collect();
+    assert!(
+        on_trail.iter().all(|&v| v > 65535 / 5),
+        "far level along the trail: {on_trail:?}"
+    );
+    for i in 1..8 {
+        for z in [-3, -1, 0, 2] {
+            assert_eq!(far[&(i, z)], expected[&(i, z)], "far texel ({i}, {z})");
+        }
+    }
+    assert!(
+        beside.iter().all(|&v| v == 0),
+        "far level beside the trail: {beside:?}"
+    );
+    let s = t.stats();
+    assert!(s.texels_out > 0 && s.bytes_folded > 0, "{s:?}");
+}
+
+#[test]
+fn bad_terrains_and_foci_are_refused_in_one_sentence() {
+    let mut w = SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            pool_bytes: 1 << 20,
+            ..WorldConfig::default()
+        },
+    )
+    .unwrap();
+    let cases: [(TerrainDesc, &str); 4] = [
+        (
+            terrain("a", &[([0, 16], 0.05)]),
+            "level 0's texels is [0, 16]",
+        ),
+        (
+            terrain("b", &[([16, 16], 0.05), ([16, 16], f32::NAN)]),
+            "level 1's texel_size is NaN",
+        ),
+        (
+            terrain("c", &[([1024, 1024], 0.05)]),
+            "the levels' heightmaps is 4194304 bytes, but it must be at most the pool's 1048576 bytes",
+        ),
+        (terrain("d", &[]), "levels is empty"),
+    ];
+    for (desc, expected) in cases {
+        let e = Terrain::new(&mut w, desc, Vec3::ZERO)
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(e.contains(expected), "{e}");
+        assert_eq!(e.lines().count(), 1);
+    }
+    assert_eq!(
+        w.surfaces().count(),
+        0,
+        "a refused terrain left surfaces behind"
+    );
+    let mut t = Terrain::new(&mut w, terrain("e", &[([16, 16], 0.05)]), Vec3::ZERO).unwrap();
+    let e = t.follow(&mut w, Vec3::new(f32::NAN, 0.0, 0.0)).unwrap_err();
+    assert!(matches!(e, SnowError::InvalidTerrain { .. }), "{e}");
+    assert!(
+        e.to_string().contains("the focus is [NaN, 0.0, 0.0]"),
+        "{e}"
+    );
+    // Between encode_step and submitted the window cannot move: refused, nothing recorded.
+    let id = t.surfaces()[0];
+    let wrap = w.wrap(id).unwrap();
+    let mut enc = w.device().create_command_encoder(&Default::default());
+    let pending = w.encode_step(&mut enc, 1.0 / 60.0, &[]).unwrap();
+    let e = t
+        .follow(&mut w, Vec3::new(3.0, 0.0, 0.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("cannot scroll while a snow frame is encoded"),
+        "{e}"
+    );
+    assert_eq!(
+        (w.wrap(id).unwrap(), t.origin(0), t.scrolls_in_flight()),
+        (wrap, Some([-8, -8]), 0)
+    );
+    w.queue().submit([enc.finish()]);
+    w.submitted(pending).unwrap();
+    t.follow(&mut w, Vec3::new(3.0, 0.0, 0.0)).unwrap();
+    assert_eq!(t.origin(0), Some([52, -8]));
+}
+
+mod render {
+    use super::*;
+    use snowprint::render::{Environment, RenderConfig, RenderFrame, Renderer, Tier};
+    use snowprint::{Camera, GroundMaterial, SurfaceId};
+
+    fn shoot(
+        w: &SnowWorld,
+        ids: &[SurfaceId],
+        tier: Tier,
+        camera: Camera,
+        size: (u32, u32),
+    ) -> Vec<u8> {
+        let mut c = RenderConfig::new(size.0, size.1, tier);
+        c.shadow_map_size = 256;
+        c.snowflakes = 0;
+        let surfaces: Vec<_> = ids.iter().map(|&i| (i, GroundMaterial::Concrete)).collect();
+        let mut r = Renderer::new(common::gpu(), c).unwrap();
+        let f = RenderFrame {
+            camera,
+            time: 0.0,
+            surfaces: &surfaces,
+            instances: &[],
+            lights: &[],
+            environment: Environment::moonlit_night(),
+            snowfall: false,
+        };
+        r.render(w, &f).unwrap().rgba8
+    }
+
+    fn save(name: &str, rgba: &[u8], size: (u32, u32)) {
+        let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("window");
+        std::fs::create_dir_all(&dir).unwrap();
+        image::save_buffer(
+            dir.join(name),
+            rgba,
+            size.0,
+            size.1,
+            image::ColorType::Rgba8,
+        )
+        .unwrap();
+    }
+
+    /// The renderer's heightfield pass reads a wrapped level through the wrap: the walk on a level
+    /// stored with offsets (14, 7) and on the same rectangle stored plainly give the same image,
+    /// bit for bit, in the relief and tessellated tiers (and not the untouched snow's).
+    #[test]
+    fn a_wrapped_level_renders_as_the_same_surface_stored_plainly() {
+        let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
+        let mut t =
+            Terrain::new(&mut a, terrain("wrapped", &[([64, 48], 0.04)]), Vec3::ZERO).unwrap();
+        t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04))
+            .unwrap();
+        let level = t.surfaces()[0];
+        let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
+        let camera = Camera {
+            eye: Vec3::new(1.9, 2.6, -0.9),
+            target: Vec3::new(1.9, 1.0, 1.25),
+            fov_y_degrees: 50.0,
+        };
+        let size = (160, 90);
+        let untouched = shoot(&a, &[level], Tier::Relief, camera, size);
+        for d in walk() {
+            let d = Deformer {
+                pose: Pose::at((d.pose.position + Vec3::new(0.4, 0.0, 1.2)).to_array()),
+                ..d
+            };
+            a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+            b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        }
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            let wrapped = shoot(&a, &[level], tier, camera, size);
+            let plainly = shoot(&b, &[plain], tier, camera, size);
+            save(&format!("wrapped_{tier:?}.png"), &wrapped, size);
+            assert!(
+                wrapped == plainly,
+                "{tier:?}: the wrapped level renders differently"
+            );
+            if tier == Tier::Relief {
+                let changed = wrapped
+                    .iter()
+                    .zip(&untouched)
+                    .filter(|(x, y)| x != y)
+                    .count();
+                assert!(
+                    changed > 2000,
+                    "the trail changed only {changed} bytes of the image"
+                );
+            }
+        }
+    }
+
+    /// Two levels of one window, both untouched, drawn together look as the far level alone: the
+    /// far one leaves the near one's extent to it (no overlap, no seam where they meet); with a
+    /// trail across the near level, the still shows it inside the far level's snow.
+    #[test]
+    fn near_and_far_levels_meet_without_a_seam() {
+        let mut w = world(Precision::Bits16);
+        let levels = [([64, 64], 0.05), ([64, 64], 0.2)];
+        let t = Terrain::new(&mut w, terrain("clip", &levels), Vec3::new(1.6, 0.0, 0.0)).unwrap();
+        let [near, far] = [t.surfaces()[0], t.surfaces()[1]];
+        let hole = w
+            .frame_view()
+            .surface(far)
+            .unwrap()
+            .hole
+            .expect("the far level has a hole");
+        // The near level's extent, inset by a quarter of its texel (the two overlap that much).
+        let q = 0.25 * 0.05;
+        for (h, e) in hole.iter().zip([-1.6 + q, -1.6 + q, 1.6 - q, 1.6 - q]) {
+            assert!((h - e).abs() < 1e-5, "{hole:?}");
+        }
+        let camera = Camera {
+            eye: Vec3::new(1.6, 5.0, -5.5),
+            target: Vec3::new(1.6, 1.0, 0.5),
+            fov_y_degrees: 55.0,
+        };
+        let size = (320, 180);
+        let mut alone = world(Precision::Bits16);
+        let only = Terrain::new(
+            &mut alone,
+            terrain("clip", &levels[1..]),
+            Vec3::new(1.6, 0.0, 0.0),
+        )
+        .unwrap();
+        let far_only = only.surfaces()[0];
+        assert_eq!(
+            alone.surface(far_only).unwrap().center,
+            w.surface(far).unwrap().center
+        );
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            let both = shoot(&w, &[near, far], tier, camera, size);
+            let reference = shoot(&alone, &[far_only], tier, camera, size);
+            save(&format!("levels_untouched_{tier:?}.png"), &both, size);
+            let differ: Vec<usize> = (0..both.len() / 4)
+                .filter(|&i| (0..3).any(|c| both[4 * i + c].abs_diff(reference[4 * i + c]) > 2))
+                .collect();
+            let at: Vec<(usize, usize)> = differ
+                .iter()
+                .take(8)
+                .map(|i| (i % size.0 as usize, i / size.0 as usize))
+                .collect();
+            println!(
+                "{tier:?}: untouched levels against the far level alone: {} pixels differ by more than 2 of 255, at {at:?}",
+                differ.len()
+            );
+            // A crack where the meshes meet is a pixel or two: none is allowed.
+            assert!(
+                differ.is_empty(),
+                "{tier:?}: {} pixels differ, at {at:?}",
+                differ.len()
+            );
+        }
+        for d in walk() {
+            w.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        }
+        let trail = shoot(&w, &[near, far], Tier::Relief, camera, size);
+        save("levels_trail.png", &trail, size);
+        let trail_t = shoot(&w, &[near, far], Tier::Tessellated, camera, size);
+        save("levels_trail_tessellated.png", &trail_t, size);
+        // The window moves 2 m on (-x): the trail's far end leaves the near level, and the far
+        // level draws it from what the near one folded into it (coarse, as it must be).
+        let mut t = t;
+        t.follow(&mut w, Vec3::new(-0.4, 0.0, 0.0)).unwrap();
+        t.flush(&mut w).unwrap();
+        w.step(1.0 / 60.0, &[]).unwrap();
+        let moved = shoot(&w, &[near, far], Tier::Relief, camera, size);
+        save("levels_trail_moved.png", &moved, size);
+        assert_ne!(
+            moved, trail,
+            "the window moved and nothing changed on screen"
+        );
+    }
+}
+
+/// `[[terrain]]` in a scene file: its keys become a `TerrainDesc` (levels finest first, inline or
+/// as `[[terrain.levels]]`), and its refusals name the file and line (more in
+/// `tests/hostile/scenes/terrain_*`).
+#[test]
+fn scene_keys_make_a_terrain_and_refuse_bad_ones_with_their_line() {
+    use snowprint::scene::{Scene, TerrainFollow};
+    let path = std::path::Path::new("valley.toml");
+    let text = "version = 1\n\n[[material]]\nname = \"dry\"\nlike = \"powder\"\n\n\
+                [[terrain]]\nname = \"valley\"\nground_height = 12.5\nsnow_depth = 0.4\n\
+                replenish_rate = 0.01\nmaterial = \"dry\"\n\n\
+                [[terrain.levels]]\ntexels = [1024, 1024]\ntexel_size = 0.05\n\n\
+                [[terrain.levels]]\ntexels = [512, 256]\ntexel_size = 0.4\n";
+    let scene = Scene::parse(text, path).unwrap();
+    assert!(scene.surfaces.is_empty());
+    let t = &scene.terrains[0];
+    assert_eq!((t.line, t.follow), (7, TerrainFollow::Player));
+    assert_eq!(t.desc.name, "valley");
+    assert_eq!(
+        (
+            t.desc.ground_height,
+            t.desc.snow_depth,
+            t.desc.replenish_rate
+        ),
+        (12.5, 0.4, 0.01)
+    );
+    assert_eq!(t.desc.material.look, Material::powder().look);
+    assert_eq!(
+        t.desc.levels,
+        vec![
+            LevelDesc {
+                texels: [1024, 1024],
+                texel_size: 0.05
+            },
+            LevelDesc {
+                texels: [512, 256],
+                texel_size: 0.4
+            },
+        ]
+    );
+    let refused = |extra: &str| {
+        Scene::parse(&format!("{text}{extra}"), path)
+            .unwrap_err()
+            .to_string()
+    };
+    let twice = refused(
+        "\n[[surface]]\nname = \"valley\"\ncenter = [0, 0, 0]\nsize = [1, 1]\nsnow_depth = 0.3\n",
+    );
+    assert!(
+        twice.starts_with("valley.toml:8: surface name \"valley\" is used twice"),
+        "{twice}"
+    );
+    let size = refused(
+        "\n[[terrain]]\nname = \"b\"\nsnow_depth = 0.3\nlevels = [{ texels = [64, 64], texel_size = 0.01 }]\n",
+    );
+    assert!(
+        size.starts_with("valley.toml:25: terrain \"b\"'s level 0 has texel_size 0.01"),
+        "{size}"
+    );
+    let pool = refused("\n[budget]\npool_bytes = 4194304\n");
+    assert!(pool.starts_with("valley.toml:14: terrain \"valley\"'s levels need 4718592 bytes of heightmap pool, and the pool has 4194304 left"), "{pool}");
+}
+
+/// A terrain on sine hills (a height grid over 20 m x 20 m of the world): after the window has
+/// scrolled (offsets (14, 7)) a walk leaves on the level what it leaves on a plain surface of the
+/// same rectangle laid on the same heights, bit for bit, and the prints follow the hills.
+#[test]
+fn a_terrain_on_hills_presses_as_a_surface_on_the_same_ground() {
+    use snowprint::{Ground, HeightGrid, SlopeRule, TerrainGround};
+    let hills = |x: f32, z: f32| 0.4 * (x * 0.9).sin() * (z * 0.7).cos();
+    let n = 101u32;
+    let grid = HeightGrid {
+        columns: n,
+        rows: n,
+        heights: (0..n * n)
+            .map(|i| hills(-10.0 + 0.2 * (i % n) as f32, -10.0 + 0.2 * (i / n) as f32))
+            .collect(),
+    };
+    let mut desc = terrain("hills", &[([64, 48], 0.04)]);
+    desc.ground = Some(TerrainGround {
+        grid,
+        origin: [-10.1, -10.1],
+        size: [20.2, 20.2],
+        slope: SlopeRule::default(),
+    });
+    let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
+    let mut t = Terrain::new(&mut a, desc, Vec3::new(-3.0, 0.0, 0.0)).unwrap();
+    t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04))
+        .unwrap();
+    let level = t.surfaces()[0];
+    assert_eq!(a.wrap(level).unwrap(), 14 | 7 << 16);
+    let field = a
+        .ground(level)
+        .unwrap()
+        .expect("the level lies on the hills")
+        .clone();
+    let plain = b.add_surface(a.surface(level).unwrap().clone()).unwrap();
+    let heights = HeightGrid {
+        columns: 64,
+        rows: 48,
+        heights: field.ground.clone(),
+    };
+    b.set_ground(plain, &Ground::Grid(heights), SlopeRule::default())
+        .unwrap();
+    assert_eq!(b.ground(plain).unwrap().unwrap(), &field);
+    // The field follows the hills at the texels' world centres.
+    let o = t.origin(0).unwrap();
+    for (c, r) in [(0u32, 0u32), (40, 20), (63, 47)] {
+        let (x, z) = (
+            (o[0] + c as i64) as f32 * 0.04 + 0.02,
+            (o[1] + r as i64) as f32 * 0.04 + 0.02,
+        );
+        let g = field.ground[(r * 64 + c) as usize];
+        assert!(
+            (g - hills(x, z)).abs() < 0.01,
+            "texel ({c}, {r}): {g} against {}",
+            hills(x, z)
+        );
+    }
+    for d in walk() {
+        let p = d.pose.position + Vec3::new(0.4, 0.0, 1.2);
+        let p = Vec3::new(p.x, p.y + hills(p.x, p.z), p.z);
+        let d = Deformer {
+            pose: Pose::at(p.to_array()),
+            ..d
+        };
+        a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    let (la, lb) = (
+        a.read_channels(level).unwrap(),
+        b.read_channels(plain).unwrap(),
+    );
+    assert!(
+        la.0.iter().filter(|&&v| v > 65535 / 4).count() > 100,
+        "the walk on the hills pressed little"
+    );
+    assert_eq!(la, lb, "the level on hills and the plain surface differ");
+}
+
+/// `[[terrain]]`'s ground keys: a raw f32 grid laid over `ground_rect`, with the slope rule.
+#[test]
+fn scene_keys_lay_a_terrain_on_a_grid() {
+    use snowprint::scene::Scene;
+    let dir = std::env::temp_dir().join(format!("snowprint-window-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let heights: Vec<f32> = (0..12).map(|i| i as f32 * 0.25).collect();
+    std::fs::write(dir.join("hills.f32"), bytemuck::cast_slice(&heights)).unwrap();
+    let text = "version = 1\n\n[[terrain]]\nname = \"hills\"\nsnow_depth = 0.3\n\
+                levels = [{ texels = [64, 64], texel_size = 0.05 }]\nground = \"hills.f32\"\n\
+                ground_grid = [4, 3]\nground_rect = [-8, -2, 12, 4]\nbare_slope_degrees = 70\n";
+    std::fs::write(dir.join("hills.toml"), text).unwrap();
+    let scene = Scene::load(&dir.join("hills.toml")).unwrap();
+    let g = scene.terrains[0].desc.ground.as_ref().expect("a ground");
+    assert_eq!(
+        (g.grid.columns, g.grid.rows, &g.grid.heights),
+        (4, 3, &heights)
+    );
+    assert_eq!((g.origin, g.size), ([-8.0, -2.0], [20.0, 6.0]));
+    assert_eq!((g.slope.full_degrees, g.slope.bare_degrees), (35.0, 70.0));
+    let bad = text.replace(
+        "ground_rect = [-8, -2, 12, 4]",
+        "ground_rect = [12, -2, -8, 4]",
+    );
+    std::fs::write(dir.join("bad.toml"), bad).unwrap();
+    let e = Scene::load(&dir.join("bad.toml")).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.toml:9: terrain \"hills\" has ground_rect [12, -2, -8, 4]"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
