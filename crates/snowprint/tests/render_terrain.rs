@@ -204,6 +204,56 @@ fn keep(name: &str, out: &RenderOutput) {
     }
 }
 
+/// A camera standing inside a surface's box (on ground that rises metres across a valley the box
+/// is metres tall) sees the snow: the box's back faces are drawn, the rays starting at the eye.
+#[test]
+fn a_camera_inside_the_box_sees_the_snow() {
+    let mut scene = scene(true, true);
+    scene.renderer.set_tier(Tier::Relief);
+    let slope = patches()[0].desc.clone();
+    // 0.3 m above the local snow top, half way up the plane: inside its box, which runs from the
+    // lowest base to the highest top plus the ankle room.
+    let x = 0.3;
+    let top = plane(x, 0.0) + DEPTH;
+    let eye = slope.center + Vec3::new(x, top + 0.3, 0.0);
+    assert!(
+        top + 0.3 < plane(1.2, 0.0) + DEPTH,
+        "the eye must be inside the box"
+    );
+    let mut frame = |surfaces: &[(SurfaceId, GroundMaterial)]| {
+        let frame = RenderFrame {
+            camera: Camera {
+                eye,
+                target: slope.center + Vec3::new(-0.9, plane(-0.9, 0.0), 0.0),
+                fov_y_degrees: 60.0,
+            },
+            time: 1.0,
+            surfaces,
+            instances: &scene.instances,
+            lights: &[],
+            environment: Environment::moonlit_night(),
+            snowfall: false,
+        };
+        scene
+            .renderer
+            .render(&scene.world, &frame)
+            .expect("render")
+            .rgba8
+    };
+    let with = frame(&[(scene.surfaces[0], GroundMaterial::Concrete)]);
+    let without = frame(&[]);
+    let differ = with
+        .chunks_exact(4)
+        .zip(without.chunks_exact(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    let share = differ as f32 / (with.len() / 4) as f32;
+    assert!(
+        share > 0.5,
+        "only {share} of the pixels show the snow the eye stands in"
+    );
+}
+
 /// Mean luminance (0 to 255) over the slope patch's part of the image, and the share of its pixels
 /// that differ from their right neighbour by more than 40 (speckle).
 fn slope_patch(out: &RenderOutput) -> (f32, f32) {

@@ -16,8 +16,9 @@ pub const STATE_HEIGHTFIELD_DISPATCH: u64 = 8;
 pub const STATE_TOUCHED: u64 = crate::wgsl::consts::STATE_TOUCHED as u64;
 /// Offset of the deepest depression (an f32 fraction of the snow depth, as bits).
 pub const STATE_DEEPEST: u64 = 12;
-/// Vertices of a surface's box: five faces of two triangles (no bottom).
-pub const BOX_VERTICES: u32 = 30;
+/// Vertices of a surface's box: six faces of two triangles (the bottom for a camera inside the
+/// box, looking down through it).
+pub const BOX_VERTICES: u32 = 36;
 /// Alignment of uniform blocks addressed by offset.
 pub const UNIFORM_STRIDE: u64 = crate::gpu::resources::UNIFORM_STRIDE;
 /// Spacing of the per-surface [`SurfaceUniform`] blocks in the snow pass's buffer, bytes: two

@@ -5,9 +5,11 @@
 //! cross by the cabin and the lake, and the cameras follow the hiker, look over the valley, and
 //! watch the loop close over the start of its own trail.
 //!
-//! The snow lies on the ground: every surface is laid on the valley's heights (`terrain.rs`) or
-//! on the roof's mesh, so prints are measured from the local snow top and never dig into the
-//! ground ([`snowprint::Ground`]).
+//! The snow lies on the ground: the valley is a terrain-wide layer ([`snowprint::Terrain`]) on
+//! its heights (`terrain.rs`) whose windows follow the hiker (a near level of 1024^2 texels of
+//! 5 cm, a far one of 512^2 of 40 cm): the start of the loop is paged out of the near level while
+//! the hiker is away and paged back in when it returns; the cabin's roof is a surface laid on its
+//! mesh. Prints are measured from the local snow top and never dig into the ground.
 
 mod hike;
 mod props;
@@ -16,7 +18,7 @@ pub mod terrain;
 
 use glam::{Vec2, Vec3};
 use snowprint::render::{Instance, PointLight, Renderer};
-use snowprint::{Camera, Deformer, GroundMaterial, SnowWorld, SurfaceId};
+use snowprint::{Camera, Deformer, GroundMaterial, SnowWorld, SurfaceId, Terrain};
 
 use super::DemoScene;
 use super::standin::body::BodyMeshes;
@@ -35,6 +37,7 @@ const CAMERAS: &[&str] = &["follow", "overview", "closing"];
 
 /// The mountain, ready to simulate and draw.
 pub struct Mountain {
+    valley: Terrain,
     surfaces: Vec<(SurfaceId, GroundMaterial)>,
     statics: Vec<Instance>,
     lights: Vec<PointLight>,
@@ -71,12 +74,12 @@ fn walk_plane(p: Vec2) -> f32 {
 impl Mountain {
     /// Build the valley: its snow into `world`, its meshes into `renderer`.
     pub fn new(world: &mut SnowWorld, renderer: &mut Renderer) -> Result<Self, String> {
-        let surfaces = snow::lay(world)?;
         let hiker = {
             let path = Path::through(&loop_controls(), true);
             let seconds = path.length() / HIKING + 4.0;
             Hiker::new(path, 0.0, HIKING, 0.0, seconds)
         };
+        let (valley, surfaces) = snow::lay(world, focus(&hiker, 0.0))?;
         let walkers = walkers();
         let clear = |p: Vec2| {
             let near = |h: &Hiker| {
@@ -86,6 +89,7 @@ impl Mountain {
         };
         let statics = props::build(renderer, clear)?;
         Ok(Self {
+            valley,
             surfaces,
             statics,
             lights: props::lights(),
@@ -93,6 +97,11 @@ impl Mountain {
             walkers,
             body: body_meshes(renderer)?,
         })
+    }
+
+    /// The valley's snow (its levels' surfaces, what scrolling cost).
+    pub fn valley(&self) -> &Terrain {
+        &self.valley
     }
 
     /// The seconds the hiker takes to close the loop.
@@ -103,6 +112,12 @@ impl Mountain {
     fn everyone(&self) -> impl Iterator<Item = &Hiker> {
         std::iter::once(&self.hiker).chain(&self.walkers)
     }
+}
+
+/// Where the windows centre: on the hiker, at the snow's top under it.
+fn focus(hiker: &Hiker, t: f32) -> Vec3 {
+    let (p, _) = hiker.position(t);
+    Vec3::new(p.x, snow::top(p), p.y)
 }
 
 /// Two walkers by the cabin and one across the lake's ice, out and back.
@@ -135,6 +150,9 @@ impl DemoScene for Mountain {
     }
 
     fn advance(&mut self, world: &mut SnowWorld, t0: f32, t1: f32) -> Result<(), String> {
+        self.valley
+            .follow(world, focus(&self.hiker, t1))
+            .map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         for h in self.everyone() {
             let a = h.skeleton(t0, &walk_plane).shapes();

@@ -38,7 +38,7 @@ impl SnowPass {
         let layout =
             crate::wgsl::SURFACE.bind_group_layout_for(device, "snow surface", 1, filterable);
         let module = pipeline::shader(device, "surface.wgsl", crate::wgsl::SURFACE.wgsl());
-        let snow = |label, vs, fs, constants| {
+        let snow = |label, vs, fs, constants, primitive| {
             pipeline::Raster {
                 label,
                 module: &module,
@@ -46,19 +46,28 @@ impl SnowPass {
                 fs,
                 buffers: &[],
                 groups: &[frame_layout, &layout],
-                primitive: pipeline::back_culled(),
+                primitive,
                 depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
                 targets: &pipeline::hdr_target(),
                 constants,
             }
             .build(device)
         };
-        let basic = snow("snow basic", "vs_surface", "fs_basic", &[]);
+        let basic = snow(
+            "snow basic",
+            "vs_surface",
+            "fs_basic",
+            &[],
+            pipeline::back_culled(),
+        );
+        // Both sides: `fs_deformable` keeps the front faces of a box seen from outside and the back
+        // faces of one seen from inside.
         let deformable = snow(
             "snow deformable",
             "vs_surface_deformable",
             "fs_deformable",
             pipeline::manual_filter(filterable),
+            wgpu::PrimitiveState::default(),
         );
         Self {
             uniforms: Growable::new(

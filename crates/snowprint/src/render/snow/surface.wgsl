@@ -23,8 +23,9 @@
 // Set when the device cannot filter Rgba16Float: bilinear filtering is then done by hand.
 override MANUAL_FILTER: bool = false;
 
-// Corners of the five visible faces of the box (no bottom): face k uses vertices 6k..6k+5. The
-// deformable material's box rises `rim_room` above the snow top, the room for rims.
+// Corners of the six faces of the box: face k uses vertices 6k..6k+5. The deformable material's
+// box rises `rim_room` above the snow top, the room for rims. The bottom is seen only from inside
+// the box (a camera standing in a valley's box, looking down at the snow through it).
 fn box_vertex(i: u32, rim_room: f32) -> array<vec3<f32>, 2> {
     let face = i / 6u;
     let corner = array<vec2<f32>, 6>(
@@ -56,9 +57,14 @@ fn box_vertex(i: u32, rim_room: f32) -> array<vec3<f32>, 2> {
             p = vec3<f32>(a.x * hx, y, hz);
             n = vec3<f32>(0.0, 0.0, 1.0);
         }
-        default: {
+        case 4u: {
             p = vec3<f32>(-a.x * hx, y, -hz);
             n = vec3<f32>(0.0, 0.0, -1.0);
+        }
+        // Bottom: counter-clockwise seen from below.
+        default: {
+            p = vec3<f32>(a.x * hx, surface.terrain_low, a.y * hz);
+            n = vec3<f32>(0.0, -1.0, 0.0);
         }
     }
     return array<vec3<f32>, 2>(p, n);
@@ -252,14 +258,24 @@ struct SnowOut {
 
 // The deformable snow material (the talk's second material): relief mapping (or POM), the two
 // stages blended by the heightmap, RNM normals, fake SSS, occlusion from the heightmap.
+//
+// Both sides of the box are rasterised: from outside it, its front faces, the ray entering where
+// the face is; from inside it (a camera standing in a valley's box, metres tall), its back faces,
+// the ray starting at the eye. The other side's fragments are discarded.
 @fragment
-fn fs_deformable(in: SurfaceVarying) -> SnowOut {
+fn fs_deformable(in: SurfaceVarying, @builtin(front_facing) front: bool) -> SnowOut {
     // Footprint of the pixel on the surface, before any non-uniform control flow.
     let pixel = length(fwidth(in.local));
     let eye = (surface.world_to_local * vec4<f32>(frame.eye.xyz, 1.0)).xyz;
+    let top = snow_top(surface);
+    let inside = all(abs(eye.xz) <= surface.half_size) && eye.y >= surface.terrain_low && eye.y <= top;
+    if front == inside {
+        discard;
+    }
+    let o = select(in.local, eye, inside);
     let d = normalize(in.local - eye);
     let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
-    let hit = snow_trace(surface, in.local, d, frame.options.z, moon);
+    let hit = snow_trace(surface, o, d, frame.options.z, moon);
     // Where a finer terrain window level draws, this one does not (`SnowSurface::hole`).
     if hit.found == 0u || snow_in_hole(surface, hit.position.xz) {
         discard;
