@@ -322,10 +322,11 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
     // Interrupt the second run once its staging folder exists: its set is staged (the folder is
     // made before the first frame and published by one rename after the last file). Waiting for
     // files in it caught the writing itself only when the test ran alone: in a full clean-clone
-    // run every dump finished unseen.
+    // run every dump finished unseen. With two frames the run also outran the signal in a clean
+    // clone (twenty times in a row): forty frames keep it staging long after the folder appears.
     let mut interrupted = false;
     for _attempt in 0..20 {
-        let mut child = run("2");
+        let mut child = run("40");
         let staging = dump.join(format!(".snowprint-dump-partial-{}", child.id()));
         let start = std::time::Instant::now();
         let mut writing = false;
@@ -360,7 +361,7 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
                     1,
                     "the interrupted run's staging"
                 ),
-                2 => {}
+                40 => {}
                 other => panic!("frames {other}"),
             }
             break;
