@@ -5,7 +5,7 @@
 //! near level's texels taken before the scroll.
 
 use super::strip::{Direction, StripParams};
-use super::{InFlight, Level, Terrain, plan};
+use super::{Level, Terrain, plan};
 use crate::error::Result;
 use crate::world::SnowWorld;
 
@@ -51,22 +51,7 @@ impl Terrain {
         if dispatches.is_empty() {
             return Ok(());
         }
-        let mut enc = world.device().create_command_encoder(&Default::default());
-        let read = self.strips.encode(
-            world.device(),
-            world.queue(),
-            &mut enc,
-            world.pool_buffer(),
-            &dispatches,
-            &incoming,
-        );
-        world.queue().submit([enc.finish()]);
-        read.submitted();
-        self.in_flight.push_back(InFlight {
-            read,
-            leaving: Vec::new(),
-            fold: true,
-        });
+        self.submit_strips(world, &dispatches, &incoming, Vec::new(), true);
         Ok(())
     }
 }

@@ -347,22 +347,7 @@ impl Terrain {
                 wrap = step.wrap;
             }
         }
-        let mut enc = world.device().create_command_encoder(&Default::default());
-        let read = self.strips.encode(
-            world.device(),
-            world.queue(),
-            &mut enc,
-            world.pool_buffer(),
-            &dispatches,
-            &incoming,
-        );
-        world.queue().submit([enc.finish()]);
-        read.submitted();
-        self.in_flight.push_back(InFlight {
-            read,
-            leaving,
-            fold: false,
-        });
+        self.submit_strips(world, &dispatches, &incoming, leaving, false);
         for (i, to, steps) in &moves {
             let l = &mut self.levels[*i];
             l.origin = *to;
@@ -394,6 +379,35 @@ impl Terrain {
     }
 
     /// Whether a strip of level `level` still on its way overlaps world texels of `strip`.
+    /// Record `dispatches` of the strips' pass (with `incoming`, the words that enter) in a
+    /// submission of their own and keep its readback in flight: a scroll's (`leaving` the strips
+    /// read back, in order) or a fold's.
+    fn submit_strips(
+        &mut self,
+        world: &SnowWorld,
+        dispatches: &[(Direction, StripParams)],
+        incoming: &[u32],
+        leaving: Vec<(usize, plan::Strip)>,
+        fold: bool,
+    ) {
+        let mut enc = world.device().create_command_encoder(&Default::default());
+        let read = self.strips.encode(
+            world.device(),
+            world.queue(),
+            &mut enc,
+            world.pool_buffer(),
+            dispatches,
+            incoming,
+        );
+        world.queue().submit([enc.finish()]);
+        read.submitted();
+        self.in_flight.push_back(InFlight {
+            read,
+            leaving,
+            fold,
+        });
+    }
+
     fn in_flight_overlaps(&self, level: usize, strip: &plan::Strip) -> bool {
         let span = |s: &plan::Strip| {
             let (x0, z0) = (s.world[0], s.world[1]);
