@@ -115,9 +115,15 @@ impl Deformer {
 
     /// Check sizes and poses are finite and positive where they must be.
     pub fn validate(&self, name: &str) -> Result<()> {
+        self.validate_named(|| name.to_owned())
+    }
+
+    /// [`Self::validate`] naming the deformer only when it is refused (a world checks every
+    /// deformer of every frame: formatting each name costs more than the check).
+    pub(crate) fn validate_named(&self, name: impl Fn() -> String) -> Result<()> {
         let bad = |what: &'static str, value: String, expected: &'static str| {
             Err(SnowError::InvalidDeformer {
-                name: name.to_owned(),
+                name: name(),
                 what,
                 value,
                 expected,

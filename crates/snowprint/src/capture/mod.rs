@@ -314,6 +314,27 @@ impl CaptureVolume {
     }
 }
 
+/// A world-space ball holding an analytic deformer at every pose of its motion (the positions
+/// move on a straight line from `previous` to `pose`), a little larger than needed so that
+/// rounding never leaves out a primitive the exact tests would keep; `None` for a mesh.
+pub fn swept_ball(deformer: &Deformer) -> Option<(Vec3, f32)> {
+    let reach = match deformer.shape {
+        Shape::Sphere { radius } => radius,
+        Shape::Capsule {
+            radius,
+            half_height,
+        } => radius + half_height,
+        Shape::Box { half_extents } => half_extents.length(),
+        Shape::Mesh(_) => return None,
+    };
+    let (a, b) = (
+        deformer.previous.unwrap_or(deformer.pose).position,
+        deformer.pose.position,
+    );
+    let radius = 0.5 * a.distance(b) + reach;
+    Some(((a + b) * 0.5, radius * 1.001 + 1e-4))
+}
+
 /// Number of sub-steps for a motion of `distance` metres by a shape whose smallest feature is
 /// `feature` metres: steps no longer than half the feature, at most [`MAX_SUBSTEPS`].
 pub fn substeps(distance: f32, feature: f32) -> u32 {
@@ -345,6 +366,13 @@ pub fn mesh_substeps(a: &Pose, b: &Pose, radius: f32) -> u32 {
 /// Append the analytic primitives of one deformer, in the local frame of `volume`, culled against
 /// it. Meshes append nothing (they are drawn separately).
 pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Vec<GpuPrimitive>) {
+    // Most deformers of a world are far from most of its surfaces: one ball around the whole
+    // motion rules them out before any primitive is built.
+    if let Some((center, radius)) = swept_ball(deformer)
+        && !volume.overlaps_ball(center, radius)
+    {
+        return;
+    }
     let m = volume.world_to_local;
     let (_, local_rot, _) = m.to_scale_rotation_translation();
     let prev = deformer.previous.unwrap_or(deformer.pose);
@@ -626,6 +654,56 @@ pub fn pack_atlas_compact(rects: &[(u32, u32)], max_side: u32) -> (Vec<AtlasPlac
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    fn shape_of(kind: u8, a: f32, b: f32, c: f32) -> Shape {
+        match kind {
+            0 => Shape::Sphere { radius: a },
+            1 => Shape::Capsule {
+                radius: a,
+                half_height: b,
+            },
+            _ => Shape::Box {
+                half_extents: Vec3::new(a, b, c),
+            },
+        }
+    }
+
+    proptest! {
+        /// The ball that rules a deformer out holds every primitive of its motion (their bounds,
+        /// which the exact test reads): culling by it never leaves out what would be captured.
+        #[test]
+        fn the_swept_ball_holds_every_primitive(
+            kind in 0u8..3,
+            (a, b, c) in (0.01f32..2.0, 0.01f32..2.0, 0.01f32..2.0),
+            from in prop::array::uniform3(-50.0f32..50.0),
+            step in prop::array::uniform3(-3.0f32..3.0),
+            (q0, q1) in (prop::array::uniform4(-1.0f32..1.0), prop::array::uniform4(-1.0f32..1.0)),
+        ) {
+            let rot = |q: [f32; 4]| {
+                let q = glam::Quat::from_array(q);
+                if q.length() < 1e-3 { glam::Quat::IDENTITY } else { q.normalize() }
+            };
+            let p0 = Pose { position: Vec3::from(from), rotation: rot(q0) };
+            let p1 = Pose { position: Vec3::from(from) + Vec3::from(step), rotation: rot(q1) };
+            let d = Deformer::moving(shape_of(kind, a, b, c), p0, p1);
+            let everywhere = CaptureVolume {
+                world_to_local: Mat4::IDENTITY,
+                half_size: glam::Vec2::splat(1e4),
+                frustum_height: 2e4,
+                ground: (-1e4, 0.0),
+            };
+            let mut prims = Vec::new();
+            push_primitives(&d, &everywhere, &mut prims);
+            prop_assert!(!prims.is_empty());
+            let (centre, radius) = swept_ball(&d).unwrap();
+            for p in &prims {
+                let (lo, hi) = p.bounds();
+                prop_assert!(lo.cmpge(centre - radius).all() && hi.cmple(centre + radius).all(),
+                    "{lo} {hi} outside {centre} +- {radius}");
+            }
+        }
+    }
 
     /// The view and the primitive have the Rust side's sizes (`prims.wgsl` reads the view word by
     /// word, in its fields' order; `tests/capture_paths.rs` holds it to the raster path).

@@ -11,7 +11,7 @@
 //! comes down into an older print lands when it passes that height, and its depth is measured from
 //! it, at most the snow the texel holds.
 
-use glam::{Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::SurfaceUpdate;
 use crate::deformer::{Pose, Shape};
@@ -90,8 +90,8 @@ fn lowest_vertex(vertices: &[Vec3], pose: &Pose) -> Option<Vec3> {
 }
 
 /// Whether a world point lies over a surface's rectangle (its yawed local frame).
-pub fn over_surface(desc: &SurfaceDesc, point: Vec3) -> bool {
-    let local = desc.world_to_local().transform_point3(point);
+fn over_local(desc: &SurfaceDesc, world_to_local: &Mat4, point: Vec3) -> bool {
+    let local = world_to_local.transform_point3(point);
     let half = desc.size * 0.5;
     Vec2::new(local.x, local.z).abs().cmple(half).all()
 }
@@ -107,16 +107,29 @@ pub fn landing<'a>(
     elapsed: f32,
     mesh_vertices: impl Fn(MeshId) -> Option<&'a [Vec3]> + Copy,
 ) -> Option<(Vec3, f32, f32)> {
-    landing_on(desc, None, shape, previous, pose, elapsed, mesh_vertices)
+    let m = desc.world_to_local();
+    landing_on(
+        (desc, &m),
+        None,
+        shape,
+        previous,
+        pose,
+        elapsed,
+        mesh_vertices,
+    )
 }
 
 /// The fresh snow top's world height over `point` and the snow depth it holds there: the flat
 /// surface's, or on a ground field the local top of the texel under the point.
-fn top_over(desc: &SurfaceDesc, ground: Option<&GroundField>, point: Vec3) -> (f32, f32) {
+fn top_over(
+    (desc, world_to_local): (&SurfaceDesc, &Mat4),
+    ground: Option<&GroundField>,
+    point: Vec3,
+) -> (f32, f32) {
     let Some(g) = ground else {
         return (desc.center.y + desc.snow_depth, desc.snow_depth);
     };
-    let local = desc.world_to_local().transform_point3(point);
+    let local = world_to_local.transform_point3(point);
     let cell = |v: f32, side: f32, n: u32| {
         (((v / side + 0.5) * n as f32).floor().max(0.0) as u32).min(n - 1)
     };
@@ -131,10 +144,11 @@ fn top_over(desc: &SurfaceDesc, ground: Option<&GroundField>, point: Vec3) -> (f
     )
 }
 
-/// [`landing`] on a surface that may lie on a ground field.
+/// [`landing`] on a surface (given with its world-to-local transform) that may lie on a ground
+/// field.
 #[allow(clippy::too_many_arguments)]
 pub fn landing_on<'a>(
-    desc: &SurfaceDesc,
+    (desc, world_to_local): (&SurfaceDesc, &Mat4),
     ground: Option<&GroundField>,
     shape: &Shape,
     previous: &Pose,
@@ -144,10 +158,10 @@ pub fn landing_on<'a>(
 ) -> Option<(Vec3, f32, f32)> {
     // The current pose first: a deformer above the snow or beside the surface needs no more.
     let now = lowest_point(shape, pose, mesh_vertices)?;
-    if !over_surface(desc, now) {
+    if !over_local(desc, world_to_local, now) {
         return None;
     }
-    let (top, held) = top_over(desc, ground, now);
+    let (top, held) = top_over((desc, world_to_local), ground, now);
     if now.y >= top {
         return None;
     }
@@ -178,12 +192,13 @@ pub fn footsteps<'a, 'm>(
         let Some((d, ground)) = desc(u.surface) else {
             continue;
         };
+        let m = d.world_to_local();
         for (i, deformer) in u.deformers.iter().enumerate() {
             let Some(previous) = deformer.previous.as_ref() else {
                 continue;
             };
             if let Some((point, depth_m, speed)) = landing_on(
-                d,
+                (d, &m),
                 ground,
                 &deformer.shape,
                 previous,
@@ -298,7 +313,15 @@ mod tests {
         );
         // Yawed 90 degrees, the 2 m side runs along world z.
         desc.yaw_degrees = 90.0;
-        assert!(over_surface(&desc, Vec3::new(0.0, 1.0, 0.9)));
-        assert!(!over_surface(&desc, Vec3::new(0.9, 1.0, 0.0)));
+        assert!(over_local(
+            &desc,
+            &desc.world_to_local(),
+            Vec3::new(0.0, 1.0, 0.9)
+        ));
+        assert!(!over_local(
+            &desc,
+            &desc.world_to_local(),
+            Vec3::new(0.9, 1.0, 0.0)
+        ));
     }
 }

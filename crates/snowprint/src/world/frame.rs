@@ -91,7 +91,7 @@ impl SnowWorld {
             return Err(SnowError::InvalidTimeStep { dt });
         }
         for (i, d) in deformers.iter().enumerate() {
-            d.validate(&format!("#{i}"))?;
+            d.validate_named(|| format!("#{i}"))?;
         }
         let updates: Vec<SurfaceUpdate<'_>> = self
             .surfaces()
@@ -313,6 +313,8 @@ impl SnowWorld {
     }
 
     fn validate_with(&self, updates: &[SurfaceUpdate<'_>], seen: &mut [bool]) -> Result<()> {
+        // `encode_step` hands every surface the same list: check a list once, not once a surface.
+        let mut checked: Option<(*const Deformer, usize)> = None;
         for u in updates {
             let dt = u.elapsed;
             if !(dt.is_finite() && dt >= 0.0) {
@@ -324,8 +326,13 @@ impl SnowWorld {
                 return Err(SnowError::DuplicateUpdate { index: u.surface.0 });
             }
             *flag = true;
+            let list = (u.deformers.as_ptr(), u.deformers.len());
+            if checked == Some(list) {
+                continue;
+            }
+            checked = Some(list);
             for (i, d) in u.deformers.iter().enumerate() {
-                d.validate(&format!("#{i}"))?;
+                d.validate_named(|| format!("#{i}"))?;
                 if let Shape::Mesh(id) = d.shape
                     && self
                         .meshes

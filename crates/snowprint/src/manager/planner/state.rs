@@ -158,7 +158,7 @@ impl Planner {
                 .chain(&s.applied)
                 .enumerate()
             {
-                d.validate(&format!("{} imprint #{k}", s.desc.name))?;
+                d.validate_named(|| format!("{} imprint #{k}", s.desc.name))?;
                 p.sweep_of(d)?;
             }
             let st = &mut p.status[i];

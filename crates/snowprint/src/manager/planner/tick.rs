@@ -81,7 +81,7 @@ impl Planner {
         sweeps.clear();
         for (i, d) in deformers.iter().enumerate() {
             if !plausible(&d.deformer) {
-                d.deformer.validate(&format!("#{i}"))?;
+                d.deformer.validate_named(|| format!("#{i}"))?;
             }
             sweeps.push(self.sweep_of(&d.deformer)?);
         }

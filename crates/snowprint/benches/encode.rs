@@ -1,0 +1,114 @@
+//! CPU time to plan and record a world's update, without submitting it: `SnowWorld::encode_step`
+//! and `encode_update` into an encoder that is dropped, the frame then abandoned. Two ways to
+//! hand deformers over for N surfaces of 128^2 with 10 moving spheres each: one shared list of all
+//! of them (`encode_step`, every surface offered every deformer) and a list per surface
+//! (`encode_update`, what `snowprint bench` does).
+//!
+//! `cargo bench -p snowprint --bench encode` (add `-- --quick` for a software adapter).
+//! Results: `docs/PERFORMANCE.md`, "CPU encode".
+
+use std::time::Instant;
+
+use snowprint::{
+    Deformer, GpuContext, GpuOptions, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
+    SurfaceUpdate, WorldConfig,
+};
+
+const SPHERES: u32 = 10;
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+fn world(gpu: &GpuContext, surfaces: u32) -> (SnowWorld, Vec<(SurfaceId, [f32; 3])>) {
+    let metres = 4.0;
+    let mut world = SnowWorld::new(
+        gpu,
+        WorldConfig {
+            pool_bytes: 128 * 128 * 4 * surfaces as u64,
+            atlas_side: 8192.min(gpu.caps.max_texture_side),
+            ..Default::default()
+        },
+    )
+    .expect("world");
+    let ids = (0..surfaces)
+        .map(|i| {
+            let c = [
+                (i % 64) as f32 * (metres + 1.0),
+                0.0,
+                (i / 64) as f32 * (metres + 1.0),
+            ];
+            let desc = SurfaceDesc::new(&format!("s{i}"), c, [metres, metres], 0.3);
+            (world.add_surface(desc).expect("surface"), c)
+        })
+        .collect();
+    (world, ids)
+}
+
+/// Each surface's spheres at time `t`, moving along a small Lissajous curve over it.
+fn spheres(c: [f32; 3], t: f32) -> impl Iterator<Item = Deformer> {
+    (0..SPHERES).map(move |k| {
+        let a = t + k as f32 * 0.9;
+        let at = |a: f32| Pose::at([c[0] + 1.6 * a.cos(), 0.3, c[2] + 1.6 * (a * 1.3).sin()]);
+        Deformer::moving(Shape::Sphere { radius: 0.15 }, at(a - 1.0 / 60.0), at(a))
+    })
+}
+
+/// Median milliseconds to encode a frame: (shared list, a list per surface).
+fn run(gpu: &GpuContext, surfaces: u32, frames: u32) -> (f64, f64) {
+    let (mut world, ids) = world(gpu, surfaces);
+    let (mut shared, mut each) = (Vec::new(), Vec::new());
+    for f in 0..frames {
+        let t = f as f32 / 60.0;
+        let all: Vec<Deformer> = ids.iter().flat_map(|&(_, c)| spheres(c, t)).collect();
+        let lists: Vec<Vec<Deformer>> = ids.iter().map(|&(_, c)| spheres(c, t).collect()).collect();
+        let updates: Vec<SurfaceUpdate<'_>> = ids
+            .iter()
+            .zip(&lists)
+            .map(|(&(surface, _), deformers)| SurfaceUpdate {
+                surface,
+                elapsed: 1.0 / 60.0,
+                deformers,
+            })
+            .collect();
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let start = Instant::now();
+        let pending = world
+            .encode_step(&mut encoder, 1.0 / 60.0, &all)
+            .expect("encode");
+        shared.push(start.elapsed().as_secs_f64() * 1e3);
+        drop((pending, encoder));
+        world.abandon_pending();
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        let start = Instant::now();
+        let pending = world.encode_update(&mut encoder, &updates).expect("encode");
+        each.push(start.elapsed().as_secs_f64() * 1e3);
+        drop((pending, encoder));
+        world.abandon_pending();
+    }
+    (median(&mut shared), median(&mut each))
+}
+
+fn main() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("GPU");
+    let quick = std::env::args().any(|a| a == "--quick");
+    let (counts, frames): (&[u32], u32) = if quick {
+        (&[16, 256, 1024], 5)
+    } else {
+        (&[16, 256, 1024, 4096], 30)
+    };
+    println!("encode on {}", gpu.info.name);
+    println!(
+        "{:<10} {:>16} {:>16}",
+        "surfaces", "shared_list_ms", "per_surface_ms"
+    );
+    for &n in counts {
+        let (shared, each) = run(&gpu, n, frames);
+        println!("{n:<10} {shared:>16.3} {each:>16.3}");
+    }
+}
