@@ -2,7 +2,9 @@
 //! comes back to find its trail as a window that never scrolled keeps it; a scroll by k columns
 //! writes exactly the entering strip's bytes and nothing else in the pool; wrapped and unwrapped
 //! storage give the same logical heightmap; the far level keeps the trail's broad shape after the
-//! near one paged it out; refusals in one sentence.
+//! near one paged it out; a level on hills moves its ground field as laying it whole at the new
+//! origin would, bit for bit, writing only its part of the ground buffers; refusals in one
+//! sentence.
 
 mod common;
 
