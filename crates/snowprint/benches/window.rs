@@ -7,6 +7,9 @@
 //! copying both levels whole, out and back (`copy_buffer_to_buffer` of their 5 MiB at 16 bits),
 //! every frame it moves.
 //!
+//! And the CPU that moving the levels' ground fields costs: the same levels on hills, followed
+//! one near texel a call with no update in between.
+//!
 //! `cargo bench -p snowprint --bench window -- --warm-up-time 1 --measurement-time 10`.
 //! Each iteration runs 60 frames (a second of walking); divide by 60 for a frame.
 //! Results: `docs/PERFORMANCE.md`, "The sliding window".
@@ -16,8 +19,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use snowprint::{
-    Deformer, GpuContext, GpuOptions, LevelDesc, Material, Pose, Shape, SnowWorld, Terrain,
-    TerrainDesc, WorldConfig,
+    Deformer, GpuContext, GpuOptions, HeightGrid, LevelDesc, Material, Pose, Shape, SlopeRule,
+    SnowWorld, Terrain, TerrainDesc, TerrainGround, WorldConfig,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -107,10 +110,60 @@ fn copies(world: &SnowWorld, scratch: &wgpu::Buffer, bytes: u64) {
     }
 }
 
+/// The terrain on hills: sine hills over 200 m x 200 m of the world, a grid of 257^2 heights.
+fn on_hills() -> TerrainDesc {
+    let n = 257u32;
+    let hill = |i: u32| {
+        let (x, z) = ((i % n) as f32 * 0.78, (i / n) as f32 * 0.78);
+        3.0 * (x * 0.05).sin() * (z * 0.04).cos() + 0.5 * (x * 0.6).sin()
+    };
+    TerrainDesc {
+        ground: Some(TerrainGround {
+            grid: HeightGrid {
+                columns: n,
+                rows: n,
+                heights: (0..n * n).map(hill).collect(),
+            },
+            origin: [-100.0, -100.0],
+            size: [200.0, 200.0],
+            slope: SlopeRule::default(),
+        }),
+        ..terrain()
+    }
+}
+
+/// The CPU of `Terrain::follow` on hills, the focus moving one near texel (5 cm) a call along x
+/// (the far level moves every eighth call), 60 calls; the strips' GPU work is left to run.
+fn follow_on_hills(world: &mut SnowWorld, terrain: &mut Terrain, x: &mut f32) {
+    for _ in 0..FRAMES {
+        *x += 0.05;
+        terrain
+            .follow(world, Vec3::new(*x, 0.0, 0.0))
+            .expect("follow");
+    }
+    terrain.flush(world).expect("flush");
+}
+
 fn window(c: &mut Criterion) {
     let gpu = GpuContext::new(&GpuOptions::default()).expect("GPU");
     let mut g = c.benchmark_group("window");
     g.sample_size(10);
+    {
+        let mut world = SnowWorld::new(
+            &gpu,
+            WorldConfig {
+                pool_bytes: 8 << 20,
+                ..WorldConfig::default()
+            },
+        )
+        .expect("world");
+        let mut terrain = Terrain::new(&mut world, on_hills(), Vec3::ZERO).expect("terrain");
+        let mut x = 0.0;
+        g.bench_function(
+            "1024^2 + 512^2 on hills, 60 follows of one near texel: follow only",
+            |b| b.iter(|| follow_on_hills(&mut world, &mut terrain, &mut x)),
+        );
+    }
     for (name, speed) in [("hiking 1.5 m/s", 1.5), ("running 5 m/s", 5.0)] {
         let mut walk = Walk::new(&gpu);
         g.bench_function(

@@ -2,7 +2,9 @@
 //! comes back to find its trail as a window that never scrolled keeps it; a scroll by k columns
 //! writes exactly the entering strip's bytes and nothing else in the pool; wrapped and unwrapped
 //! storage give the same logical heightmap; the far level keeps the trail's broad shape after the
-//! near one paged it out; refusals in one sentence.
+//! near one paged it out; a level on hills moves its ground field as laying it whole at the new
+//! origin would, bit for bit, writing only its part of the ground buffers; refusals in one
+//! sentence.
 
 mod common;
 
@@ -731,4 +733,152 @@ fn scene_keys_lay_a_terrain_on_a_grid() {
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A level of 60 x 44 texels of 4 cm (sizes at which resampling a laid grid again would not give
+/// the same heights) on sine hills with a steep ridge (bare at its flanks), followed along moves
+/// of 1, 2 and 7 texels in x, in z and diagonally, and one jump larger than the window: after
+/// every move its ground field (heights and columns) and its range are bit for bit those of the
+/// same level laid whole at that origin, a 2-column move writes only that level's part of the
+/// ground buffers (another surface on a ground lies before it there), and at the end a walk
+/// presses the moved level as it presses the level laid whole.
+#[test]
+fn a_level_on_hills_moves_its_ground_as_laying_it_whole_would() {
+    use snowprint::{Ground, HeightGrid, SlopeRule, SurfaceDesc, TerrainGround};
+    let ground = |x: f32, z: f32| {
+        let ridge = 1.2 * (1.0 - (x - 0.9).abs() / 0.25).max(0.0);
+        0.4 * (x * 0.9).sin() * (z * 0.7).cos() + ridge
+    };
+    let n = 121u32;
+    let grid = HeightGrid {
+        columns: n,
+        rows: n,
+        heights: (0..n * n)
+            .map(|i| ground(-6.0 + 0.1 * (i % n) as f32, -6.0 + 0.1 * (i / n) as f32))
+            .collect(),
+    };
+    let (texels, s) = ([60u32, 44u32], 0.04f32);
+    let desc = |name: &str| {
+        let mut d = terrain(name, &[(texels, s)]);
+        d.ground = Some(TerrainGround {
+            grid: grid.clone(),
+            origin: [-6.05, -6.05],
+            size: [12.1, 12.1],
+            slope: SlopeRule::default(),
+        });
+        d
+    };
+    // The focus whose window starts at world texel `o` (a quarter texel off the rounding's ties).
+    let focus = |o: [i64; 2]| {
+        let at = |k: usize| (o[k] as f32 + texels[k] as f32 / 2.0 + 0.25) * s;
+        Vec3::new(at(0), 0.0, at(1))
+    };
+    let bits = |f: &snowprint::GroundField| {
+        let g: Vec<u32> = f.ground.iter().map(|v| v.to_bits()).collect();
+        let c: Vec<[u32; 2]> = f.columns.iter().map(|c| c.map(f32::to_bits)).collect();
+        (g, c)
+    };
+    let mut a = world(Precision::Bits16);
+    let other = a
+        .add_surface(SurfaceDesc {
+            name: "roof".into(),
+            center: Vec3::new(10.0, 1.0, 10.0),
+            size: glam::Vec2::new(1.0, 1.0),
+            yaw_degrees: 0.0,
+            snow_depth: DEPTH,
+            replenish_rate: 0.0,
+            material: Material::snow(),
+        })
+        .unwrap();
+    let roof = HeightGrid {
+        columns: 2,
+        rows: 2,
+        heights: vec![0.0, 0.5, 0.2, 0.9],
+    };
+    a.set_ground(other, &Ground::Grid(roof), SlopeRule::default())
+        .unwrap();
+    let other_field = a.ground(other).unwrap().unwrap().clone();
+    let mut origin = [-20i64, -10];
+    let mut t = Terrain::new(&mut a, desc("hills"), focus(origin)).unwrap();
+    let level = t.surfaces()[0];
+    let placement = a.ground_placement(level).unwrap().unwrap();
+    assert!(placement.0 > 0, "the level's field lies after the roof's");
+    let mut bare = 0;
+    let moves: [[i64; 2]; 13] = [
+        [1, 0],
+        [0, 1],
+        [2, 0],
+        [0, -2],
+        [7, 0],
+        [0, 7],
+        [-1, -1],
+        [2, -2],
+        [-7, 7],
+        [7, 7],
+        [3, -5],
+        [97, -71],
+        [-2, 0],
+    ];
+    for (k, by) in moves.into_iter().enumerate() {
+        origin = [origin[0] + by[0], origin[1] + by[1]];
+        let written = a.ground_bytes_written();
+        t.follow(&mut a, focus(origin)).unwrap();
+        assert_eq!(t.origin(0).unwrap(), origin);
+        let mut b = world(Precision::Bits16);
+        let whole = Terrain::new(&mut b, desc("whole"), focus(origin)).unwrap();
+        assert_eq!(whole.origin(0).unwrap(), origin);
+        let (moved, laid) = (
+            a.ground(level).unwrap().unwrap(),
+            b.ground(whole.surfaces()[0]).unwrap().unwrap(),
+        );
+        assert!(
+            bits(moved) == bits(laid),
+            "move {k} by {by:?}: the fields differ"
+        );
+        let (pa, pb) = (
+            a.ground_placement(level).unwrap().unwrap(),
+            b.ground_placement(whole.surfaces()[0]).unwrap().unwrap(),
+        );
+        assert_eq!(
+            (pa.1.to_bits(), pa.2.to_bits()),
+            (pb.1.to_bits(), pb.2.to_bits())
+        );
+        assert_eq!(
+            pa.0, placement.0,
+            "the level's field moved in the ground buffer"
+        );
+        bare += moved.columns.iter().filter(|c| c[1] == DEPTH).count();
+        if by == [2, 0] || by == [-2, 0] {
+            let field_bytes = texels[0] as u64 * texels[1] as u64 * (8 + 4);
+            assert_eq!(a.ground_bytes_written() - written, field_bytes);
+        }
+    }
+    assert!(
+        bare > 100,
+        "the ridge bared only {bare} texels along the path"
+    );
+    assert_eq!(a.ground(other).unwrap().unwrap(), &other_field);
+    // The GPU reads the moved field where the whole one lies: a walk presses both alike.
+    let mut b = world(Precision::Bits16);
+    let whole = Terrain::new(&mut b, desc("whole"), focus(origin)).unwrap();
+    let o = focus(origin);
+    for d in walk() {
+        let p = d.pose.position + Vec3::new(o.x - 1.5, 0.0, o.z);
+        let p = Vec3::new(p.x, p.y + ground(p.x, p.z), p.z);
+        let d = Deformer {
+            pose: Pose::at(p.to_array()),
+            ..d
+        };
+        a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
+    let (la, lb) = (
+        a.read_channels(level).unwrap(),
+        b.read_channels(whole.surfaces()[0]).unwrap(),
+    );
+    assert!(
+        la.0.iter().filter(|&&v| v > 65535 / 4).count() > 100,
+        "the walk on the hills pressed little"
+    );
+    assert_eq!(la, lb, "the moved level and the level laid whole differ");
 }

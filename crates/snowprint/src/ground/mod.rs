@@ -243,11 +243,7 @@ impl GroundField {
         let texel = size / glam::Vec2::new(w as f32, h as f32);
         let columns = (0..h)
             .flat_map(|r| (0..w).map(move |c| (c, r)))
-            .map(|(c, r)| {
-                let degrees = slope_degrees(&ground, w, h, texel, c, r);
-                let bare = (1.0 - slope.holds(degrees)) * snow_depth;
-                [ground[(r * w + c) as usize] - bare, bare]
-            })
+            .map(|(c, r)| column_at(&ground, w, h, texel, c, r, snow_depth, slope))
             .collect();
         Self {
             width: w,
@@ -255,6 +251,50 @@ impl GroundField {
             ground,
             columns,
         }
+    }
+
+    /// Move the field's window by `by` texels (logical texel `(c, r)` becomes what was
+    /// `(c + by[0], r + by[1])`), in place: the heights that stay are moved, `sample(c, r)` gives
+    /// those of the texels that enter, and the columns are computed again only where they can
+    /// differ from [`GroundField::build`] on the moved heights: the entering strips, the texels
+    /// that were on an edge (their differences now reach into the strips) and those that now are
+    /// (one-sided there). The result is bit for bit `build`'s. `false`, and nothing changed, for
+    /// a move as large as the field (a jump): build it whole then.
+    pub(crate) fn scroll(
+        &mut self,
+        by: [i64; 2],
+        size: glam::Vec2,
+        snow_depth: f32,
+        slope: SlopeRule,
+        mut sample: impl FnMut(u32, u32) -> f32,
+    ) -> bool {
+        let (w, h) = (self.width, self.height);
+        let [dx, dz] = by;
+        if dx.unsigned_abs() >= w as u64 || dz.unsigned_abs() >= h as u64 {
+            return false;
+        }
+        shift(&mut self.ground, w, h, dx, dz);
+        shift(&mut self.columns, w, h, dx, dz);
+        let xs = entering(w, dx);
+        let zs = entering(h, dz);
+        for r in 0..h {
+            let cs = if zs.contains(&r) { 0..w } else { xs.clone() };
+            for c in cs {
+                self.ground[(r * w + c) as usize] = sample(c, r);
+            }
+        }
+        let texel = size / glam::Vec2::new(w as f32, h as f32);
+        let mut redo = |c: u32, r: u32| {
+            self.columns[(r * w + c) as usize] =
+                column_at(&self.ground, w, h, texel, c, r, snow_depth, slope);
+        };
+        for c in changed(w, dx) {
+            (0..h).for_each(|r| redo(c, r));
+        }
+        for r in changed(h, dz) {
+            (0..w).for_each(|c| redo(c, r));
+        }
+        true
     }
 
     /// Lowest base and highest ground: the capture volume reaches from the first to the second plus
@@ -281,6 +321,72 @@ pub fn sample_grid(grid: &HeightGrid, layout: SurfaceLayout) -> Vec<f32> {
         .flat_map(|r| (0..w).map(move |c| (c, r)))
         .map(|(c, r)| grid.sample((c as f32 + 0.5) / w as f32, (r as f32 + 0.5) / h as f32))
         .collect()
+}
+
+/// The `[base, bare]` column of texel `(c, r)` of ground heights `g` (`w x h` texels of
+/// `texel` metres) under snow `snow_depth` deep, bared by `slope`.
+#[allow(clippy::too_many_arguments)]
+fn column_at(
+    g: &[f32],
+    w: u32,
+    h: u32,
+    texel: glam::Vec2,
+    c: u32,
+    r: u32,
+    snow_depth: f32,
+    slope: SlopeRule,
+) -> [f32; 2] {
+    let degrees = slope_degrees(g, w, h, texel, c, r);
+    let bare = (1.0 - slope.holds(degrees)) * snow_depth;
+    [g[(r * w + c) as usize] - bare, bare]
+}
+
+/// Move a `w x h` row-major field by `(dx, dz)` in place: texel `(c, r)` takes what was at
+/// `(c + dx, r + dz)`; the texels that enter keep stale values, to be written.
+fn shift<T: Copy>(v: &mut [T], w: u32, h: u32, dx: i64, dz: i64) {
+    let (w, h) = (w as i64, h as i64);
+    let keep = (w - dx.abs()) as usize;
+    let (to, from) = (dx.min(0).unsigned_abs() as usize, dx.max(0) as usize);
+    let row = |r: i64| {
+        let from_row = r + dz;
+        (0..h).contains(&from_row).then_some((r * w) as usize)
+    };
+    // Rows in the order that reads each source row before it is written over.
+    let order: Box<dyn Iterator<Item = i64>> = if dz > 0 {
+        Box::new(0..h)
+    } else {
+        Box::new((0..h).rev())
+    };
+    for r in order {
+        if let Some(at) = row(r) {
+            let src = ((r + dz) * w) as usize + from;
+            v.copy_within(src..src + keep, at + to);
+        }
+    }
+}
+
+/// The logical texels along a side of `n` that enter when the window moves by `d` texels.
+fn entering(n: u32, d: i64) -> std::ops::Range<u32> {
+    let k = d.unsigned_abs() as u32;
+    if d >= 0 { n - k..n } else { 0..k }
+}
+
+/// The logical texels along a side of `n` whose column may change when the window moves by `d`:
+/// those that enter, those that were on an edge and those that are now. None when `d` is 0 (the
+/// texels along that side keep their neighbours).
+fn changed(n: u32, d: i64) -> Vec<u32> {
+    if d == 0 {
+        return Vec::new();
+    }
+    let old_edges = [0, n as i64 - 1].map(|e| e - d);
+    let mut v: Vec<u32> = entering(n, d)
+        .chain(old_edges.into_iter().filter_map(|e| u32::try_from(e).ok()))
+        .chain([0, n - 1])
+        .filter(|&c| c < n)
+        .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
 }
 
 /// Slope angle at texel `(c, r)`, degrees, from central differences of the heights (one-sided at
@@ -356,6 +462,66 @@ mod tests {
         for (i, c) in f.columns.iter().enumerate() {
             assert!((c[1] - 0.3).abs() < 1e-4, "{i}: {c:?}");
             assert!((c[0] - (g[i] - c[1])).abs() < 1e-6);
+        }
+    }
+
+    /// Every move of a 9 x 7 field on rough, steep ground (partly bared, partly bare) by up to
+    /// its size in each direction: the field scrolled in place is bit for bit the field built
+    /// whole at the new origin, and a move as large as the field is refused.
+    #[test]
+    fn a_scrolled_field_is_the_field_built_at_its_new_origin() {
+        let (w, h) = (9u32, 7u32);
+        let layout = SurfaceLayout {
+            width: w,
+            height: h,
+        };
+        let size = glam::Vec2::new(0.9, 0.7);
+        // Heights as a function of the world texel: hills and a hash-like roughness, 0.1 m texels.
+        let height = |x: i64, z: i64| {
+            let (x, z) = (x as f32, z as f32);
+            0.1 * (x * 0.7).sin()
+                + 0.05 * (z * 1.3).cos()
+                + 0.2 * ((x * 12.9898 + z * 78.233).sin() * 43758.5).fract()
+        };
+        let at = |o: [i64; 2]| {
+            let g = (0..h as i64)
+                .flat_map(|r| (0..w as i64).map(move |c| height(o[0] + c, o[1] + r)))
+                .collect();
+            GroundField::build(layout, size, g, 0.3, SlopeRule::default())
+        };
+        let whole = at([0, 0]);
+        assert!(whole.columns.iter().any(|c| c[1] == 0.3), "nothing bare");
+        assert!(
+            whole.columns.iter().any(|c| c[1] > 0.0 && c[1] < 0.3),
+            "nothing bared in part"
+        );
+        assert!(
+            whole.columns.iter().any(|c| c[1] == 0.0),
+            "nothing holds all its snow"
+        );
+        let (o0, o1) = (3i64, -5i64);
+        let start = at([o0, o1]);
+        for dz in -(h as i64)..=h as i64 {
+            for dx in -(w as i64)..=w as i64 {
+                let mut f = start.clone();
+                let to = [o0 + dx, o1 + dz];
+                let moved = f.scroll([dx, dz], size, 0.3, SlopeRule::default(), |c, r| {
+                    height(to[0] + c as i64, to[1] + r as i64)
+                });
+                if dx.abs() >= w as i64 || dz.abs() >= h as i64 {
+                    assert!(!moved, "({dx}, {dz}) is a jump");
+                    assert_eq!(f, start, "a refused jump changed the field");
+                    continue;
+                }
+                assert!(moved);
+                let want = at(to);
+                let bits = |f: &GroundField| {
+                    let g: Vec<u32> = f.ground.iter().map(|v| v.to_bits()).collect();
+                    let c: Vec<[u32; 2]> = f.columns.iter().map(|c| c.map(f32::to_bits)).collect();
+                    (g, c)
+                };
+                assert_eq!(bits(&f), bits(&want), "moved by ({dx}, {dz})");
+            }
         }
     }
 }

@@ -22,6 +22,7 @@ pub mod strip;
 use glam::{Vec2, Vec3};
 
 use crate::error::{Result, SnowError};
+use crate::ground::GroundField;
 use crate::material::Material;
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 use crate::world::SnowWorld;
@@ -64,8 +65,9 @@ pub struct TerrainDesc {
     /// World height of the ground under the snow, metres (of the flat ground, or the height the
     /// `ground`'s heights are measured from).
     pub ground_height: f32,
-    /// The ground when it is not flat. Each level's ground field is laid again, whole, when the
-    /// level moves (not only its entering strips).
+    /// The ground when it is not flat. When a level moves, its ground field moves with it: only
+    /// the entering strips are sampled and the slopes next to them and on its edges computed
+    /// again (a jump larger than the window lays it whole).
     pub ground: Option<TerrainGround>,
     /// Depth of fresh snow, metres.
     pub snow_depth: f32,
@@ -195,32 +197,47 @@ impl Terrain {
         Ok(terrain)
     }
 
-    /// Lay level `i` on the terrain's ground where its window stands (nothing on flat ground):
-    /// the ground's heights sampled at the level's texel centres, its field built as a
-    /// surface's (`SnowWorld::set_ground`), in logical order, which the capture reads.
+    /// Lay level `i` on the terrain's ground where its window stands, whole (nothing on flat
+    /// ground): the ground's heights sampled once at the level's texel centres
+    /// ([`ground_height`]), its field built as a surface's ([`GroundField::build`]), in logical
+    /// order, which the capture reads.
     fn lay_ground(&self, world: &mut SnowWorld, i: usize) -> Result<()> {
         let Some(g) = &self.desc.ground else {
             return Ok(());
         };
         let l = &self.levels[i];
         let [w, h] = l.desc.texels;
-        let s = l.desc.texel_size as f64;
-        let uv = |t: i64, k: usize| {
-            (((t as f64 + 0.5) * s - g.origin[k] as f64) / g.size[k] as f64).clamp(0.0, 1.0) as f32
-        };
         let heights = (0..h as i64)
             .flat_map(|r| (0..w as i64).map(move |c| (c, r)))
-            .map(|(c, r)| {
-                g.grid
-                    .sample(uv(l.origin[0] + c, 0), uv(l.origin[1] + r, 1))
-            })
+            .map(|(c, r)| ground_height(g, &l.desc, [l.origin[0] + c, l.origin[1] + r]))
             .collect();
-        let grid = crate::ground::HeightGrid {
-            columns: w,
-            rows: h,
-            heights,
+        let desc = world.surface(l.surface)?;
+        let layout = SurfaceLayout {
+            width: w,
+            height: h,
         };
-        world.set_ground(l.surface, &crate::ground::Ground::Grid(grid), g.slope)
+        let field = GroundField::build(layout, desc.size, heights, desc.snow_depth, g.slope);
+        world.set_ground_field(l.surface, Some(field))
+    }
+
+    /// Move level `i`'s ground field with its window, which was at world texel `from`: the field
+    /// shifted, the entering strips sampled, the columns computed again only where they can
+    /// change and only that level's part of the ground buffers written (bit for bit the field
+    /// [`Terrain::lay_ground`] gives at the new origin); a jump larger than the window lays it
+    /// whole.
+    fn scroll_ground(&self, world: &mut SnowWorld, i: usize, from: [i64; 2]) -> Result<()> {
+        let Some(g) = &self.desc.ground else {
+            return Ok(());
+        };
+        let l = &self.levels[i];
+        let by = [l.origin[0] - from[0], l.origin[1] - from[1]];
+        let at = |c: u32, r: u32| {
+            ground_height(g, &l.desc, [l.origin[0] + c as i64, l.origin[1] + r as i64])
+        };
+        if !world.scroll_ground(l.surface, by, g.slope, at)? {
+            self.lay_ground(world, i)?;
+        }
+        Ok(())
     }
 
     /// Leave each level's finer neighbour's extent to it: level `i > 0` does not draw the
@@ -348,15 +365,17 @@ impl Terrain {
             }
         }
         self.submit_strips(world, &dispatches, &incoming, leaving, false);
+        let mut from = Vec::new();
         for (i, to, steps) in &moves {
             let l = &mut self.levels[*i];
+            from.push(l.origin);
             l.origin = *to;
             let wrap = steps.last().map_or(0, |s| s.wrap);
             world.move_level(l.surface, center_of(&self.desc, &l.desc, *to), wrap)?;
         }
         self.set_holes(world)?;
-        for (i, _, _) in &moves {
-            self.lay_ground(world, *i)?;
+        for ((i, _, _), from) in moves.iter().zip(from) {
+            self.scroll_ground(world, *i, from)?;
         }
         self.stats.scrolls += 1;
         self.stats.texels_out += out_texels as u64;
@@ -456,6 +475,17 @@ impl Terrain {
         }
         self.fold(world, &folds)
     }
+}
+
+/// The height of `g` at the centre of world texel `t` of a level of `l`'s texel side (clamped at
+/// the ground's rectangle): a pure function of the world texel, so that a field laid whole and
+/// one moved strip by strip agree bit for bit.
+fn ground_height(g: &TerrainGround, l: &LevelDesc, t: [i64; 2]) -> f32 {
+    let s = l.texel_size as f64;
+    let uv = |k: usize| {
+        (((t[k] as f64 + 0.5) * s - g.origin[k] as f64) / g.size[k] as f64).clamp(0.0, 1.0) as f32
+    };
+    g.grid.sample(uv(0), uv(1))
 }
 
 /// The world centre of a level's rectangle whose first world texel is `origin`, on the ground.

@@ -131,6 +131,61 @@ impl SnowWorld {
         Ok(())
     }
 
+    /// Move a surface's ground field by `by` texels ([`GroundField::scroll`]: `sample(c, r)` gives
+    /// the heights of the texels that enter, at their new logical place) and write that surface's
+    /// part of the ground buffers, nothing else. `false`, and nothing changed, on flat ground or
+    /// for a move as large as the field: lay it whole then. Refused while an encoded frame is not
+    /// submitted.
+    pub(crate) fn scroll_ground(
+        &mut self,
+        id: SurfaceId,
+        by: [i64; 2],
+        slope: SlopeRule,
+        sample: impl FnMut(u32, u32) -> f32,
+    ) -> Result<bool> {
+        if self.in_flight.is_some() {
+            return Err(SnowError::FramePending);
+        }
+        self.state(id)?;
+        let ankle = self.config.capture.ankle_height;
+        let s = self.surfaces[id.0 as usize]
+            .as_mut()
+            .expect("checked live above");
+        let Some(g) = s.ground.as_mut() else {
+            return Ok(false);
+        };
+        if !g
+            .field
+            .scroll(by, s.desc.size, s.desc.snow_depth, slope, sample)
+        {
+            return Ok(false);
+        }
+        g.range = g.field.range();
+        let frustum = s.desc.snow_depth + ankle;
+        let codes: Vec<u32> = g
+            .field
+            .columns
+            .iter()
+            .map(|c| encode_depth(c[1] / frustum))
+            .collect();
+        let offset = g.offset as u64;
+        let columns: &[u8] = bytemuck::cast_slice(&g.field.columns);
+        let codes: &[u8] = bytemuck::cast_slice(&codes);
+        self.queue
+            .write_buffer(&self.grounds.buffer, offset * 8, columns);
+        self.queue
+            .write_buffer(&self.ground_codes.buffer, offset * 4, codes);
+        self.ground_bytes_written += (columns.len() + codes.len()) as u64;
+        Ok(true)
+    }
+
+    /// Bytes written into the ground buffers ([`Self::ground_buffer`] and the ground's capture
+    /// codes) since the world was made: every field, packed again, when a surface's ground is
+    /// set; only the moved field's part when a terrain's window scrolls.
+    pub fn ground_bytes_written(&self) -> u64 {
+        self.ground_bytes_written
+    }
+
     /// A surface's ground field (`None` on flat ground).
     pub fn ground(&self, id: SurfaceId) -> Result<Option<&GroundField>> {
         Ok(self.state(id)?.ground.as_ref().map(|g| &g.field))
@@ -149,7 +204,7 @@ impl SnowWorld {
     /// Every surface's ground field, packed (`array<vec2<f32>>` in WGSL: `[base, bare]` per
     /// texel, row after row from each surface's first texel), for renderers that draw the snow on
     /// its ground. Read it through `ground_texel` (`ground/texel.wgsl`). Rewritten by
-    /// [`Self::set_ground`] only.
+    /// [`Self::set_ground`] (every field) and by a terrain's scroll (the moved field's part).
     pub fn ground_buffer(&self) -> &wgpu::Buffer {
         &self.grounds.buffer
     }
@@ -175,8 +230,10 @@ impl SnowWorld {
         let bytes: &[u8] = bytemuck::cast_slice(&columns);
         self.grounds.ensure(&self.device, bytes.len() as u64);
         self.queue.write_buffer(&self.grounds.buffer, 0, bytes);
+        self.ground_bytes_written += bytes.len() as u64;
         let bytes: &[u8] = bytemuck::cast_slice(&codes);
         self.ground_codes.ensure(&self.device, bytes.len() as u64);
         self.queue.write_buffer(&self.ground_codes.buffer, 0, bytes);
+        self.ground_bytes_written += bytes.len() as u64;
     }
 }

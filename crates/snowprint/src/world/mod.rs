@@ -133,6 +133,8 @@ pub struct SnowWorld {
     grounds: Growable,
     /// The capture code of the ground at each texel of those fields, parallel to `grounds`.
     ground_codes: Growable,
+    /// Bytes written into `grounds` and `ground_codes` so far.
+    ground_bytes_written: u64,
     /// The ground mesh rasterisation, built the first time a mesh ground is set.
     ground_raster: Option<crate::ground::raster::GroundRaster>,
     last: LastFrame,
@@ -287,6 +289,7 @@ impl SnowWorld {
             scratch: Growable::new(&device, "scratch", U::STORAGE | U::COPY_SRC, 4 * 4096),
             grounds: Growable::new(&device, "ground fields", U::STORAGE | U::COPY_DST, 16),
             ground_codes: Growable::new(&device, "ground codes", U::COPY_SRC | U::COPY_DST, 16),
+            ground_bytes_written: 0,
             ground_raster: None,
             queue: gpu.queue.clone(),
             caps: gpu.caps.clone(),
