@@ -2,7 +2,8 @@
 //! dispatch for every surface, `CapturePath::Compute`) against the raster path (a viewport and a draw
 //! per surface, `CapturePath::Raster`), for many small surfaces of 128^2 with 10 moving spheres
 //! each and the talk's frame (2 x 512^2, 10 each), from the world's per-pass GPU timestamps and
-//! the CPU time of `step`'s encoding: medians over the measured frames, both paths in one run.
+//! the CPU time of the update's encoding (each surface handed its own spheres): medians over the
+//! measured frames, both paths in one run.
 //!
 //! `cargo bench -p snowprint --bench capture` (prints a table; needs timestamp queries);
 //! `-- --quick` measures fewer frames and surfaces (for software Vulkan); `-- --wall` also times
@@ -11,7 +12,7 @@
 
 use snowprint::{
     CapturePath, Deformer, GpuContext, GpuOptions, PoolFormat, Pose, Shape, SnowWorld, StageTimes,
-    SurfaceDesc, WorldConfig,
+    SurfaceDesc, SurfaceUpdate, WorldConfig,
 };
 
 /// Frames run before measuring, and measured: full and `--quick`.
@@ -47,16 +48,18 @@ fn run(
     )
     .expect("world");
     world.set_profiling(true);
-    let mut centers = Vec::new();
+    let (mut centers, mut ids) = (Vec::new(), Vec::new());
     for i in 0..surfaces {
         let c = [
             (i % 64) as f32 * (metres + 1.0),
             0.0,
             (i / 64) as f32 * (metres + 1.0),
         ];
-        world
-            .add_surface(SurfaceDesc::new(&format!("s{i}"), c, [metres, metres], 0.3))
-            .expect("surface");
+        ids.push(
+            world
+                .add_surface(SurfaceDesc::new(&format!("s{i}"), c, [metres, metres], 0.3))
+                .expect("surface"),
+        );
         centers.push(c);
     }
     let mut times: Vec<(u64, StageTimes)> = Vec::new();
@@ -69,20 +72,33 @@ fn run(
             first_measured = f as u64 + 1;
         }
         let t = f as f32 / 60.0;
-        let deformers: Vec<Deformer> = centers
+        // Each surface is handed its own spheres, as a game that knows which surface a body
+        // stands on does (`SnowWorld::step` would offer every surface every sphere).
+        let lists: Vec<Vec<Deformer>> = centers
             .iter()
-            .flat_map(|c| {
-                (0..spheres).map(move |k| {
-                    let a = t + k as f32 * 0.9;
-                    let at = |a: f32| {
-                        Pose::at([c[0] + reach * a.cos(), 0.3, c[2] + reach * (a * 1.3).sin()])
-                    };
-                    Deformer::moving(Shape::Sphere { radius: 0.15 }, at(a - 1.0 / 60.0), at(a))
-                })
+            .map(|c| {
+                (0..spheres)
+                    .map(|k| {
+                        let a = t + k as f32 * 0.9;
+                        let at = |a: f32| {
+                            Pose::at([c[0] + reach * a.cos(), 0.3, c[2] + reach * (a * 1.3).sin()])
+                        };
+                        Deformer::moving(Shape::Sphere { radius: 0.15 }, at(a - 1.0 / 60.0), at(a))
+                    })
+                    .collect()
+            })
+            .collect();
+        let updates: Vec<SurfaceUpdate<'_>> = ids
+            .iter()
+            .zip(&lists)
+            .map(|(&surface, deformers)| SurfaceUpdate {
+                surface,
+                elapsed: 1.0 / 60.0,
+                deformers,
             })
             .collect();
         let start = std::time::Instant::now();
-        let stats = world.step(1.0 / 60.0, &deformers).expect("step");
+        let stats = world.update(&updates).expect("update");
         if f >= warmup {
             cpu.push(stats.cpu_encode_ms);
             if wall_clock {
