@@ -681,16 +681,10 @@ fn a_terrain_on_hills_presses_as_a_surface_on_the_same_ground() {
             hills(x, z)
         );
     }
-    for d in walk() {
-        let p = d.pose.position + Vec3::new(0.4, 0.0, 1.2);
-        let p = Vec3::new(p.x, p.y + hills(p.x, p.z), p.z);
-        let d = Deformer {
-            pose: Pose::at(p.to_array()),
-            ..d
-        };
-        a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
-        b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
-    }
+    walk_both(&mut a, &mut b, |p| {
+        let p = p + Vec3::new(0.4, 0.0, 1.2);
+        Vec3::new(p.x, p.y + hills(p.x, p.z), p.z)
+    });
     let (la, lb) = (
         a.read_channels(level).unwrap(),
         b.read_channels(plain).unwrap(),
@@ -862,16 +856,10 @@ fn a_level_on_hills_moves_its_ground_as_laying_it_whole_would() {
     let mut b = world(Precision::Bits16);
     let whole = Terrain::new(&mut b, desc("whole"), focus(origin)).unwrap();
     let o = focus(origin);
-    for d in walk() {
-        let p = d.pose.position + Vec3::new(o.x - 1.5, 0.0, o.z);
-        let p = Vec3::new(p.x, p.y + ground(p.x, p.z), p.z);
-        let d = Deformer {
-            pose: Pose::at(p.to_array()),
-            ..d
-        };
-        a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
-        b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
-    }
+    walk_both(&mut a, &mut b, |p| {
+        let p = p + Vec3::new(o.x - 1.5, 0.0, o.z);
+        Vec3::new(p.x, p.y + ground(p.x, p.z), p.z)
+    });
     let (la, lb) = (
         a.read_channels(level).unwrap(),
         b.read_channels(whole.surfaces()[0]).unwrap(),
@@ -881,4 +869,16 @@ fn a_level_on_hills_moves_its_ground_as_laying_it_whole_would() {
         "the walk on the hills pressed little"
     );
     assert_eq!(la, lb, "the moved level and the level laid whole differ");
+}
+
+/// The walk, each pose moved by `at`, stepped in both worlds alike.
+fn walk_both(a: &mut SnowWorld, b: &mut SnowWorld, at: impl Fn(Vec3) -> Vec3) {
+    for d in walk() {
+        let d = Deformer {
+            pose: Pose::at(at(d.pose.position).to_array()),
+            ..d
+        };
+        a.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+        b.step(1.0 / 60.0, std::slice::from_ref(&d)).unwrap();
+    }
 }
