@@ -104,9 +104,12 @@ pub struct Args {
     /// Leave out the kicked-up snow (the world's spray particles, on by default).
     #[arg(long)]
     pub no_spray: bool,
-    /// Side of each of the moon's two shadow cascades, texels (default: 4096 on a GPU, 2048 on a
-    /// software adapter). The report's `shadow_last_frame.view_pixel_m` against `texel_m` says
-    /// how dense the view needs the near one.
+    /// Side of each of the moon's two shadow cascades, texels. Default on a GPU: fitted to the
+    /// view, a texel no larger than a pixel of the scene at the near cascade's focus for the
+    /// clip's narrowest field of view (`RenderConfig::shadow_map_size_for_view`; 3072 at 1080p
+    /// and 50 degrees); 2048 on a software adapter. The report's `shadow_map_size` says which,
+    /// and `shadow_last_frame.view_pixel_m` against `texel_m` how dense the view needs the near
+    /// one.
     #[arg(long)]
     pub shadow_map_size: Option<u32>,
 }
@@ -171,6 +174,11 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
         Renderer::new(&ctx, settings.render_config(args)).map_err(|e| e.to_string())?;
     let mut scene = build_scene(&args.scene, &mut world, &mut renderer)?;
     let clip = Clip::new(scene.as_ref(), args, settings.frames)?;
+    if let Some(size) = settings.fitted_shadow_map(scene.as_ref(), args, &clip) {
+        renderer
+            .set_shadow_map_size(size)
+            .map_err(|e| e.to_string())?;
+    }
     let mut demo = Demo {
         args,
         scene: scene.as_mut(),
@@ -256,13 +264,26 @@ impl Settings {
         config.opaque = args.opaque;
         if self.software {
             config.snowflakes = 3000;
-        } else {
-            config.shadow_map_size = 4096;
         }
         if let Some(size) = args.shadow_map_size {
             config.shadow_map_size = size;
         }
         config
+    }
+
+    /// On a GPU, unless `--shadow-map-size` says: the shadow map that gives a texel a pixel at
+    /// the near cascade's focus for the clip's narrowest field of view.
+    fn fitted_shadow_map(&self, scene: &dyn DemoScene, args: &Args, clip: &Clip) -> Option<u32> {
+        if self.software || args.shadow_map_size.is_some() {
+            return None;
+        }
+        let fov = clip
+            .times
+            .iter()
+            .filter_map(|&t| scene.camera(&args.camera, t))
+            .map(|c| c.fov_y_degrees)
+            .reduce(f32::min)?;
+        Some(self.render_config(args).shadow_map_size_for_view(fov))
     }
 }
 
@@ -579,6 +600,7 @@ impl Demo<'_> {
             "simulation_hz": settings.sim_hz,
             "instances_last_frame": m.instances_count,
             "instances_culled_last_frame": m.culled_last,
+            "shadow_map_size": self.renderer.config().shadow_map_size,
             "shadow_last_frame": m.shadow_last,
             "search": renderer.config().search_settings(),
             "passes": renderer.passes(),

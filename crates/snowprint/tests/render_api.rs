@@ -392,3 +392,52 @@ fn supersampling_and_resize() {
         );
     }
 }
+
+/// A shadow map set on a running renderer is the map a renderer made with that side has: a cube
+/// casting on snow renders bit for bit as by a renderer built with it, the map of the first side
+/// does not (the shadow's edge falls on other pixels), and a side out of range is refused with
+/// its value, the renderer unchanged.
+#[test]
+fn the_shadow_map_can_be_resized_on_a_running_renderer() {
+    let gpu = common::gpu();
+    let mut world = world();
+    let s = world
+        .add_surface(SurfaceDesc::new("s", [0.0, 0.0, 0.0], [3.0, 3.0], 0.2))
+        .unwrap();
+    let surfaces = [(s, GroundMaterial::Concrete)];
+    let shoot = |r: &mut Renderer| {
+        let cube = r.add_mesh(&Mesh::cuboid(Vec3::splat(0.3))).unwrap();
+        let inst = [Instance::new(
+            cube,
+            Mat4::from_translation(Vec3::new(0.2, 0.7, 0.1)),
+            [0.6, 0.2, 0.1],
+        )];
+        let mut f = frame(&surfaces, &inst);
+        f.snowfall = false;
+        r.render(&world, &f).unwrap().rgba8
+    };
+    let config = |size| RenderConfig {
+        shadow_map_size: size,
+        ..small(Tier::Relief)
+    };
+    let mut resized = Renderer::new(gpu, config(64)).unwrap();
+    let coarse = shoot(&mut resized);
+    resized.set_shadow_map_size(1024).unwrap();
+    assert_eq!(resized.config().shadow_map_size, 1024);
+    let fine = shoot(&mut resized);
+    let built = shoot(&mut Renderer::new(gpu, config(1024)).unwrap());
+    assert!(fine == built, "the resized map renders differently");
+    let moved = coarse
+        .chunks_exact(4)
+        .zip(fine.chunks_exact(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        moved > 0,
+        "a 64-texel map and a 1024-texel one gave the same image"
+    );
+    let e = resized.set_shadow_map_size(32).unwrap_err().to_string();
+    assert!(e.contains("shadow_map_size") && e.contains("32"), "{e}");
+    assert_eq!(resized.config().shadow_map_size, 1024);
+    assert!(shoot(&mut resized) == built);
+}

@@ -20,6 +20,17 @@ pub(super) fn view_pixel(frame: &RenderFrame<'_>, rows: u32) -> f32 {
     2.0 * distance * (frame.camera.fov_y_degrees.to_radians() * 0.5).tan() / rows as f32
 }
 
+/// Side of the shadow map, texels, whose near cascade has a texel no larger than a scene pixel at
+/// its focus for a camera of `fov_y_degrees` over `rows` pixels: the smallest multiple of 256 that
+/// is, from 512 to 8192. A larger map costs texels (fill and memory) that the view cannot show.
+pub(super) fn shadow_map_size_for_view(fov_y_degrees: f32, rows: u32) -> u32 {
+    let distance = NEAR_CASCADE * NEAR_FOCUS;
+    let pixel = 2.0 * distance * (fov_y_degrees.clamp(1.0, 179.0).to_radians() * 0.5).tan()
+        / rows.max(1) as f32;
+    let texels = (NEAR_CASCADE / pixel).ceil() as u32;
+    texels.div_ceil(256).clamp(2, 32) * 256
+}
+
 /// The moon's two shadow projections and their texels in metres.
 pub(super) struct ShadowCascades {
     pub near: Mat4,
@@ -115,5 +126,28 @@ pub(super) fn shadow_cascades<'a>(
         far: proj * view,
         near_texel,
         far_texel,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// By hand: the near cascade's focus is 4.8 m along the view, where a pixel of a camera of
+    /// field `f` over `rows` rows is 9.6 tan(f/2) / rows metres; its 12 m then need
+    /// 1.25 rows / tan(f/2) texels, rounded up to a multiple of 256.
+    #[test]
+    fn the_shadow_map_fitted_to_a_view_has_a_texel_a_pixel() {
+        // 50 degrees: tan 25 = 0.46631. 1080 rows need 2895.1 texels, 1440 need 3860.1 (over 15 x 256).
+        assert_eq!(shadow_map_size_for_view(50.0, 1080), 3072);
+        assert_eq!(shadow_map_size_for_view(50.0, 1440), 4096);
+        // 55 degrees: tan 27.5 = 0.52057; 720 rows need 1728.9 texels.
+        assert_eq!(shadow_map_size_for_view(55.0, 720), 1792);
+        // A tiny image or a wide field asks for little: the map keeps 512 texels.
+        assert_eq!(shadow_map_size_for_view(90.0, 36), 512);
+        // A narrow field over many rows asks for more than is useful: 8192 at most.
+        assert_eq!(shadow_map_size_for_view(10.0, 2160), 8192);
+        // No field or no rows is no panic.
+        assert_eq!(shadow_map_size_for_view(0.0, 0), 512);
     }
 }

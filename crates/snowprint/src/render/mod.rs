@@ -333,6 +333,23 @@ impl Renderer {
         Ok(())
     }
 
+    /// A moon's shadow map of `size` texels a side from the next frame on (each of its two
+    /// cascades); [`RenderConfig::shadow_map_size_for_view`] gives the side a view needs.
+    pub fn set_shadow_map_size(&mut self, size: u32) -> RenderResult<()> {
+        let config = RenderConfig {
+            shadow_map_size: size,
+            ..self.config
+        };
+        config.validate(&self.device)?;
+        self.config = config;
+        if size != self.shadow.size {
+            self.shadow.resize(&self.device, size);
+            self.frame
+                .rebind_shadow_map(&self.device, &self.shadow.view);
+        }
+        Ok(())
+    }
+
     /// Register a mesh to draw; normals are computed here (smooth, split at creases).
     pub fn add_mesh(&mut self, mesh: &Mesh) -> RenderResult<RenderMeshId> {
         self.meshes.add(&self.device, mesh)

@@ -37,38 +37,19 @@ impl ShadowPass {
             &buffers,
             "SHADOW_CASCADE",
         );
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("moon shadow cascades"),
-            size: wgpu::Extent3d {
-                width: size,
-                height: size,
-                depth_or_array_layers: 2,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let cascade_views = [0, 1].map(|layer| {
-            texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer,
-                array_layer_count: Some(1),
-                ..Default::default()
-            })
-        });
+        let (view, cascade_views) = cascade_maps(device, size);
         Self {
             pipelines,
             view,
             cascade_views,
             size,
         }
+    }
+
+    /// A new map of `size` texels a side in place of the old one (the pipelines stay).
+    pub(super) fn resize(&mut self, device: &wgpu::Device, size: u32) {
+        (self.view, self.cascade_views) = cascade_maps(device, size);
+        self.size = size;
     }
 
     /// A render pass into one cascade (`clear`: the first to draw into it this frame); the
@@ -126,4 +107,36 @@ impl ShadowPass {
             }
         }
     }
+}
+
+/// The two cascades' depth map of `size` texels a side: the view that samples both and one view
+/// each to render into.
+fn cascade_maps(device: &wgpu::Device, size: u32) -> (wgpu::TextureView, [wgpu::TextureView; 2]) {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("moon shadow cascades"),
+        size: wgpu::Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 2,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let cascade_views = [0, 1].map(|layer| {
+        texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
+    });
+    (view, cascade_views)
 }

@@ -63,7 +63,10 @@ pub(super) struct FrameResources {
     /// Group 0 of the shadow passes: the uniform alone.
     pub shadow_layout: wgpu::BindGroupLayout,
     buffer: wgpu::Buffer,
-    /// Bind groups of `layout` and `shadow_layout` (made once: what they bind lives as long).
+    shadow_sampler: wgpu::Sampler,
+    linear_sampler: wgpu::Sampler,
+    /// Bind groups of `layout` and `shadow_layout` (made once, and `bind_group` again when the
+    /// shadow map is replaced: what they bind lives as long).
     pub bind_group: wgpu::BindGroup,
     pub shadow_bind_group: wgpu::BindGroup,
 }
@@ -122,16 +125,12 @@ impl FrameResources {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let colour_group = bind_group(
+        let colour_group = colour_group(
             device,
-            "frame",
             &layouts.layout,
-            &[
-                buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(shadow_view),
-                wgpu::BindingResource::Sampler(&shadow_sampler),
-                wgpu::BindingResource::Sampler(&linear_sampler),
-            ],
+            &buffer,
+            shadow_view,
+            [&shadow_sampler, &linear_sampler],
         );
         let shadow_bind_group = bind_group(
             device,
@@ -143,15 +142,53 @@ impl FrameResources {
             layout: layouts.layout,
             shadow_layout: layouts.shadow_layout,
             buffer,
+            shadow_sampler,
+            linear_sampler,
             bind_group: colour_group,
             shadow_bind_group,
         }
+    }
+
+    /// The colour passes' group over a new shadow map.
+    pub(super) fn rebind_shadow_map(
+        &mut self,
+        device: &wgpu::Device,
+        shadow_view: &wgpu::TextureView,
+    ) {
+        self.bind_group = colour_group(
+            device,
+            &self.layout,
+            &self.buffer,
+            shadow_view,
+            [&self.shadow_sampler, &self.linear_sampler],
+        );
     }
 
     /// Upload the frame's uniform.
     pub(super) fn prepare(&self, queue: &wgpu::Queue, uniform: &FrameUniform) {
         queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(uniform));
     }
+}
+
+/// Group 0 of the colour passes: the uniform, the shadow map and the two samplers.
+fn colour_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffer: &wgpu::Buffer,
+    shadow_view: &wgpu::TextureView,
+    [shadow_sampler, linear_sampler]: [&wgpu::Sampler; 2],
+) -> wgpu::BindGroup {
+    bind_group(
+        device,
+        "frame",
+        layout,
+        &[
+            buffer.as_entire_binding(),
+            wgpu::BindingResource::TextureView(shadow_view),
+            wgpu::BindingResource::Sampler(shadow_sampler),
+            wgpu::BindingResource::Sampler(linear_sampler),
+        ],
+    )
 }
 
 /// The frame uniform of a frame: camera, moon and sky, the 8 lights nearest the camera, options.
