@@ -3,8 +3,8 @@
 //! writes exactly the entering strip's bytes and nothing else in the pool; wrapped and unwrapped
 //! storage give the same logical heightmap; the far level keeps the trail's broad shape after the
 //! near one paged it out; a level on hills moves its ground field as laying it whole at the new
-//! origin would, bit for bit, writing only its part of the ground buffers; refusals in one
-//! sentence.
+//! origin would, bit for bit, writing only its part of the ground buffers; a level and a surface
+//! beside it draw untouched as one surface over both; refusals in one sentence.
 
 mod common;
 
@@ -560,6 +560,123 @@ mod render {
             moved, trail,
             "the window moved and nothing changed on screen"
         );
+    }
+
+    /// A window's level and a surface laid beside it (a rooftop or a deck at the snow's height,
+    /// its texels on the level's grid) against one surface over both rectangles. Untouched, the
+    /// two draw as the one within 2 of 255 in both tiers: no crack, no overlap, and the open
+    /// edge's layers run on across the meeting line. (In the tessellated tier the outline of the
+    /// snow against the sky is rasterised from other triangles, so a pixel on it may flip: only
+    /// pixels inside a smooth region of the one surface's image count.) A walk across the line
+    /// leaves in each, texel for texel, what the one surface holds, within a unit, but for the
+    /// two columns along the line: there each blurs only its own texels (the update reads no
+    /// neighbour; `docs/RENDERING.md`, "Side by side", says what that leaves visible).
+    #[test]
+    fn a_window_and_a_surface_beside_it_meet_without_a_seam() {
+        let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
+        let mut valley = terrain("valley", &[([64, 48], 0.04)]);
+        // Glints are single pixels that a rounding of the hit switches on or off.
+        valley.material.look.sparkle = 0.0;
+        let mut t = Terrain::new(&mut a, valley, Vec3::ZERO).unwrap();
+        t.follow(&mut a, Vec3::new(46.0 * 0.04, 0.0, 31.0 * 0.04))
+            .unwrap();
+        let level = t.surfaces()[0];
+        assert_ne!(a.wrap(level).unwrap(), 0, "the level is stored wrapped");
+        let desc = a.surface(level).unwrap().clone();
+        let line = (t.origin(0).unwrap()[0] + 64) as f32 * 0.04;
+        let beside = |name: &str, columns: u32, from: f32| snowprint::SurfaceDesc {
+            name: name.into(),
+            center: Vec3::new(from + columns as f32 * 0.02, desc.center.y, desc.center.z),
+            size: glam::Vec2::new(columns as f32 * 0.04, desc.size.y),
+            ..desc.clone()
+        };
+        let roof = a.add_surface(beside("roof", 32, line)).unwrap();
+        let one = b
+            .add_surface(beside("one", 96, line - 64.0 * 0.04))
+            .unwrap();
+        let width = |w: &SnowWorld, id| w.layout(id).unwrap().width;
+        assert_eq!(
+            (width(&a, level), width(&a, roof), width(&b, one)),
+            (64, 32, 96)
+        );
+        let camera = Camera {
+            eye: Vec3::new(line - 0.5, 2.7, desc.center.z - 2.2),
+            target: Vec3::new(line, 1.2, desc.center.z),
+            fov_y_degrees: 45.0,
+        };
+        let size = (240, 160);
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            let two = shoot(&a, &[level, roof], tier, camera, size);
+            let reference = shoot(&b, &[one], tier, camera, size);
+            save(&format!("beside_untouched_{tier:?}.png"), &two, size);
+            let differ = seam_pixels(&two, &reference, size, tier == Tier::Tessellated);
+            println!(
+                "{tier:?}: untouched, {} pixels differ from the one surface by more than 2 of 255, at {:?}",
+                differ.len(),
+                &differ[..differ.len().min(8)]
+            );
+            assert!(differ.is_empty(), "{tier:?}: a seam at {differ:?}");
+        }
+        walk_both(&mut a, &mut b, |p| {
+            p + Vec3::new(line - 1.665, 0.0, desc.center.z)
+        });
+        let (l, r, u) = (
+            a.read_channels(level).unwrap().0,
+            a.read_channels(roof).unwrap().0,
+            b.read_channels(one).unwrap().0,
+        );
+        let (mut inside, mut edge) = (0u32, 0u32);
+        for row in 0..48usize {
+            for c in 0..96usize {
+                let two = if c < 64 {
+                    l[row * 64 + c]
+                } else {
+                    r[row * 32 + c - 64]
+                };
+                let d = two.abs_diff(u[row * 96 + c]);
+                if c == 63 || c == 64 {
+                    edge = edge.max(d);
+                } else {
+                    inside = inside.max(d);
+                }
+            }
+        }
+        let pressed = u.iter().filter(|&&v| v > 65535 / 4).count();
+        println!(
+            "trodden: {pressed} texels pressed past a quarter; off the line the two differ from the one surface by at most {inside} of 65535, on it by {edge}"
+        );
+        assert!(pressed > 100, "the walk pressed only {pressed} texels");
+        assert!(inside <= 1, "off the line: {inside}");
+        for tier in [Tier::Relief, Tier::Tessellated] {
+            let two = shoot(&a, &[level, roof], tier, camera, size);
+            save(&format!("beside_trodden_{tier:?}.png"), &two, size);
+        }
+    }
+
+    /// Pixels (x, y) where `two` differs from `reference` by more than 2 of 255 in a channel;
+    /// with `inside_only`, only where the reference's 3x3 neighbourhood is smooth (within 8 of
+    /// 255 of the pixel: not an outline).
+    fn seam_pixels(
+        two: &[u8],
+        reference: &[u8],
+        size: (u32, u32),
+        inside_only: bool,
+    ) -> Vec<(u32, u32)> {
+        let at = |x: u32, y: u32, c: usize| reference[4 * (y * size.0 + x) as usize + c];
+        let smooth = |x: u32, y: u32| {
+            (x.saturating_sub(1)..=(x + 1).min(size.0 - 1)).all(|nx| {
+                (y.saturating_sub(1)..=(y + 1).min(size.1 - 1))
+                    .all(|ny| (0..3).all(|c| at(nx, ny, c).abs_diff(at(x, y, c)) <= 8))
+            })
+        };
+        (0..size.1)
+            .flat_map(|y| (0..size.0).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let i = 4 * (y * size.0 + x) as usize;
+                (0..3).any(|c| two[i + c].abs_diff(reference[i + c]) > 2)
+                    && (!inside_only || smooth(x, y))
+            })
+            .collect()
     }
 }
 

@@ -690,8 +690,10 @@ fn snow_basic(s: SnowSurface, p: vec3<f32>, face: vec3<f32>, sky: vec3<f32>, pix
         m.transition = 0.0;
         m.sparkle = s.grain.y;
     } else {
-        // The cut through the snow at an open edge: faint layers of successive snowfalls.
-        let along = dot(p.xz, vec2<f32>(-face.z, face.x));
+        // The cut through the snow at an open edge: faint layers of successive snowfalls, laid
+        // out where the patterns are (`q`), so that the open edges of two surfaces side by side
+        // run on without a jump.
+        let along = dot(q, vec2<f32>(-face.z, face.x));
         let layers = snow_noise(vec2<f32>(along * 2.0, p.y * 40.0)).x;
         m.normal = face;
         m.albedo = s.albedo.xyz * (0.85 + 0.1 * layers);
