@@ -33,3 +33,51 @@ pub fn assemble_save(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
     }
     out
 }
+
+/// How far a GPU may place a texel's ray from where the CPU does, metres: a few last bits of a
+/// coordinate some metres from the origin (one bit of 6.0 is 4.8e-7), after the compiler fuses
+/// and reorders the transforms' products.
+pub const POSITION_SLACK: f32 = 2e-6;
+
+/// The deformers moved by `by` (world metres), both poses of a moving one.
+pub fn nudged(deformers: &[snowprint::Deformer], by: glam::Vec3) -> Vec<snowprint::Deformer> {
+    deformers
+        .iter()
+        .map(|d| {
+            let mut d = d.clone();
+            d.pose.position += by;
+            if let Some(p) = d.previous.as_mut() {
+                p.position += by;
+            }
+            d
+        })
+        .collect()
+}
+
+/// Per texel, the range of a CPU capture over the deformers at their place and nudged by
+/// [`POSITION_SLACK`] along world x and z each way: where a ray grazes a silhouette, the height
+/// it meets changes without bound as the ray moves, so a GPU's last-bit difference in where the
+/// ray is can only be judged against how much the height moves there.
+pub fn capture_envelope(
+    deformers: &[snowprint::Deformer],
+    capture: impl Fn(&[snowprint::Deformer]) -> Vec<f32>,
+) -> Vec<(f32, f32)> {
+    let s = POSITION_SLACK;
+    let mut env: Vec<(f32, f32)> = capture(deformers).iter().map(|&c| (c, c)).collect();
+    for by in [
+        glam::Vec3::new(s, 0.0, 0.0),
+        glam::Vec3::new(-s, 0.0, 0.0),
+        glam::Vec3::new(0.0, 0.0, s),
+        glam::Vec3::new(0.0, 0.0, -s),
+    ] {
+        for (e, c) in env.iter_mut().zip(capture(&nudged(deformers, by))) {
+            *e = (e.0.min(c), e.1.max(c));
+        }
+    }
+    env
+}
+
+/// How far `g` lies outside `range`.
+pub fn outside(g: f32, range: (f32, f32)) -> f32 {
+    (range.0 - g).max(g - range.1).max(0.0)
+}

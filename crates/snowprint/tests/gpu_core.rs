@@ -14,11 +14,13 @@ use snowprint::{
 
 const ANKLE: f32 = 0.25;
 
-/// Largest difference in captured height between GPU and CPU, metres (a 1/800 of a 4 cm texel).
-/// GPU compilers contract `a * b + c` into fused multiply-adds and use approximate square roots
-/// and divisions; where a vertical ray grazes a silhouette, the root of a nearly-zero discriminant
-/// amplifies those last-bit differences (seen on an H100: 14 um). Software Vulkan matches the CPU
-/// to about 1e-7.
+/// Largest difference in captured height between GPU and CPU, metres (a 1/800 of a 4 cm texel),
+/// beyond the range the CPU's heights span with the deformers nudged by
+/// `common::POSITION_SLACK`. GPU compilers contract `a * b + c` into fused multiply-adds and use
+/// approximate square roots and divisions; where a vertical ray grazes a silhouette, the root of a
+/// nearly-zero discriminant amplifies those last-bit differences without bound (an H100 put one
+/// texel 78 um from the CPU's height at its centre, inside the nudged range). Software Vulkan
+/// matches the CPU to about 1e-7.
 const CAPTURE_HEIGHT_TOLERANCE: f32 = 5e-5;
 
 fn world(mode: CaptureMode) -> SnowWorld {
@@ -190,15 +192,29 @@ fn every_stage_matches_its_cpu_reference() {
                 &prims,
                 &[],
             );
+            let envelope = common::capture_envelope(&deformers[frame..], |ds| {
+                let mut prims = vec![];
+                for d in ds {
+                    capture::push_primitives(d, &vol, &mut prims);
+                }
+                cap_cpu::capture(
+                    l.width,
+                    l.height,
+                    vol.half_size,
+                    vol.frustum_height,
+                    &prims,
+                    &[],
+                )
+            });
             let mut coverage_mismatch = 0;
-            for (g, c) in gpu_cap.iter().zip(&cpu_cap) {
+            for ((g, c), range) in gpu_cap.iter().zip(&cpu_cap).zip(&envelope) {
                 if (*g < 1.0) != (*c < 1.0) {
                     coverage_mismatch += 1;
                 } else {
-                    let dh = (g - c).abs() * vol.frustum_height;
+                    let dh = common::outside(*g, *range) * vol.frustum_height;
                     assert!(
                         dh <= CAPTURE_HEIGHT_TOLERANCE,
-                        "capture {g} vs cpu {c}: {dh} m apart ({size:?})"
+                        "capture {g} vs cpu {c} (nudged {range:?}): {dh} m apart ({size:?})"
                     );
                 }
             }

@@ -159,13 +159,34 @@ fn assert_capture_matches_reference(
         &[],
         Some(&field.columns),
     );
+    // Judged against the heights the CPU gives with the deformers nudged by a GPU's last bits of
+    // position (`common::capture_envelope`): an H100 put a grazing texel 165 um from the height
+    // at its centre, within that range.
+    let envelope = common::capture_envelope(prims_of, |ds| {
+        let mut prims = vec![];
+        for d in ds {
+            capture::push_primitives(d, &vol, &mut prims);
+        }
+        cap_cpu::capture_on_ground(
+            l.width,
+            l.height,
+            vol.half_size,
+            vol.frustum_height,
+            &prims,
+            &[],
+            Some(&field.columns),
+        )
+    });
     let mut mismatched = 0;
-    for (g, c) in gpu.iter().zip(&cpu) {
+    for ((g, c), range) in gpu.iter().zip(&cpu).zip(&envelope) {
         if (*g < 1.0) != (*c < 1.0) {
             mismatched += 1;
         } else {
-            let dh = (g - c).abs() * vol.frustum_height;
-            assert!(dh <= 5e-5, "capture {g} vs reference {c}: {dh} m apart");
+            let dh = common::outside(*g, *range) * vol.frustum_height;
+            assert!(
+                dh <= 5e-5,
+                "capture {g} vs reference {c} (nudged {range:?}): {dh} m apart"
+            );
         }
     }
     // Rim texels whose centre grazes the sphere may fall either side.
