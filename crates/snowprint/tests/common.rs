@@ -44,7 +44,7 @@ pub fn nudged(deformers: &[snowprint::Deformer], by: glam::Vec3) -> Vec<snowprin
     deformers
         .iter()
         .map(|d| {
-            let mut d = d.clone();
+            let mut d = *d;
             d.pose.position += by;
             if let Some(p) = d.previous.as_mut() {
                 p.position += by;
