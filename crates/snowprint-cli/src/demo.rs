@@ -354,6 +354,8 @@ struct Measured {
     /// CPU time to build and submit each frame (no readback, no image encoding).
     encode_ms: Vec<f64>,
     pass_ms: Vec<(&'static str, Vec<f64>)>,
+    /// Each frame's CPU steps (`RenderOutput::cpu_phases`), by name.
+    phase_ms: Vec<(&'static str, Vec<f64>)>,
     first_surfaces: Option<Vec<SurfaceShading>>,
     last_surfaces: Vec<SurfaceShading>,
     last_overflow: u32,
@@ -404,6 +406,7 @@ impl Demo<'_> {
             render_ms: Vec::new(),
             encode_ms: Vec::new(),
             pass_ms: Vec::new(),
+            phase_ms: Vec::new(),
             first_surfaces: None,
             last_surfaces: Vec::new(),
             last_overflow: 0,
@@ -445,6 +448,12 @@ impl Demo<'_> {
                 .map_err(|e| e.to_string())?;
             m.render_ms.push(out.cpu_ms);
             m.encode_ms.push(out.cpu_encode_ms);
+            for p in &out.cpu_phases {
+                match m.phase_ms.iter_mut().find(|(n, _)| *n == p.name) {
+                    Some((_, v)) => v.push(p.ms),
+                    None => m.phase_ms.push((p.name, vec![p.ms])),
+                }
+            }
             for p in &out.pass_times {
                 match m.pass_ms.iter_mut().find(|(n, _)| *n == p.name) {
                     Some((_, v)) => v.push(p.gpu_ms),
@@ -611,6 +620,11 @@ impl Demo<'_> {
                 "simulation_total": m.sim_ms,
                 "render_median_per_frame": median(&mut m.render_ms.clone()),
                 "frame_build_median": median(&mut m.encode_ms.clone()),
+                "frame_build_phases_median": m
+                    .phase_ms
+                    .iter()
+                    .map(|(name, v)| serde_json::json!({"phase": name, "median_ms": median(&mut v.clone())}))
+                    .collect::<Vec<_>>(),
                 "render_total": m.render_ms.iter().sum::<f64>(),
             },
             "surfaces": surfaces_json,

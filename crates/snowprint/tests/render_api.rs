@@ -86,6 +86,31 @@ fn a_surface_switches_to_the_deformable_material_when_pressed() {
     assert_eq!(shading_a.material, SnowMaterialKind::Deformable);
     // The sphere's bottom is 0.1 m below the ground under 0.2 m of snow: pressed to the ground.
     assert!(shading_a.deepest > 0.9, "{}", shading_a.deepest);
+    // The CPU's steps of the frame, in order, within the time to build and submit it.
+    let names: Vec<&str> = out.cpu_phases.iter().map(|p| p.name).collect();
+    assert_eq!(
+        names,
+        [
+            "surfaces",
+            "classify",
+            "heightfield",
+            "snow",
+            "dice",
+            "banks",
+            "tess_surface",
+            "meshes",
+            "opaque_tonemap",
+            "record",
+            "submit"
+        ]
+    );
+    let steps: f64 = out.cpu_phases.iter().map(|p| p.ms).sum();
+    assert!(
+        out.cpu_phases.iter().all(|p| p.ms >= 0.0) && steps <= out.cpu_encode_ms,
+        "{:?} against {} ms",
+        out.cpu_phases,
+        out.cpu_encode_ms
+    );
 
     if r.has_timestamps() {
         let names: Vec<&str> = out.pass_times.iter().map(|p| p.name).collect();

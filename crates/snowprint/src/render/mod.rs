@@ -110,7 +110,7 @@ pub use error::{RenderError, RenderResult};
 pub use graph::{PASSES, PassInfo, PassKind, Resource};
 pub use inputs::{Environment, Instance, MeshMaterial, PointLight, RenderFrame, RenderMeshId};
 pub use report::{
-    FrameReport, PassTime, RenderOutput, ShadowStats, SnowMaterialKind, SurfaceShading,
+    CpuPhase, FrameReport, PassTime, RenderOutput, ShadowStats, SnowMaterialKind, SurfaceShading,
 };
 pub use targets::OUTPUT_FORMAT;
 pub use tessellate::{
@@ -166,6 +166,8 @@ pub struct Renderer {
     latest: Option<FrameReport>,
     /// The latest frame's shadow cascades.
     shadow_stats: ShadowStats,
+    /// The last frame's CPU steps.
+    phases: Vec<CpuPhase>,
 }
 
 impl std::fmt::Debug for Renderer {
@@ -239,6 +241,7 @@ impl Renderer {
             last_surfaces: Vec::new(),
             latest: None,
             shadow_stats: ShadowStats::default(),
+            phases: Vec::new(),
             queue: gpu.queue.clone(),
             device,
             config,
@@ -398,7 +401,10 @@ impl Renderer {
             },
         );
         self.copy_stats(&mut encoder, surfaces);
+        let mut laps = Laps::start();
         self.queue.submit([encoder.finish()]);
+        laps.mark("submit");
+        self.phases.extend(laps.phases);
         let cpu_encode_ms = encode_start.elapsed().as_secs_f64() * 1e3;
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Gpu(e));
@@ -434,6 +440,7 @@ impl Renderer {
             dice_overflow: report.dice_overflow,
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
             cpu_encode_ms,
+            cpu_phases: self.phases.clone(),
             culled_instances: self.meshes.culled,
             shadow: self.shadow_stats,
         })
@@ -574,6 +581,7 @@ impl Renderer {
         format: wgpu::TextureFormat,
     ) -> RenderResult<Vec<SurfaceId>> {
         frame.check(self.meshes.meshes.len())?;
+        let mut laps = Laps::start();
         let view = world.frame_view();
         let tessellated_tier = self.config.tier == Tier::Tessellated;
         let surfaces = frame_surfaces(
@@ -587,13 +595,16 @@ impl Renderer {
         let shadow = cascades::shadow_cascades(descs, frame, &self.meshes.meshes, self.shadow.size);
         let uniform = frame::frame_uniform(&self.config, frame, &shadow);
         self.frame.prepare(&self.queue, &uniform);
+        laps.mark("surfaces");
 
         let (device, queue) = (&self.device, &self.queue);
         let (pool, ground) = (view.pool_buffer, view.ground_buffer);
         self.classify.prepare(device, queue, pool, &surfaces);
+        laps.mark("classify");
         let moon = frame.environment.moon_direction;
         self.heightfield
             .prepare(device, queue, pool, ground, &surfaces, moon);
+        laps.mark("heightfield");
         self.snow.prepare(
             device,
             queue,
@@ -602,6 +613,7 @@ impl Renderer {
             &self.heightfield,
             ground,
         );
+        laps.mark("snow");
         self.last_surfaces = surfaces.iter().map(|s| s.view.id).collect();
         let state = &self.classify.state.buffer;
         self.dice.prepare(
@@ -617,6 +629,7 @@ impl Renderer {
             state,
             ground,
         )?;
+        laps.mark("dice");
         self.banks.prepare(
             device,
             queue,
@@ -624,6 +637,7 @@ impl Renderer {
             &surfaces,
             &self.heightfield,
         );
+        laps.mark("banks");
         let uniforms = &self.snow.uniforms.buffer;
         self.tess_surface.prepare(
             device,
@@ -633,6 +647,7 @@ impl Renderer {
             state,
             ground,
         );
+        laps.mark("tess_surface");
         let view_proj = glam::Mat4::from_cols_array_2d(&uniform.view_proj);
         self.meshes.prepare(
             device,
@@ -641,6 +656,7 @@ impl Renderer {
             view_proj,
             [shadow.near, shadow.far],
         );
+        laps.mark("meshes");
         self.shadow_stats = ShadowStats {
             casters: self.meshes.cascade_casters,
             texel_m: [shadow.near_texel, shadow.far_texel],
@@ -655,6 +671,7 @@ impl Renderer {
             format,
             self.config.supersample,
         );
+        laps.mark("opaque_tonemap");
 
         // The table sets the order: pass `slot` of PASSES is recorded `slot`-th.
         let flakes = uniform.options[3];
@@ -665,6 +682,8 @@ impl Renderer {
         for slot in 0..PASSES.len() {
             self.encode_pass(encoder, slot, target, flakes, spray);
         }
+        laps.mark("record");
+        self.phases = laps.phases;
         Ok(self.last_surfaces.clone())
     }
 
@@ -744,4 +763,28 @@ fn frame_surfaces<'a>(
             })
         })
         .collect()
+}
+
+/// CPU steps of a frame, each timed from the end of the one before.
+struct Laps {
+    phases: Vec<CpuPhase>,
+    last: Instant,
+}
+
+impl Laps {
+    fn start() -> Self {
+        Self {
+            phases: Vec::with_capacity(12),
+            last: Instant::now(),
+        }
+    }
+
+    fn mark(&mut self, name: &'static str) {
+        let now = Instant::now();
+        self.phases.push(CpuPhase {
+            name,
+            ms: (now - self.last).as_secs_f64() * 1e3,
+        });
+        self.last = now;
+    }
 }

@@ -11,6 +11,19 @@ pub struct PassTime {
     pub gpu_ms: f64,
 }
 
+/// CPU time of one step of building a frame.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct CpuPhase {
+    /// In order: `surfaces` (the frame's surfaces, shadow cascades and uniform); the tables and
+    /// bind groups of `classify`, `heightfield`, `snow`, `dice`, `banks`, `tess_surface` (the
+    /// tessellated snow's draws), `meshes` (instances culled and uploaded for the shadow and
+    /// opaque passes) and `opaque_tonemap`; `record` (every pass's commands); and for
+    /// [`Renderer::render`](super::Renderer::render), `submit`.
+    pub name: &'static str,
+    /// Milliseconds.
+    pub ms: f64,
+}
+
 /// Which snow material a surface was drawn with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -84,6 +97,8 @@ pub struct RenderOutput {
     /// CPU time to build the frame and submit it (every pass's tables written and its commands
     /// recorded), milliseconds: what a frame costs the CPU when nothing is read back.
     pub cpu_encode_ms: f64,
+    /// Where `cpu_encode_ms` went, step by step, in order.
+    pub cpu_phases: Vec<CpuPhase>,
     /// Instances of the frame outside the view's frustum, not drawn by the opaque pass (shadow
     /// casters among them still cast).
     pub culled_instances: usize,
