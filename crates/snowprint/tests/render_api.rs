@@ -101,6 +101,7 @@ fn a_surface_switches_to_the_deformable_material_when_pressed() {
             "meshes",
             "opaque_tonemap",
             "record",
+            "finish",
             "submit"
         ]
     );

@@ -402,7 +402,9 @@ impl Renderer {
         );
         self.copy_stats(&mut encoder, surfaces);
         let mut laps = Laps::start();
-        self.queue.submit([encoder.finish()]);
+        let commands = encoder.finish();
+        laps.mark("finish");
+        self.queue.submit([commands]);
         laps.mark("submit");
         self.phases.extend(laps.phases);
         let cpu_encode_ms = encode_start.elapsed().as_secs_f64() * 1e3;

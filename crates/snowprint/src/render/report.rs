@@ -18,7 +18,8 @@ pub struct CpuPhase {
     /// bind groups of `classify`, `heightfield`, `snow`, `dice`, `banks`, `tess_surface` (the
     /// tessellated snow's draws), `meshes` (instances culled and uploaded for the shadow and
     /// opaque passes) and `opaque_tonemap`; `record` (every pass's commands); and for
-    /// [`Renderer::render`](super::Renderer::render), `submit`.
+    /// [`Renderer::render`](super::Renderer::render), `finish` (the command encoder finished:
+    /// wgpu validates and encodes the recorded passes there) and `submit`.
     pub name: &'static str,
     /// Milliseconds.
     pub ms: f64,
