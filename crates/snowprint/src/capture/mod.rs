@@ -17,7 +17,10 @@
 pub(crate) mod cpu;
 mod encode;
 
-pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode, work_table};
+pub use encode::{
+    CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, append_work_table, encode,
+    work_table_bytes,
+};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -374,7 +377,6 @@ pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Ve
         return;
     }
     let m = volume.world_to_local;
-    let (_, local_rot, _) = m.to_scale_rotation_translation();
     let prev = deformer.previous.unwrap_or(deformer.pose);
     let mut push = |p: GpuPrimitive| {
         let (lo, hi) = p.bounds();
@@ -419,6 +421,8 @@ pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Ve
             let corner_move = prev.position.distance(deformer.pose.position)
                 + prev.rotation.angle_between(deformer.pose.rotation) * half_extents.length();
             let n = substeps(corner_move, half_extents.min_element() * 2.0);
+            // Only a box needs the frame's rotation (a decomposition of the matrix).
+            let (_, local_rot, _) = m.to_scale_rotation_translation();
             for k in 0..=n {
                 let t = k as f32 / n as f32;
                 let p = prev.lerp(&deformer.pose, t);

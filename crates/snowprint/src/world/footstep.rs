@@ -14,7 +14,8 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use super::SurfaceUpdate;
-use crate::deformer::{Pose, Shape};
+use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
+use crate::deformer::{Deformer, Pose, Shape};
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::surface::{SurfaceDesc, SurfaceId};
@@ -180,22 +181,25 @@ pub fn landing_on<'a>(
 
 /// Every footstep of an update, in the order of its surfaces and their deformers. Deformers without
 /// a `previous` pose (at rest) never land. `desc` looks up a live surface, `mesh_vertices` a mesh's
-/// vertices.
-pub fn footsteps<'a, 'm>(
+/// vertices. A long list shared by surfaces is looked up in `nearby` (built over it when it is not
+/// already), so that each surface tests only the deformers near it.
+pub(crate) fn footsteps<'a, 'm>(
     updates: &[SurfaceUpdate<'_>],
     desc: impl Fn(SurfaceId) -> Option<(&'a SurfaceDesc, Option<&'a GroundField>)>,
     mesh_vertices: impl Fn(MeshId) -> Option<&'m [Vec3]> + Copy,
+    nearby: &mut NearbyDeformers,
     out: &mut Vec<Footstep>,
 ) {
     out.clear();
+    let mut near = Vec::new();
     for u in updates {
         let Some((d, ground)) = desc(u.surface) else {
             continue;
         };
         let m = d.world_to_local();
-        for (i, deformer) in u.deformers.iter().enumerate() {
+        let mut land = |i: usize, deformer: &Deformer| {
             let Some(previous) = deformer.previous.as_ref() else {
-                continue;
+                return;
             };
             if let Some((point, depth_m, speed)) = landing_on(
                 (d, &m),
@@ -213,6 +217,17 @@ pub fn footsteps<'a, 'm>(
                     depth_m,
                     speed,
                 });
+            }
+        };
+        if u.deformers.len() >= INDEX_FROM {
+            nearby.index(u.deformers);
+            nearby.near(surface_rect(d), &mut near);
+            for &i in &near {
+                land(i as usize, &u.deformers[i as usize]);
+            }
+        } else {
+            for (i, deformer) in u.deformers.iter().enumerate() {
+                land(i, deformer);
             }
         }
     }

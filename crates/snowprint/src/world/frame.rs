@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use super::plan::{FramePlan, PlanSettings, PlanSurface};
-use super::{FrameStats, InFlight, SnowWorld, StageTimes, SurfaceUpdate};
+use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
 use crate::capture::{self, CaptureBuffers};
 use crate::deformer::{Deformer, Shape};
@@ -144,6 +144,9 @@ impl SnowWorld {
         };
         self.scratch_cpu.carries.clear();
         self.scratch_cpu.settles.clear();
+        let kept = &mut self.scratch_cpu.kept;
+        kept.clear();
+        kept.resize(self.surfaces.len(), 0);
         // The ring is taken out while the layers borrow its query set.
         let ring = self.timestamps.take();
         // A frame is measured only while a readback slot is free: times are never waited for.
@@ -198,11 +201,12 @@ impl SnowWorld {
 
     /// Keep the settle counters a layer leaves (remembering the first for an abandoned frame).
     fn keep_settles(&mut self, settles: &[(usize, crate::relax::Settle)]) {
+        let scratch = &mut self.scratch_cpu;
         for &(index, settle) in settles {
             if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
-                let before = &mut self.scratch_cpu.settles;
-                if !before.iter().any(|&(i, _)| i == index) {
-                    before.push((index, s.settle));
+                if scratch.kept[index] & KEPT_SETTLE == 0 {
+                    scratch.kept[index] |= KEPT_SETTLE;
+                    scratch.settles.push((index, s.settle));
                 }
                 s.settle = settle;
             }
@@ -212,11 +216,12 @@ impl SnowWorld {
     /// Keep the carries a layer leaves, remembering each surface's carry before the frame so
     /// that an abandoned frame puts it back.
     fn keep_carries(&mut self, carries: &[(usize, f64)]) {
+        let scratch = &mut self.scratch_cpu;
         for &(index, carry) in carries {
             if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
-                let before = &mut self.scratch_cpu.carries;
-                if !before.iter().any(|&(i, _)| i == index) {
-                    before.push((index, s.carry));
+                if scratch.kept[index] & KEPT_CARRY == 0 {
+                    scratch.kept[index] |= KEPT_CARRY;
+                    scratch.carries.push((index, s.carry));
                 }
                 s.carry = carry;
             }
@@ -400,7 +405,7 @@ impl SnowWorld {
         if !c.work.is_empty() {
             // The compute path's work list and its place, after the blocks (`prims.wgsl`).
             blocks.truncate(c.views.len() * UNIFORM_STRIDE as usize);
-            blocks.extend_from_slice(bytemuck::cast_slice(&capture::work_table(c).0));
+            capture::append_work_table(c, blocks);
         }
         self.views.ensure(device, sizes.views);
         write(&self.views.buffer, blocks);

@@ -11,6 +11,7 @@ use std::ops::Range;
 
 use glam::{Vec2, Vec3};
 
+use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
 use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
 use crate::capture::{
@@ -181,6 +182,11 @@ pub struct FramePlan {
     rects: Vec<(u32, u32)>,
     /// Scratch of the compute path's tiles, a flag a tile of one surface.
     seen: Vec<bool>,
+    /// The grid over a long list of deformers shared by surfaces (`encode_step`'s), kept for the
+    /// frame's footsteps; forgotten at the next rebuild.
+    pub(crate) nearby: NearbyDeformers,
+    /// Scratch: the deformers of a long list near one surface.
+    near: Vec<u32>,
 }
 
 impl FramePlan {
@@ -241,6 +247,7 @@ impl FramePlan {
         self.sizes = BufferSizes::default();
         self.jobs.clear();
         self.rects.clear();
+        self.nearby.forget();
     }
 
     /// Replenishment, culling and sweeping of one surface; a job when there is anything to do.
@@ -264,22 +271,24 @@ impl FramePlan {
             frustum_height,
             ground: s.ground.map_or((0.0, 0.0), |g| g.range),
         };
-        let prims = &mut self.capture.prims;
-        let (draws, draw_meshes) = (&mut self.capture.draws, &mut self.capture.draw_meshes);
-        let p0 = prims.len() as u32;
-        let d0 = draws.len() as u32;
-        for d in s.deformers {
-            match d.shape {
-                Shape::Mesh(id) => {
-                    let Some(radius) = mesh_radius(id) else {
-                        continue;
-                    };
-                    capture::push_mesh_draws(d, id, radius, &volume, draws, draw_meshes);
-                }
-                _ => capture::push_primitives(d, &volume, prims),
+        let p0 = self.capture.prims.len() as u32;
+        let d0 = self.capture.draws.len() as u32;
+        if s.deformers.len() >= INDEX_FROM {
+            // A long list (every deformer of the world): only those in the grid's cells near the
+            // surface, in the list's order.
+            self.nearby.index(s.deformers);
+            self.nearby.near(surface_rect(s.desc), &mut self.near);
+            for &i in &self.near {
+                self.capture
+                    .push_deformer(&s.deformers[i as usize], &volume, mesh_radius);
+            }
+        } else {
+            for d in s.deformers {
+                self.capture.push_deformer(d, &volume, mesh_radius);
             }
         }
-        let (p1, d1) = (prims.len() as u32, draws.len() as u32);
+        let prims = &self.capture.prims;
+        let (p1, d1) = (prims.len() as u32, self.capture.draws.len() as u32);
         let captured = p1 > p0 || d1 > d0;
         // A slumping material relaxes in every update that presses it and for `settle_updates`
         // after the last, over what may be unsettled (what it pressed, and what earlier updates
@@ -517,7 +526,7 @@ impl FramePlan {
                 + if c.work.is_empty() {
                     0
                 } else {
-                    capture::work_table(c).1 - c.views.len() as u64 * UNIFORM_STRIDE
+                    capture::work_table_bytes(c) - c.views.len() as u64 * UNIFORM_STRIDE
                 },
             prims: std::mem::size_of_val(c.prims.as_slice()) as u64,
             draws: c.draws.len() as u64 * UNIFORM_STRIDE,
@@ -591,4 +600,30 @@ pub fn replenish(carry: f64, rate: f32, elapsed: f32, channel_max: u32) -> (f64,
     let carry = carry + rate as f64 * elapsed as f64 * channel_max as f64;
     let units = carry.floor().min(u32::MAX as f64);
     (carry - units, units as u32)
+}
+
+impl CapturePlan {
+    /// Append what one deformer draws over `volume`: its primitives, or a registered mesh's draws.
+    fn push_deformer(
+        &mut self,
+        d: &Deformer,
+        volume: &CaptureVolume,
+        mesh_radius: &impl Fn(MeshId) -> Option<f32>,
+    ) {
+        match d.shape {
+            Shape::Mesh(id) => {
+                if let Some(radius) = mesh_radius(id) {
+                    capture::push_mesh_draws(
+                        d,
+                        id,
+                        radius,
+                        volume,
+                        &mut self.draws,
+                        &mut self.draw_meshes,
+                    );
+                }
+            }
+            _ => capture::push_primitives(d, volume, &mut self.prims),
+        }
+    }
 }

@@ -180,6 +180,8 @@ impl SnowWorld {
         let mut steps = std::mem::take(&mut self.probes.footsteps);
         let meshes = &self.probes.mesh_vertices;
         let all: Vec<_> = layers.iter().flat_map(|l| l.iter().copied()).collect();
+        // The plan's grid over a shared list (the layers' lists are still borrowed), if any.
+        let mut nearby = std::mem::take(&mut self.scratch_cpu.plan.nearby);
         crate::world::footstep::footsteps(
             &all,
             |id| {
@@ -187,8 +189,11 @@ impl SnowWorld {
                 Some((&s.desc, s.ground.as_ref().map(|g| &g.field)))
             },
             |m| meshes.get(m.0 as usize)?.as_deref(),
+            &mut nearby,
             &mut steps,
         );
+        nearby.forget();
+        self.scratch_cpu.plan.nearby = nearby;
         self.probes.footsteps = steps;
         self.poll_probes_only();
     }
