@@ -13,8 +13,6 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::SurfaceUpdate;
-use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
 use crate::deformer::{Deformer, Pose, Shape};
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
@@ -179,58 +177,35 @@ pub fn landing_on<'a>(
     Some((now, depth, speed))
 }
 
-/// Every footstep of an update, in the order of its surfaces and their deformers. Deformers without
-/// a `previous` pose (at rest) never land. `desc` looks up a live surface, `mesh_vertices` a mesh's
-/// vertices. A long list shared by surfaces is looked up in `nearby` (built over it when it is not
-/// already), so that each surface tests only the deformers near it.
-pub(crate) fn footsteps<'a, 'm>(
-    updates: &[SurfaceUpdate<'_>],
-    desc: impl Fn(SurfaceId) -> Option<(&'a SurfaceDesc, Option<&'a GroundField>)>,
+/// The footstep of deformer `i` of a surface's update (`id`, with its description and
+/// world-to-local transform) that may lie on a ground field, if the deformer landed on it during
+/// `elapsed` seconds. A deformer without a `previous` pose (at rest) never lands. The world's
+/// frame plan runs it over each surface's deformers ([`crate::world::FramePlan::footsteps`]).
+pub(crate) fn footstep<'m>(
+    i: usize,
+    deformer: &Deformer,
+    (id, desc, world_to_local): (SurfaceId, &SurfaceDesc, &Mat4),
+    ground: Option<&GroundField>,
+    elapsed: f32,
     mesh_vertices: impl Fn(MeshId) -> Option<&'m [Vec3]> + Copy,
-    nearby: &mut NearbyDeformers,
-    out: &mut Vec<Footstep>,
-) {
-    out.clear();
-    let mut near = Vec::new();
-    for u in updates {
-        let Some((d, ground)) = desc(u.surface) else {
-            continue;
-        };
-        let m = d.world_to_local();
-        let mut land = |i: usize, deformer: &Deformer| {
-            let Some(previous) = deformer.previous.as_ref() else {
-                return;
-            };
-            if let Some((point, depth_m, speed)) = landing_on(
-                (d, &m),
-                ground,
-                &deformer.shape,
-                previous,
-                &deformer.pose,
-                u.elapsed,
-                mesh_vertices,
-            ) {
-                out.push(Footstep {
-                    deformer: i,
-                    surface: u.surface,
-                    point,
-                    depth_m,
-                    speed,
-                });
-            }
-        };
-        if u.deformers.len() >= INDEX_FROM {
-            nearby.index(u.deformers);
-            nearby.near(surface_rect(d), &mut near);
-            for &i in &near {
-                land(i as usize, &u.deformers[i as usize]);
-            }
-        } else {
-            for (i, deformer) in u.deformers.iter().enumerate() {
-                land(i, deformer);
-            }
-        }
-    }
+) -> Option<Footstep> {
+    let previous = deformer.previous.as_ref()?;
+    let (point, depth_m, speed) = landing_on(
+        (desc, world_to_local),
+        ground,
+        &deformer.shape,
+        previous,
+        &deformer.pose,
+        elapsed,
+        mesh_vertices,
+    )?;
+    Some(Footstep {
+        deformer: i,
+        surface: id,
+        point,
+        depth_m,
+        speed,
+    })
 }
 
 #[cfg(test)]

@@ -5,14 +5,15 @@
 
 use std::time::Instant;
 
-use super::plan::{FramePlan, PlanSettings, PlanSurface};
+use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
 use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
-use crate::capture::{self, CaptureBuffers};
+use crate::capture::{self, CaptureBuffers, CaptureMesh};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::gpu::timestamps::StageQueries;
+use crate::mesh::MeshId;
 use crate::pool::SurfaceRecord;
 use crate::relax::{self, RelaxBuffers};
 
@@ -154,9 +155,11 @@ impl SnowWorld {
         let slot = measured.and_then(|r| r.free_slot());
         let mut queries =
             StageQueries::new(measured.filter(|_| slot.is_some()).map(|r| r.timestamps()));
+        self.probes.footsteps.clear();
         for (j, updates) in layers.iter().enumerate() {
             let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
             self.plan_into(&mut plan, updates);
+            self.probes.footsteps.extend_from_slice(&plan.footsteps);
             stats.add_layer(&plan.stats());
             // The spray's particles move by the layer's longest step (a step passes one dt).
             let dt = updates.iter().map(|u| u.elapsed).fold(0.0, f32::max);
@@ -189,7 +192,7 @@ impl SnowWorld {
             frame: self.frames,
             timestamp_slot,
         });
-        self.probes_after_update(layers);
+        self.probes_after_update();
         stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(PendingFrame {
             world: self.id,
@@ -363,6 +366,7 @@ impl SnowWorld {
             let s = self.surfaces[index].as_ref()?;
             Some(PlanSurface {
                 index,
+                id: u.surface,
                 desc: &s.desc,
                 layout: s.layout,
                 heights_word: s.slot.heights_word(),
@@ -375,12 +379,14 @@ impl SnowWorld {
                 deformers: u.deformers,
                 settle: s.settle,
                 ground: s.ground.as_ref().map(|g| g.plan()),
+                ground_field: s.ground.as_ref().map(|g| &g.field),
             })
         });
-        let meshes = &self.meshes;
-        plan.rebuild(&PlanSettings::of(&self.config), surfaces, |id| {
-            meshes.get(id.0 as usize)?.as_ref().map(|m| m.radius)
-        });
+        let meshes = WorldMeshes {
+            capture: &self.meshes,
+            vertices: &self.probes.mesh_vertices,
+        };
+        plan.rebuild(&PlanSettings::of(&self.config), surfaces, meshes);
     }
 
     /// Grow the per-frame buffers the plan needs and write its tables: with `queue.write_buffer`
@@ -507,6 +513,23 @@ impl SnowWorld {
         );
     }
 }
+/// The world's meshes as its plan sees them: their capture radius and the CPU copy of their
+/// vertices the footstep test reads, both by mesh index.
+struct WorldMeshes<'a> {
+    capture: &'a [Option<CaptureMesh>],
+    vertices: &'a [Option<Vec<glam::Vec3>>],
+}
+
+impl PlanMeshes for WorldMeshes<'_> {
+    fn radius(&self, id: MeshId) -> Option<f32> {
+        self.capture.get(id.0 as usize)?.as_ref().map(|m| m.radius)
+    }
+
+    fn vertices(&self, id: MeshId) -> Option<&[glam::Vec3]> {
+        self.vertices.get(id.0 as usize)?.as_deref()
+    }
+}
+
 /// Write `items` as uniform blocks [`UNIFORM_STRIDE`] apart into `bytes` (at least `min` blocks).
 fn uniform_blocks<T: bytemuck::Pod>(bytes: &mut Vec<u8>, items: &[T], min: usize) {
     let stride = UNIFORM_STRIDE as usize;

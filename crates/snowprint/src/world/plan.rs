@@ -11,6 +11,7 @@ use std::ops::Range;
 
 use glam::{Vec2, Vec3};
 
+use super::footstep::{Footstep, footstep};
 use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
 use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
@@ -19,13 +20,14 @@ use crate::capture::{
 };
 use crate::deformer::{Deformer, Shape};
 use crate::gpu::resources::UNIFORM_STRIDE;
+use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::pool::{
     MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER,
     TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
-use crate::surface::{SurfaceDesc, SurfaceLayout};
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 
 #[cfg(test)]
 mod tests;
@@ -65,12 +67,33 @@ impl PlanSettings {
     }
 }
 
+/// What a plan knows of the world's meshes.
+pub trait PlanMeshes {
+    /// The bounding radius of a registered mesh (`None`: not registered; its deformers are
+    /// skipped).
+    fn radius(&self, id: MeshId) -> Option<f32>;
+
+    /// Its vertices as last posed, for the footstep test (`None`: its deformers never land).
+    fn vertices(&self, _id: MeshId) -> Option<&[Vec3]> {
+        None
+    }
+}
+
+/// A function giving a mesh's radius, and no vertices.
+impl<F: Fn(MeshId) -> Option<f32>> PlanMeshes for F {
+    fn radius(&self, id: MeshId) -> Option<f32> {
+        self(id)
+    }
+}
+
 /// One surface to update, as the plan sees it: its description, its place in the pool, the
 /// replenishment it carried, and what touched it.
 #[derive(Clone, Copy, Debug)]
 pub struct PlanSurface<'a> {
     /// The world's index of the surface (carried to the plan's outputs).
     pub index: usize,
+    /// Its handle (named by its footsteps).
+    pub id: SurfaceId,
     /// The surface.
     pub desc: &'a SurfaceDesc,
     /// Its heightmap resolution.
@@ -92,6 +115,8 @@ pub struct PlanSurface<'a> {
     pub settle: Settle,
     /// Its ground field in the capture's ground buffer, or `None` on flat ground.
     pub ground: Option<PlanGround>,
+    /// The ground field itself, for the footstep test (`None` on flat ground).
+    pub ground_field: Option<&'a GroundField>,
 }
 
 /// Where a surface's ground field lies for the capture, and the heights it spans.
@@ -178,6 +203,10 @@ pub struct FramePlan {
     pub settles: Vec<(usize, Settle)>,
     /// What each per-frame buffer must hold.
     pub sizes: BufferSizes,
+    /// Every deformer that landed on a surface, in the order of the surfaces and their deformers
+    /// (see [`crate::SnowWorld::footsteps`]): the footstep test runs in the same walk over a
+    /// surface's deformers as the capture's culling.
+    pub footsteps: Vec<Footstep>,
     jobs: Vec<Job>,
     rects: Vec<(u32, u32)>,
     /// Scratch of the compute path's tiles, a flag a tile of one surface.
@@ -190,15 +219,16 @@ pub struct FramePlan {
 }
 
 impl FramePlan {
-    /// Plan a frame of `surfaces` (each listed once). `mesh_radius` gives the bounding radius of
-    /// a registered mesh (`None`: not registered; its deformers are skipped).
+    /// Plan a frame of `surfaces` (each listed once). `meshes` gives the bounding radius of a
+    /// registered mesh (`None`: not registered; its deformers are skipped), and its vertices for
+    /// the footstep test.
     pub fn build<'a>(
         settings: &PlanSettings,
         surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
-        mesh_radius: impl Fn(MeshId) -> Option<f32>,
+        meshes: impl PlanMeshes,
     ) -> Self {
         let mut plan = Self::default();
-        plan.rebuild(settings, surfaces, mesh_radius);
+        plan.rebuild(settings, surfaces, meshes);
         plan
     }
 
@@ -207,11 +237,11 @@ impl FramePlan {
         &mut self,
         settings: &PlanSettings,
         surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
-        mesh_radius: impl Fn(MeshId) -> Option<f32>,
+        meshes: impl PlanMeshes,
     ) {
         self.clear();
         for s in surfaces {
-            self.plan_surface(settings, &s, &mesh_radius);
+            self.plan_surface(settings, &s, &meshes);
         }
         // Surfaces that refill snow first: the fused grid covers records 0..dense; the others are
         // updated only where the capture listed a tile.
@@ -245,6 +275,7 @@ impl FramePlan {
         self.relax.clear();
         self.settles.clear();
         self.sizes = BufferSizes::default();
+        self.footsteps.clear();
         self.jobs.clear();
         self.rects.clear();
         self.nearby.forget();
@@ -255,7 +286,7 @@ impl FramePlan {
         &mut self,
         settings: &PlanSettings,
         s: &PlanSurface<'_>,
-        mesh_radius: &impl Fn(MeshId) -> Option<f32>,
+        meshes: &impl PlanMeshes,
     ) {
         let (carry, units) = replenish(
             s.carry,
@@ -273,18 +304,24 @@ impl FramePlan {
         };
         let p0 = self.capture.prims.len() as u32;
         let d0 = self.capture.draws.len() as u32;
+        let (capture, footsteps) = (&mut self.capture, &mut self.footsteps);
+        let mut visit = |i: usize, d: &Deformer| {
+            capture.push_deformer(d, &volume, meshes);
+            let on = (s.id, s.desc, &volume.world_to_local);
+            let vertices = |id| meshes.vertices(id);
+            footsteps.extend(footstep(i, d, on, s.ground_field, s.elapsed, vertices));
+        };
         if s.deformers.len() >= INDEX_FROM {
             // A long list (every deformer of the world): only those in the grid's cells near the
             // surface, in the list's order.
             self.nearby.index(s.deformers);
             self.nearby.near(surface_rect(s.desc), &mut self.near);
             for &i in &self.near {
-                self.capture
-                    .push_deformer(&s.deformers[i as usize], &volume, mesh_radius);
+                visit(i as usize, &s.deformers[i as usize]);
             }
         } else {
-            for d in s.deformers {
-                self.capture.push_deformer(d, &volume, mesh_radius);
+            for (i, d) in s.deformers.iter().enumerate() {
+                visit(i, d);
             }
         }
         let prims = &self.capture.prims;
@@ -604,15 +641,10 @@ pub fn replenish(carry: f64, rate: f32, elapsed: f32, channel_max: u32) -> (f64,
 
 impl CapturePlan {
     /// Append what one deformer draws over `volume`: its primitives, or a registered mesh's draws.
-    fn push_deformer(
-        &mut self,
-        d: &Deformer,
-        volume: &CaptureVolume,
-        mesh_radius: &impl Fn(MeshId) -> Option<f32>,
-    ) {
+    fn push_deformer(&mut self, d: &Deformer, volume: &CaptureVolume, meshes: &impl PlanMeshes) {
         match d.shape {
             Shape::Mesh(id) => {
-                if let Some(radius) = mesh_radius(id) {
+                if let Some(radius) = meshes.radius(id) {
                     capture::push_mesh_draws(
                         d,
                         id,

@@ -8,10 +8,10 @@ use super::*;
 use crate::capture::{CaptureVolume, GpuPrimitive, MeshDraw};
 use crate::deformer::{Pose, Shape};
 use crate::mesh::MeshId;
-use crate::surface::SurfaceLayout;
+use crate::surface::{SurfaceId, SurfaceLayout};
 use crate::world::WorldConfig;
-use crate::world::footstep::landing_on;
-use crate::world::plan::{FramePlan, PlanSettings, PlanSurface};
+use crate::world::footstep::{Footstep, landing_on};
+use crate::world::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
 
 /// A deformer: shape kind (sphere, capsule, box, mesh), sizes, position, step, rotations, and
 /// whether it moved.
@@ -113,6 +113,19 @@ fn mesh_vertices(_: MeshId) -> Option<&'static [Vec3]> {
     Some(&CORNERS)
 }
 
+/// Every mesh is registered with [`MESH_RADIUS`] and [`mesh_vertices`].
+struct TestMeshes;
+
+impl PlanMeshes for TestMeshes {
+    fn radius(&self, _: MeshId) -> Option<f32> {
+        Some(MESH_RADIUS)
+    }
+
+    fn vertices(&self, id: MeshId) -> Option<&[Vec3]> {
+        mesh_vertices(id)
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -161,7 +174,7 @@ proptest! {
 
     /// A plan over surfaces that share one long list draws, surface by surface, exactly what the
     /// capture's culling draws from the whole list: the same primitives and mesh draws in the
-    /// same order.
+    /// same order; and it finds the footsteps the test of every pair finds, in the same order.
     #[test]
     fn a_shared_list_plans_what_every_pair_plans(
         seeds in prop::collection::vec(deformer_seed(), INDEX_FROM..200),
@@ -178,6 +191,7 @@ proptest! {
                 let layout = SurfaceLayout::for_size_capped(desc.size, 512);
                 let s = PlanSurface {
                     index,
+                    id: SurfaceId(index as u32, 0),
                     desc,
                     layout,
                     heights_word: word,
@@ -188,13 +202,14 @@ proptest! {
                     deformers: &deformers,
                     settle: Default::default(),
                     ground: None,
+                    ground_field: None,
                 };
                 word += layout.width * layout.height;
                 s
             })
             .collect();
         let settings = PlanSettings::of(&WorldConfig::default());
-        let plan = FramePlan::build(&settings, inputs, |_| Some(MESH_RADIUS));
+        let plan = FramePlan::build(&settings, inputs, TestMeshes);
         let mut drawn = vec![(Vec::new(), Vec::new()); descs.len()];
         for s in &plan.capture.surfaces {
             let index = plan.surfaces[s.record as usize].index;
@@ -219,6 +234,21 @@ proptest! {
             prop_assert_eq!(&drawn[index].0, &prims, "primitives of surface {}", index);
             prop_assert_eq!(&drawn[index].1, &draws, "mesh draws of surface {}", index);
         }
+        // The footsteps, surface by surface and deformer by deformer.
+        let mut steps = Vec::new();
+        for (index, desc) in descs.iter().enumerate() {
+            let m = desc.world_to_local();
+            for (i, d) in deformers.iter().enumerate() {
+                let Some(prev) = d.previous.as_ref() else { continue };
+                if let Some((point, depth_m, speed)) =
+                    landing_on((desc, &m), None, &d.shape, prev, &d.pose, 0.1, mesh_vertices)
+                {
+                    let surface = SurfaceId(index as u32, 0);
+                    steps.push(Footstep { deformer: i, surface, point, depth_m, speed });
+                }
+            }
+        }
+        prop_assert_eq!(&plan.footsteps, &steps);
     }
 }
 
