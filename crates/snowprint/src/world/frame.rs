@@ -5,6 +5,7 @@
 
 use std::time::Instant;
 
+use super::nearby::INDEX_FROM;
 use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
 use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
@@ -134,9 +135,7 @@ impl SnowWorld {
         if self.in_flight.is_some() {
             return Err(SnowError::FramePending);
         }
-        for updates in layers {
-            self.validate(updates)?;
-        }
+        let mut first = self.check_and_plan_first(layers)?;
         self.probes_before_update(encoder);
         self.frames += 1;
         let mut stats = FrameStats {
@@ -157,8 +156,14 @@ impl SnowWorld {
             StageQueries::new(measured.filter(|_| slot.is_some()).map(|r| r.timestamps()));
         self.probes.footsteps.clear();
         for (j, updates) in layers.iter().enumerate() {
-            let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
-            self.plan_into(&mut plan, updates);
+            let plan = match first.take() {
+                Some(plan) => plan,
+                None => {
+                    let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
+                    self.plan_into(&mut plan, updates);
+                    plan
+                }
+            };
             self.probes.footsteps.extend_from_slice(&plan.footsteps);
             stats.add_layer(&plan.stats());
             // The spray's particles move by the layer's longest step (a step passes one dt).
@@ -200,6 +205,36 @@ impl SnowWorld {
             stats,
             start,
         })
+    }
+
+    /// Check every layer and plan the first, before anything changes. The first layer's short
+    /// lists (a surface's own deformers) are checked as its plan walks them, so that the
+    /// deformers are read once; if anything is refused, the whole check runs again to name the
+    /// first fault, as it always did. The plan, unless the quick check alone refused the layers.
+    fn check_and_plan_first(
+        &mut self,
+        layers: &[&[SurfaceUpdate<'_>]],
+    ) -> Result<Option<FramePlan>> {
+        let checked = layers
+            .iter()
+            .enumerate()
+            .try_for_each(|(j, updates)| self.validate(updates, j > 0));
+        let mut first = std::mem::take(&mut self.scratch_cpu.plan);
+        let planned = checked.is_ok() && !layers.is_empty();
+        if planned {
+            first.check_short_lists = true;
+            self.plan_into(&mut first, layers[0]);
+            first.check_short_lists = false;
+        }
+        if checked.is_err() || (planned && first.refused) {
+            self.scratch_cpu.plan = first;
+            layers
+                .iter()
+                .try_for_each(|updates| self.validate(updates, true))?;
+            // Unreachable: what the quick check or the plan refuses, the whole check refuses.
+            return Ok(None);
+        }
+        Ok(Some(first))
     }
 
     /// Keep the settle counters a layer leaves (remembering the first for an abandoned frame).
@@ -310,17 +345,24 @@ impl SnowWorld {
         }
     }
 
-    /// Refuse a bad time step, a stale or repeated surface, a bad deformer or a stale mesh.
-    fn validate(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<()> {
+    /// Refuse a bad time step, a stale or repeated surface, a bad deformer or a stale mesh; the
+    /// deformers of lists shorter than [`INDEX_FROM`] only when `short_lists` (else the plan's
+    /// walk checks them).
+    fn validate(&mut self, updates: &[SurfaceUpdate<'_>], short_lists: bool) -> Result<()> {
         let mut seen = std::mem::take(&mut self.scratch_cpu.seen);
         seen.clear();
         seen.resize(self.surfaces.len(), false);
-        let result = self.validate_with(updates, &mut seen);
+        let result = self.validate_with(updates, &mut seen, short_lists);
         self.scratch_cpu.seen = seen;
         result
     }
 
-    fn validate_with(&self, updates: &[SurfaceUpdate<'_>], seen: &mut [bool]) -> Result<()> {
+    fn validate_with(
+        &self,
+        updates: &[SurfaceUpdate<'_>],
+        seen: &mut [bool],
+        short_lists: bool,
+    ) -> Result<()> {
         // `encode_step` hands every surface the same list: check a list once, not once a surface.
         let mut checked: Option<(*const Deformer, usize)> = None;
         for u in updates {
@@ -335,7 +377,7 @@ impl SnowWorld {
             }
             *flag = true;
             let list = (u.deformers.as_ptr(), u.deformers.len());
-            if checked == Some(list) {
+            if checked == Some(list) || (!short_lists && u.deformers.len() < INDEX_FROM) {
                 continue;
             }
             checked = Some(list);

@@ -216,6 +216,12 @@ pub struct FramePlan {
     pub(crate) nearby: NearbyDeformers,
     /// Scratch: the deformers of a long list near one surface.
     near: Vec<u32>,
+    /// Whether to check each deformer of a short list as it is walked (see `refused`): the world
+    /// checks a frame's short lists in the plan's walk over them rather than in a pass of its own.
+    pub(crate) check_short_lists: bool,
+    /// Whether a deformer of a short list was refused ([`Deformer::validate`], or a mesh not
+    /// registered): the plan is not to be used, and the world's own check names the deformer.
+    pub(crate) refused: bool,
 }
 
 impl FramePlan {
@@ -276,6 +282,7 @@ impl FramePlan {
         self.settles.clear();
         self.sizes = BufferSizes::default();
         self.footsteps.clear();
+        self.refused = false;
         self.jobs.clear();
         self.rects.clear();
         self.nearby.forget();
@@ -320,8 +327,12 @@ impl FramePlan {
                 visit(i as usize, &s.deformers[i as usize]);
             }
         } else {
+            let check = self.check_short_lists;
             for (i, d) in s.deformers.iter().enumerate() {
                 visit(i, d);
+                if check && refused(d, meshes) {
+                    self.refused = true;
+                }
             }
         }
         let prims = &self.capture.prims;
@@ -619,6 +630,12 @@ fn pressed_rect(
         x1: clamp(b.x.ceil(), w),
         y1: clamp(b.y.ceil(), h),
     }
+}
+
+/// Whether the world refuses a deformer: invalid, or a mesh not registered.
+fn refused(d: &Deformer, meshes: &impl PlanMeshes) -> bool {
+    d.validate_named(String::new).is_err()
+        || matches!(d.shape, Shape::Mesh(id) if meshes.radius(id).is_none())
 }
 
 /// Whether the compute path captures a surface with `prims` primitives (and mesh draws when
