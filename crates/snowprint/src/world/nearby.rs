@@ -201,18 +201,19 @@ impl NearbyDeformers {
         // when a bound that is not a number reverses it).
         let [x0, z0, x1, z1] = rect;
         let beside = x1 < self.origin.x || z1 < self.origin.y || x0 > self.far.x || z0 > self.far.y;
-        let rows = if c0 <= c1 && !beside { r0..=r1 } else { 1..=0 };
-        for r in rows {
-            let row = (r * self.cells.0) as usize;
-            let (a, b) = (
-                self.starts[row + c0 as usize],
-                self.starts[row + c1 as usize + 1],
-            );
-            for &i in &self.entries[a as usize..b as usize] {
-                let stamp = &mut self.stamps[i as usize];
-                if *stamp != self.query {
-                    *stamp = self.query;
-                    out.push(i);
+        if c0 <= c1 && !beside {
+            for r in r0..=r1 {
+                let row = (r * self.cells.0) as usize;
+                let (a, b) = (
+                    self.starts[row + c0 as usize],
+                    self.starts[row + c1 as usize + 1],
+                );
+                for &i in &self.entries[a as usize..b as usize] {
+                    let stamp = &mut self.stamps[i as usize];
+                    if *stamp != self.query {
+                        *stamp = self.query;
+                        out.push(i);
+                    }
                 }
             }
         }
