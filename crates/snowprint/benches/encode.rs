@@ -4,14 +4,20 @@
 //! of them (`encode_step`, every surface offered every deformer) and a list per surface
 //! (`encode_update`, what `snowprint bench` does).
 //!
-//! `cargo bench -p snowprint --bench encode` (add `-- --quick` for a software adapter).
+//! Surfaces are captured by the compute path, as on a GPU (`CapturePath::Auto` would take the
+//! raster path on a software adapter, which plans less on the CPU).
+//!
+//! `cargo bench -p snowprint --bench encode` (add `-- --quick` for a software adapter), with
+//! `--surfaces 256,1024,4096` to choose the counts and `--texels 64` for smaller surfaces (a
+//! software adapter binds at most 128 MiB, and the capture buffer holds 4 bytes a texel of every
+//! captured surface: 2048 of 128^2 at most); `--frames N` and `--only shared|each` for a profile.
 //! Results: `docs/PERFORMANCE.md`, "CPU encode".
 
 use std::time::Instant;
 
 use snowprint::{
-    Deformer, GpuContext, GpuOptions, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
-    SurfaceUpdate, WorldConfig,
+    CapturePath, Deformer, GpuContext, GpuOptions, PoolFormat, Pose, Precision, Shape, SnowWorld,
+    SurfaceDesc, SurfaceId, SurfaceUpdate, WorldConfig,
 };
 
 const SPHERES: u32 = 10;
@@ -21,12 +27,17 @@ fn median(v: &mut [f64]) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
-fn world(gpu: &GpuContext, surfaces: u32) -> (SnowWorld, Vec<(SurfaceId, [f32; 3])>) {
-    let metres = 4.0;
+fn world(gpu: &GpuContext, surfaces: u32, texels: u32) -> (SnowWorld, Vec<(SurfaceId, [f32; 3])>) {
+    // Texels of 4 cm, as `snowprint bench` has them, at 8 bits (the smallest pool).
+    let metres = texels as f32 * 0.04;
+    let format = PoolFormat::new(Precision::Bits8);
     let mut world = SnowWorld::new(
         gpu,
         WorldConfig {
-            pool_bytes: 128 * 128 * 4 * surfaces as u64,
+            pool_bytes: format.slot_bytes(texels, texels) * surfaces as u64,
+            max_resolution: texels,
+            capture_path: CapturePath::Compute,
+            format,
             atlas_side: 8192.min(gpu.caps.max_texture_side),
             ..Default::default()
         },
@@ -55,9 +66,21 @@ fn spheres(c: [f32; 3], t: f32) -> impl Iterator<Item = Deformer> {
     })
 }
 
-/// Median milliseconds to encode a frame: (shared list, a list per surface).
-fn run(gpu: &GpuContext, surfaces: u32, frames: u32) -> (f64, f64) {
-    let (mut world, ids) = world(gpu, surfaces);
+/// Submit nothing but the tables the abandoned frame wrote with `queue.write_buffer`, and wait:
+/// their staging memory is given back as in an application that submits every frame (kept, it
+/// would grow frame after frame, each frame's writes faulting in fresh pages).
+fn flush(gpu: &GpuContext) {
+    gpu.queue.submit([]);
+    gpu.wait_idle().expect("wait");
+}
+
+/// Which ways of handing deformers over to measure: (shared list, a list per surface).
+type Cases = (bool, bool);
+
+/// Median milliseconds to encode a frame: (shared list, a list per surface), NaN for a case not
+/// measured.
+fn run(gpu: &GpuContext, (surfaces, texels): (u32, u32), frames: u32, cases: Cases) -> (f64, f64) {
+    let (mut world, ids) = world(gpu, surfaces, texels);
     let (mut shared, mut each) = (Vec::new(), Vec::new());
     for f in 0..frames {
         let t = f as f32 / 60.0;
@@ -72,16 +95,22 @@ fn run(gpu: &GpuContext, surfaces: u32, frames: u32) -> (f64, f64) {
                 deformers,
             })
             .collect();
-        let mut encoder = gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        let start = Instant::now();
-        let pending = world
-            .encode_step(&mut encoder, 1.0 / 60.0, &all)
-            .expect("encode");
-        shared.push(start.elapsed().as_secs_f64() * 1e3);
-        drop((pending, encoder));
-        world.abandon_pending();
+        if cases.0 {
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+            let start = Instant::now();
+            let pending = world
+                .encode_step(&mut encoder, 1.0 / 60.0, &all)
+                .expect("encode");
+            shared.push(start.elapsed().as_secs_f64() * 1e3);
+            drop((pending, encoder));
+            world.abandon_pending();
+            flush(gpu);
+        }
+        if !cases.1 {
+            continue;
+        }
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
@@ -90,6 +119,7 @@ fn run(gpu: &GpuContext, surfaces: u32, frames: u32) -> (f64, f64) {
         each.push(start.elapsed().as_secs_f64() * 1e3);
         drop((pending, encoder));
         world.abandon_pending();
+        flush(gpu);
     }
     (median(&mut shared), median(&mut each))
 }
@@ -97,18 +127,43 @@ fn run(gpu: &GpuContext, surfaces: u32, frames: u32) -> (f64, f64) {
 fn main() {
     let gpu = GpuContext::new(&GpuOptions::default()).expect("GPU");
     let quick = std::env::args().any(|a| a == "--quick");
-    let (counts, frames): (&[u32], u32) = if quick {
-        (&[16, 256, 1024], 5)
+    let (mut counts, mut frames): (Vec<u32>, u32) = if quick {
+        (vec![16, 256, 1024], 5)
     } else {
-        (&[16, 256, 1024, 4096], 30)
+        (vec![16, 256, 1024, 4096], 30)
     };
-    println!("encode on {}", gpu.info.name);
+    let args: Vec<String> = std::env::args().collect();
+    let value = |name: &str| {
+        let i = args.iter().position(|a| a == name)?;
+        args.get(i + 1).map(String::as_str)
+    };
+    if let Some(list) = value("--surfaces") {
+        counts = list
+            .split(',')
+            .map(|n| {
+                n.trim()
+                    .parse()
+                    .expect("--surfaces takes counts like 256,1024")
+            })
+            .collect();
+    }
+    if let Some(n) = value("--frames") {
+        frames = n.parse().expect("--frames takes a count");
+    }
+    // `--only shared` or `--only each` (for a profile of one case).
+    let cases = match value("--only") {
+        Some("shared") => (true, false),
+        Some("each") => (false, true),
+        _ => (true, true),
+    };
+    let texels: u32 = value("--texels").map_or(128, |t| t.parse().expect("--texels takes a side"));
+    println!("encode on {}, surfaces of {texels}^2", gpu.info.name);
     println!(
         "{:<10} {:>16} {:>16}",
         "surfaces", "shared_list_ms", "per_surface_ms"
     );
-    for &n in counts {
-        let (shared, each) = run(&gpu, n, frames);
+    for n in counts {
+        let (shared, each) = run(&gpu, (n, texels), frames, cases);
         println!("{n:<10} {shared:>16.3} {each:>16.3}");
     }
 }

@@ -862,6 +862,74 @@ fn bad_input_is_an_error() {
     ));
 }
 
+/// A surface's own list is checked as the plan walks it: a bad deformer or a removed mesh there is
+/// refused, the first fault of the update named, and nothing changes (no frame counted, no snow
+/// refilled, nothing pressed).
+#[test]
+fn a_bad_deformer_in_a_surfaces_own_list_changes_nothing() {
+    let mut w = world(CaptureMode::Depth);
+    let mut desc = SurfaceDesc::new("own1", [0.0; 3], [2.0, 2.0], 0.3);
+    desc.replenish_rate = 0.5;
+    let a = w.add_surface(desc.clone()).unwrap();
+    desc.name = "own2".into();
+    let b = w.add_surface(desc).unwrap();
+    let good = Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, -0.1, 0.0]));
+    let far = Pose::at([f32::NAN, 0.0, 0.0]);
+    let bad = Deformer::new(Shape::Sphere { radius: 0.3 }, far);
+    fn update(
+        surface: snowprint::SurfaceId,
+        deformers: &[Deformer],
+    ) -> snowprint::SurfaceUpdate<'_> {
+        snowprint::SurfaceUpdate {
+            surface,
+            elapsed: 1.0,
+            deformers,
+        }
+    }
+    let e = w
+        .update(&[update(a, &[good]), update(b, &[good, bad])])
+        .unwrap_err();
+    assert!(
+        matches!(&e, SnowError::InvalidDeformer { name, what: "position", .. } if name == "#1"),
+        "{e}"
+    );
+    // A bad deformer before a repeated surface: the deformer is the first fault.
+    let e = w
+        .update(&[update(a, &[bad]), update(a, &[good])])
+        .unwrap_err();
+    assert!(matches!(e, SnowError::InvalidDeformer { .. }), "{e}");
+    let m = w.add_mesh("cube", &Mesh::cuboid(Vec3::ONE)).unwrap();
+    w.remove_mesh(m).unwrap();
+    let removed = [good, Deformer::new(Shape::Mesh(m), Pose::at([0.0; 3]))];
+    let e = w.update(&[update(a, &removed)]).unwrap_err();
+    assert!(
+        matches!(e, SnowError::StaleHandle { what: "mesh", .. }),
+        "{e}"
+    );
+    for s in [a, b] {
+        let h = w.read_heightmap(s).unwrap();
+        assert!(h.depression.iter().all(|&v| v == 0), "pressed");
+    }
+    // The first frame that goes through is the first counted, and refills the one second it
+    // was given, not the refused ones' too.
+    let stats = w.update(&[update(b, &[])]).unwrap();
+    assert_eq!(stats.frame, 1);
+    let after = w.read_heightmap(b).unwrap();
+    let one_second = w.read_heightmap(a).unwrap();
+    assert!(one_second.depression.iter().all(|&v| v == 0));
+    let refilled = after.depression.iter().copied().max();
+    w.update(&[update(a, &[])]).unwrap();
+    assert_eq!(
+        w.read_heightmap(a)
+            .unwrap()
+            .depression
+            .iter()
+            .copied()
+            .max(),
+        refilled
+    );
+}
+
 #[test]
 fn update_touches_only_the_listed_surfaces() {
     let mut w = world(CaptureMode::Depth);

@@ -246,14 +246,20 @@ pub fn encode(
 const ENTRIES_PER_X: u32 = 65535;
 
 /// The words that follow the view blocks in the views buffer for the compute path: the work
-/// list, then its first word and its length. Returns them with the bytes the binding spans.
-pub fn work_table(plan: &CapturePlan) -> (Vec<u32>, u64) {
+/// list, then its first word and its length. Appends them to `bytes`, which holds the view blocks.
+pub fn append_work_table(plan: &CapturePlan, bytes: &mut Vec<u8>) {
     let first = plan.views.len() as u64 * UNIFORM_STRIDE / 4;
-    let mut words: Vec<u32> = plan.work.iter().flatten().copied().collect();
-    words.push(first as u32);
-    words.push(plan.work.len() as u32);
-    let bytes = first * 4 + words.len() as u64 * 4;
-    (words, bytes)
+    bytes.extend_from_slice(bytemuck::cast_slice(&plan.work));
+    bytes.extend_from_slice(bytemuck::cast_slice(&[
+        first as u32,
+        plan.work.len() as u32,
+    ]));
+}
+
+/// Bytes of the views buffer the compute path binds: the view blocks and
+/// [`append_work_table`]'s words.
+pub fn work_table_bytes(plan: &CapturePlan) -> u64 {
+    plan.views.len() as u64 * UNIFORM_STRIDE + (plan.work.len() as u64 * 2 + 2) * 4
 }
 
 /// The compute path: a workgroup an entry of the work list.
@@ -265,7 +271,7 @@ fn encode_compute(
     buffers: &CaptureBuffers<'_>,
     queries: &mut StageQueries<'_>,
 ) {
-    let (_, bytes) = work_table(plan);
+    let bytes = work_table_bytes(plan);
     let bg = bind_group(
         device,
         "capture compute",

@@ -17,7 +17,10 @@
 pub(crate) mod cpu;
 mod encode;
 
-pub use encode::{CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, encode, work_table};
+pub use encode::{
+    CaptureBuffers, CaptureMesh, CapturePlan, CapturedSurface, append_work_table, encode,
+    work_table_bytes,
+};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -146,9 +149,10 @@ pub fn tiles_reached(
     seen.clear();
     seen.resize((tx * ty) as usize, false);
     let texel = half * 2.0 / glam::Vec2::new(width as f32, height as f32);
-    let to_cell = |v: f32, h: f32, t: f32, n: u32| {
-        (((v + h) / t).floor() as i64).clamp(0, n as i64 - 1) as u32
-    };
+    // Truncation is the floor here: it differs only between -1 and 0, which the clamp takes to 0
+    // either way (and `floor` is a libm call on the baseline x86-64 target).
+    let to_cell =
+        |v: f32, h: f32, t: f32, n: u32| (((v + h) / t) as i64).clamp(0, n as i64 - 1) as u32;
     for p in prims {
         let [x0, z0, x1, z1] = footprint(p);
         if x1 < -half.x || z1 < -half.y || x0 > half.x || z0 > half.y {
@@ -374,7 +378,6 @@ pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Ve
         return;
     }
     let m = volume.world_to_local;
-    let (_, local_rot, _) = m.to_scale_rotation_translation();
     let prev = deformer.previous.unwrap_or(deformer.pose);
     let mut push = |p: GpuPrimitive| {
         let (lo, hi) = p.bounds();
@@ -419,6 +422,8 @@ pub fn push_primitives(deformer: &Deformer, volume: &CaptureVolume, out: &mut Ve
             let corner_move = prev.position.distance(deformer.pose.position)
                 + prev.rotation.angle_between(deformer.pose.rotation) * half_extents.length();
             let n = substeps(corner_move, half_extents.min_element() * 2.0);
+            // Only a box needs the frame's rotation (a decomposition of the matrix).
+            let (_, local_rot, _) = m.to_scale_rotation_translation();
             for k in 0..=n {
                 let t = k as f32 / n as f32;
                 let p = prev.lerp(&deformer.pose, t);
@@ -702,6 +707,51 @@ mod tests {
                 prop_assert!(lo.cmpge(centre - radius).all() && hi.cmple(centre + radius).all(),
                     "{lo} {hi} outside {centre} +- {radius}");
             }
+        }
+    }
+
+    proptest! {
+        /// The tiles listed are those whose cells the footprints (a texel wider) reach, cells
+        /// taken with `floor` as the compute shader's texels are: every tile once, in the order
+        /// the footprints reach them.
+        #[test]
+        fn tiles_reached_are_the_tiles_the_footprints_cover(
+            caps in prop::collection::vec(
+                (prop::array::uniform3(-6.0f32..6.0), prop::array::uniform3(-6.0f32..6.0), 0.01f32..2.0),
+                1..12,
+            ),
+            (w, h) in (1u32..300, 1u32..300),
+            (hx, hz) in (0.5f32..5.0, 0.5f32..5.0),
+        ) {
+            let prims: Vec<GpuPrimitive> = caps
+                .iter()
+                .map(|&(a, b, r)| GpuPrimitive::capsule(Vec3::from(a), Vec3::from(b), r))
+                .collect();
+            let half = glam::Vec2::new(hx, hz);
+            let (mut seen, mut work) = (Vec::new(), Vec::new());
+            tiles_reached(&prims, (w, h), half, 7, &mut seen, &mut work);
+            let tile = crate::pool::TILE_SIDE;
+            let texel = half * 2.0 / glam::Vec2::new(w as f32, h as f32);
+            let cell = |v: f32, h: f32, t: f32, n: u32| {
+                (((v + h) / t).floor() as i64).clamp(0, n as i64 - 1) as u32
+            };
+            let mut expected: Vec<[u32; 2]> = Vec::new();
+            for p in &prims {
+                let [x0, z0, x1, z1] = footprint(p);
+                if x1 < -half.x || z1 < -half.y || x0 > half.x || z0 > half.y {
+                    continue;
+                }
+                let (c0, c1) = (cell(x0 - texel.x, half.x, texel.x, w), cell(x1 + texel.x, half.x, texel.x, w));
+                let (r0, r1) = (cell(z0 - texel.y, half.y, texel.y, h), cell(z1 + texel.y, half.y, texel.y, h));
+                for r in r0 / tile..=r1 / tile {
+                    for c in c0 / tile..=c1 / tile {
+                        if !expected.contains(&[7, r << 16 | c]) {
+                            expected.push([7, r << 16 | c]);
+                        }
+                    }
+                }
+            }
+            prop_assert_eq!(work, expected);
         }
     }
 

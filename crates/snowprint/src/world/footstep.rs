@@ -13,8 +13,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::SurfaceUpdate;
-use crate::deformer::{Pose, Shape};
+use crate::deformer::{Deformer, Pose, Shape};
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::surface::{SurfaceDesc, SurfaceId};
@@ -178,44 +177,35 @@ pub fn landing_on<'a>(
     Some((now, depth, speed))
 }
 
-/// Every footstep of an update, in the order of its surfaces and their deformers. Deformers without
-/// a `previous` pose (at rest) never land. `desc` looks up a live surface, `mesh_vertices` a mesh's
-/// vertices.
-pub fn footsteps<'a, 'm>(
-    updates: &[SurfaceUpdate<'_>],
-    desc: impl Fn(SurfaceId) -> Option<(&'a SurfaceDesc, Option<&'a GroundField>)>,
+/// The footstep of deformer `i` of a surface's update (`id`, with its description and
+/// world-to-local transform) that may lie on a ground field, if the deformer landed on it during
+/// `elapsed` seconds. A deformer without a `previous` pose (at rest) never lands. The world's
+/// frame plan runs it over each surface's deformers ([`crate::world::FramePlan::footsteps`]).
+pub(crate) fn footstep<'m>(
+    i: usize,
+    deformer: &Deformer,
+    (id, desc, world_to_local): (SurfaceId, &SurfaceDesc, &Mat4),
+    ground: Option<&GroundField>,
+    elapsed: f32,
     mesh_vertices: impl Fn(MeshId) -> Option<&'m [Vec3]> + Copy,
-    out: &mut Vec<Footstep>,
-) {
-    out.clear();
-    for u in updates {
-        let Some((d, ground)) = desc(u.surface) else {
-            continue;
-        };
-        let m = d.world_to_local();
-        for (i, deformer) in u.deformers.iter().enumerate() {
-            let Some(previous) = deformer.previous.as_ref() else {
-                continue;
-            };
-            if let Some((point, depth_m, speed)) = landing_on(
-                (d, &m),
-                ground,
-                &deformer.shape,
-                previous,
-                &deformer.pose,
-                u.elapsed,
-                mesh_vertices,
-            ) {
-                out.push(Footstep {
-                    deformer: i,
-                    surface: u.surface,
-                    point,
-                    depth_m,
-                    speed,
-                });
-            }
-        }
-    }
+) -> Option<Footstep> {
+    let previous = deformer.previous.as_ref()?;
+    let (point, depth_m, speed) = landing_on(
+        (desc, world_to_local),
+        ground,
+        &deformer.shape,
+        previous,
+        &deformer.pose,
+        elapsed,
+        mesh_vertices,
+    )?;
+    Some(Footstep {
+        deformer: i,
+        surface: id,
+        point,
+        depth_m,
+        speed,
+    })
 }
 
 #[cfg(test)]

@@ -5,14 +5,16 @@
 
 use std::time::Instant;
 
-use super::plan::{FramePlan, PlanSettings, PlanSurface};
-use super::{FrameStats, InFlight, SnowWorld, StageTimes, SurfaceUpdate};
+use super::nearby::INDEX_FROM;
+use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
+use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
-use crate::capture::{self, CaptureBuffers};
+use crate::capture::{self, CaptureBuffers, CaptureMesh};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::gpu::timestamps::StageQueries;
+use crate::mesh::MeshId;
 use crate::pool::SurfaceRecord;
 use crate::relax::{self, RelaxBuffers};
 
@@ -133,9 +135,7 @@ impl SnowWorld {
         if self.in_flight.is_some() {
             return Err(SnowError::FramePending);
         }
-        for updates in layers {
-            self.validate(updates)?;
-        }
+        let mut first = self.check_and_plan_first(layers)?;
         self.probes_before_update(encoder);
         self.frames += 1;
         let mut stats = FrameStats {
@@ -144,6 +144,9 @@ impl SnowWorld {
         };
         self.scratch_cpu.carries.clear();
         self.scratch_cpu.settles.clear();
+        let kept = &mut self.scratch_cpu.kept;
+        kept.clear();
+        kept.resize(self.surfaces.len(), 0);
         // The ring is taken out while the layers borrow its query set.
         let ring = self.timestamps.take();
         // A frame is measured only while a readback slot is free: times are never waited for.
@@ -151,9 +154,17 @@ impl SnowWorld {
         let slot = measured.and_then(|r| r.free_slot());
         let mut queries =
             StageQueries::new(measured.filter(|_| slot.is_some()).map(|r| r.timestamps()));
+        self.probes.footsteps.clear();
         for (j, updates) in layers.iter().enumerate() {
-            let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
-            self.plan_into(&mut plan, updates);
+            let plan = match first.take() {
+                Some(plan) => plan,
+                None => {
+                    let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
+                    self.plan_into(&mut plan, updates);
+                    plan
+                }
+            };
+            self.probes.footsteps.extend_from_slice(&plan.footsteps);
             stats.add_layer(&plan.stats());
             // The spray's particles move by the layer's longest step (a step passes one dt).
             let dt = updates.iter().map(|u| u.elapsed).fold(0.0, f32::max);
@@ -186,7 +197,7 @@ impl SnowWorld {
             frame: self.frames,
             timestamp_slot,
         });
-        self.probes_after_update(layers);
+        self.probes_after_update();
         stats.cpu_encode_ms = start.elapsed().as_secs_f64() * 1e3;
         Ok(PendingFrame {
             world: self.id,
@@ -196,13 +207,44 @@ impl SnowWorld {
         })
     }
 
+    /// Check every layer and plan the first, before anything changes. The first layer's short
+    /// lists (a surface's own deformers) are checked as its plan walks them, so that the
+    /// deformers are read once; if anything is refused, the whole check runs again to name the
+    /// first fault, as it always did. The plan, unless the quick check alone refused the layers.
+    fn check_and_plan_first(
+        &mut self,
+        layers: &[&[SurfaceUpdate<'_>]],
+    ) -> Result<Option<FramePlan>> {
+        let checked = layers
+            .iter()
+            .enumerate()
+            .try_for_each(|(j, updates)| self.validate(updates, j > 0));
+        let mut first = std::mem::take(&mut self.scratch_cpu.plan);
+        let planned = checked.is_ok() && !layers.is_empty();
+        if planned {
+            first.check_short_lists = true;
+            self.plan_into(&mut first, layers[0]);
+            first.check_short_lists = false;
+        }
+        if checked.is_err() || (planned && first.refused) {
+            self.scratch_cpu.plan = first;
+            layers
+                .iter()
+                .try_for_each(|updates| self.validate(updates, true))?;
+            // Unreachable: what the quick check or the plan refuses, the whole check refuses.
+            return Ok(None);
+        }
+        Ok(Some(first))
+    }
+
     /// Keep the settle counters a layer leaves (remembering the first for an abandoned frame).
     fn keep_settles(&mut self, settles: &[(usize, crate::relax::Settle)]) {
+        let scratch = &mut self.scratch_cpu;
         for &(index, settle) in settles {
             if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
-                let before = &mut self.scratch_cpu.settles;
-                if !before.iter().any(|&(i, _)| i == index) {
-                    before.push((index, s.settle));
+                if scratch.kept[index] & KEPT_SETTLE == 0 {
+                    scratch.kept[index] |= KEPT_SETTLE;
+                    scratch.settles.push((index, s.settle));
                 }
                 s.settle = settle;
             }
@@ -212,11 +254,12 @@ impl SnowWorld {
     /// Keep the carries a layer leaves, remembering each surface's carry before the frame so
     /// that an abandoned frame puts it back.
     fn keep_carries(&mut self, carries: &[(usize, f64)]) {
+        let scratch = &mut self.scratch_cpu;
         for &(index, carry) in carries {
             if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
-                let before = &mut self.scratch_cpu.carries;
-                if !before.iter().any(|&(i, _)| i == index) {
-                    before.push((index, s.carry));
+                if scratch.kept[index] & KEPT_CARRY == 0 {
+                    scratch.kept[index] |= KEPT_CARRY;
+                    scratch.carries.push((index, s.carry));
                 }
                 s.carry = carry;
             }
@@ -302,17 +345,24 @@ impl SnowWorld {
         }
     }
 
-    /// Refuse a bad time step, a stale or repeated surface, a bad deformer or a stale mesh.
-    fn validate(&mut self, updates: &[SurfaceUpdate<'_>]) -> Result<()> {
+    /// Refuse a bad time step, a stale or repeated surface, a bad deformer or a stale mesh; the
+    /// deformers of lists shorter than [`INDEX_FROM`] only when `short_lists` (else the plan's
+    /// walk checks them).
+    fn validate(&mut self, updates: &[SurfaceUpdate<'_>], short_lists: bool) -> Result<()> {
         let mut seen = std::mem::take(&mut self.scratch_cpu.seen);
         seen.clear();
         seen.resize(self.surfaces.len(), false);
-        let result = self.validate_with(updates, &mut seen);
+        let result = self.validate_with(updates, &mut seen, short_lists);
         self.scratch_cpu.seen = seen;
         result
     }
 
-    fn validate_with(&self, updates: &[SurfaceUpdate<'_>], seen: &mut [bool]) -> Result<()> {
+    fn validate_with(
+        &self,
+        updates: &[SurfaceUpdate<'_>],
+        seen: &mut [bool],
+        short_lists: bool,
+    ) -> Result<()> {
         // `encode_step` hands every surface the same list: check a list once, not once a surface.
         let mut checked: Option<(*const Deformer, usize)> = None;
         for u in updates {
@@ -327,7 +377,7 @@ impl SnowWorld {
             }
             *flag = true;
             let list = (u.deformers.as_ptr(), u.deformers.len());
-            if checked == Some(list) {
+            if checked == Some(list) || (!short_lists && u.deformers.len() < INDEX_FROM) {
                 continue;
             }
             checked = Some(list);
@@ -358,6 +408,7 @@ impl SnowWorld {
             let s = self.surfaces[index].as_ref()?;
             Some(PlanSurface {
                 index,
+                id: u.surface,
                 desc: &s.desc,
                 layout: s.layout,
                 heights_word: s.slot.heights_word(),
@@ -370,12 +421,14 @@ impl SnowWorld {
                 deformers: u.deformers,
                 settle: s.settle,
                 ground: s.ground.as_ref().map(|g| g.plan()),
+                ground_field: s.ground.as_ref().map(|g| &g.field),
             })
         });
-        let meshes = &self.meshes;
-        plan.rebuild(&PlanSettings::of(&self.config), surfaces, |id| {
-            meshes.get(id.0 as usize)?.as_ref().map(|m| m.radius)
-        });
+        let meshes = WorldMeshes {
+            capture: &self.meshes,
+            vertices: &self.probes.mesh_vertices,
+        };
+        plan.rebuild(&PlanSettings::of(&self.config), surfaces, meshes);
     }
 
     /// Grow the per-frame buffers the plan needs and write its tables: with `queue.write_buffer`
@@ -400,7 +453,7 @@ impl SnowWorld {
         if !c.work.is_empty() {
             // The compute path's work list and its place, after the blocks (`prims.wgsl`).
             blocks.truncate(c.views.len() * UNIFORM_STRIDE as usize);
-            blocks.extend_from_slice(bytemuck::cast_slice(&capture::work_table(c).0));
+            capture::append_work_table(c, blocks);
         }
         self.views.ensure(device, sizes.views);
         write(&self.views.buffer, blocks);
@@ -502,6 +555,23 @@ impl SnowWorld {
         );
     }
 }
+/// The world's meshes as its plan sees them: their capture radius and the CPU copy of their
+/// vertices the footstep test reads, both by mesh index.
+struct WorldMeshes<'a> {
+    capture: &'a [Option<CaptureMesh>],
+    vertices: &'a [Option<Vec<glam::Vec3>>],
+}
+
+impl PlanMeshes for WorldMeshes<'_> {
+    fn radius(&self, id: MeshId) -> Option<f32> {
+        self.capture.get(id.0 as usize)?.as_ref().map(|m| m.radius)
+    }
+
+    fn vertices(&self, id: MeshId) -> Option<&[glam::Vec3]> {
+        self.vertices.get(id.0 as usize)?.as_deref()
+    }
+}
+
 /// Write `items` as uniform blocks [`UNIFORM_STRIDE`] apart into `bytes` (at least `min` blocks).
 fn uniform_blocks<T: bytemuck::Pod>(bytes: &mut Vec<u8>, items: &[T], min: usize) {
     let stride = UNIFORM_STRIDE as usize;

@@ -21,6 +21,7 @@ mod frame;
 mod ground;
 mod levels;
 mod meshes;
+mod nearby;
 pub(crate) mod plan;
 pub(crate) mod probe;
 mod readback;
@@ -88,7 +89,16 @@ struct FrameScratch {
     /// The settle states before a pending frame (see `carries`).
     settles: Vec<(usize, crate::relax::Settle)>,
     captured: Vec<(usize, SurfaceRecord)>,
+    /// By surface index, whether `carries` ([`KEPT_CARRY`]) and `settles` ([`KEPT_SETTLE`])
+    /// already hold its state from before the frame (a flag a surface, not a search of the lists:
+    /// a frame of thousands of surfaces would be quadratic).
+    kept: Vec<u8>,
 }
+
+/// A flag of [`FrameScratch::kept`]: the surface's carry is remembered.
+const KEPT_CARRY: u8 = 1;
+/// A flag of [`FrameScratch::kept`]: the surface's settle state is remembered.
+const KEPT_SETTLE: u8 = 2;
 
 /// The frame encoded and not yet reported submitted.
 #[derive(Clone, Copy, Debug)]

@@ -11,6 +11,8 @@ use std::ops::Range;
 
 use glam::{Vec2, Vec3};
 
+use super::footstep::{Footstep, footstep};
+use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
 use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
 use crate::capture::{
@@ -18,13 +20,14 @@ use crate::capture::{
 };
 use crate::deformer::{Deformer, Shape};
 use crate::gpu::resources::UNIFORM_STRIDE;
+use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::pool::{
     MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER,
     TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
-use crate::surface::{SurfaceDesc, SurfaceLayout};
+use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 
 #[cfg(test)]
 mod tests;
@@ -64,12 +67,33 @@ impl PlanSettings {
     }
 }
 
+/// What a plan knows of the world's meshes.
+pub trait PlanMeshes {
+    /// The bounding radius of a registered mesh (`None`: not registered; its deformers are
+    /// skipped).
+    fn radius(&self, id: MeshId) -> Option<f32>;
+
+    /// Its vertices as last posed, for the footstep test (`None`: its deformers never land).
+    fn vertices(&self, _id: MeshId) -> Option<&[Vec3]> {
+        None
+    }
+}
+
+/// A function giving a mesh's radius, and no vertices.
+impl<F: Fn(MeshId) -> Option<f32>> PlanMeshes for F {
+    fn radius(&self, id: MeshId) -> Option<f32> {
+        self(id)
+    }
+}
+
 /// One surface to update, as the plan sees it: its description, its place in the pool, the
 /// replenishment it carried, and what touched it.
 #[derive(Clone, Copy, Debug)]
 pub struct PlanSurface<'a> {
     /// The world's index of the surface (carried to the plan's outputs).
     pub index: usize,
+    /// Its handle (named by its footsteps).
+    pub id: SurfaceId,
     /// The surface.
     pub desc: &'a SurfaceDesc,
     /// Its heightmap resolution.
@@ -91,6 +115,8 @@ pub struct PlanSurface<'a> {
     pub settle: Settle,
     /// Its ground field in the capture's ground buffer, or `None` on flat ground.
     pub ground: Option<PlanGround>,
+    /// The ground field itself, for the footstep test (`None` on flat ground).
+    pub ground_field: Option<&'a GroundField>,
 }
 
 /// Where a surface's ground field lies for the capture, and the heights it spans.
@@ -177,22 +203,38 @@ pub struct FramePlan {
     pub settles: Vec<(usize, Settle)>,
     /// What each per-frame buffer must hold.
     pub sizes: BufferSizes,
+    /// Every deformer that landed on a surface, in the order of the surfaces and their deformers
+    /// (see [`crate::SnowWorld::footsteps`]): the footstep test runs in the same walk over a
+    /// surface's deformers as the capture's culling.
+    pub footsteps: Vec<Footstep>,
     jobs: Vec<Job>,
     rects: Vec<(u32, u32)>,
     /// Scratch of the compute path's tiles, a flag a tile of one surface.
     seen: Vec<bool>,
+    /// The grid over a long list of deformers shared by surfaces (`encode_step`'s), kept for the
+    /// frame's footsteps; forgotten at the next rebuild.
+    pub(crate) nearby: NearbyDeformers,
+    /// Scratch: the deformers of a long list near one surface.
+    near: Vec<u32>,
+    /// Whether to check each deformer of a short list as it is walked (see `refused`): the world
+    /// checks a frame's short lists in the plan's walk over them rather than in a pass of its own.
+    pub(crate) check_short_lists: bool,
+    /// Whether a deformer of a short list was refused ([`Deformer::validate`], or a mesh not
+    /// registered): the plan is not to be used, and the world's own check names the deformer.
+    pub(crate) refused: bool,
 }
 
 impl FramePlan {
-    /// Plan a frame of `surfaces` (each listed once). `mesh_radius` gives the bounding radius of
-    /// a registered mesh (`None`: not registered; its deformers are skipped).
+    /// Plan a frame of `surfaces` (each listed once). `meshes` gives the bounding radius of a
+    /// registered mesh (`None`: not registered; its deformers are skipped), and its vertices for
+    /// the footstep test.
     pub fn build<'a>(
         settings: &PlanSettings,
         surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
-        mesh_radius: impl Fn(MeshId) -> Option<f32>,
+        meshes: impl PlanMeshes,
     ) -> Self {
         let mut plan = Self::default();
-        plan.rebuild(settings, surfaces, mesh_radius);
+        plan.rebuild(settings, surfaces, meshes);
         plan
     }
 
@@ -201,11 +243,11 @@ impl FramePlan {
         &mut self,
         settings: &PlanSettings,
         surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
-        mesh_radius: impl Fn(MeshId) -> Option<f32>,
+        meshes: impl PlanMeshes,
     ) {
         self.clear();
         for s in surfaces {
-            self.plan_surface(settings, &s, &mesh_radius);
+            self.plan_surface(settings, &s, &meshes);
         }
         // Surfaces that refill snow first: the fused grid covers records 0..dense; the others are
         // updated only where the capture listed a tile.
@@ -239,8 +281,11 @@ impl FramePlan {
         self.relax.clear();
         self.settles.clear();
         self.sizes = BufferSizes::default();
+        self.footsteps.clear();
+        self.refused = false;
         self.jobs.clear();
         self.rects.clear();
+        self.nearby.forget();
     }
 
     /// Replenishment, culling and sweeping of one surface; a job when there is anything to do.
@@ -248,7 +293,7 @@ impl FramePlan {
         &mut self,
         settings: &PlanSettings,
         s: &PlanSurface<'_>,
-        mesh_radius: &impl Fn(MeshId) -> Option<f32>,
+        meshes: &impl PlanMeshes,
     ) {
         let (carry, units) = replenish(
             s.carry,
@@ -264,22 +309,34 @@ impl FramePlan {
             frustum_height,
             ground: s.ground.map_or((0.0, 0.0), |g| g.range),
         };
-        let prims = &mut self.capture.prims;
-        let (draws, draw_meshes) = (&mut self.capture.draws, &mut self.capture.draw_meshes);
-        let p0 = prims.len() as u32;
-        let d0 = draws.len() as u32;
-        for d in s.deformers {
-            match d.shape {
-                Shape::Mesh(id) => {
-                    let Some(radius) = mesh_radius(id) else {
-                        continue;
-                    };
-                    capture::push_mesh_draws(d, id, radius, &volume, draws, draw_meshes);
+        let p0 = self.capture.prims.len() as u32;
+        let d0 = self.capture.draws.len() as u32;
+        let (capture, footsteps) = (&mut self.capture, &mut self.footsteps);
+        let mut visit = |i: usize, d: &Deformer| {
+            capture.push_deformer(d, &volume, meshes);
+            let on = (s.id, s.desc, &volume.world_to_local);
+            let vertices = |id| meshes.vertices(id);
+            footsteps.extend(footstep(i, d, on, s.ground_field, s.elapsed, vertices));
+        };
+        if s.deformers.len() >= INDEX_FROM {
+            // A long list (every deformer of the world): only those in the grid's cells near the
+            // surface, in the list's order.
+            self.nearby.index(s.deformers);
+            self.nearby.near(surface_rect(s.desc), &mut self.near);
+            for &i in &self.near {
+                visit(i as usize, &s.deformers[i as usize]);
+            }
+        } else {
+            let check = self.check_short_lists;
+            for (i, d) in s.deformers.iter().enumerate() {
+                visit(i, d);
+                if check && refused(d, meshes) {
+                    self.refused = true;
                 }
-                _ => capture::push_primitives(d, &volume, prims),
             }
         }
-        let (p1, d1) = (prims.len() as u32, draws.len() as u32);
+        let prims = &self.capture.prims;
+        let (p1, d1) = (prims.len() as u32, self.capture.draws.len() as u32);
         let captured = p1 > p0 || d1 > d0;
         // A slumping material relaxes in every update that presses it and for `settle_updates`
         // after the last, over what may be unsettled (what it pressed, and what earlier updates
@@ -517,7 +574,7 @@ impl FramePlan {
                 + if c.work.is_empty() {
                     0
                 } else {
-                    capture::work_table(c).1 - c.views.len() as u64 * UNIFORM_STRIDE
+                    capture::work_table_bytes(c) - c.views.len() as u64 * UNIFORM_STRIDE
                 },
             prims: std::mem::size_of_val(c.prims.as_slice()) as u64,
             draws: c.draws.len() as u64 * UNIFORM_STRIDE,
@@ -575,6 +632,12 @@ fn pressed_rect(
     }
 }
 
+/// Whether the world refuses a deformer: invalid, or a mesh not registered.
+fn refused(d: &Deformer, meshes: &impl PlanMeshes) -> bool {
+    d.validate_named(String::new).is_err()
+        || matches!(d.shape, Shape::Mesh(id) if meshes.radius(id).is_none())
+}
+
 /// Whether the compute path captures a surface with `prims` primitives (and mesh draws when
 /// `meshes`): not when meshes press it, when it has no primitives or too many, or when the world
 /// asks for the raster path.
@@ -591,4 +654,25 @@ pub fn replenish(carry: f64, rate: f32, elapsed: f32, channel_max: u32) -> (f64,
     let carry = carry + rate as f64 * elapsed as f64 * channel_max as f64;
     let units = carry.floor().min(u32::MAX as f64);
     (carry - units, units as u32)
+}
+
+impl CapturePlan {
+    /// Append what one deformer draws over `volume`: its primitives, or a registered mesh's draws.
+    fn push_deformer(&mut self, d: &Deformer, volume: &CaptureVolume, meshes: &impl PlanMeshes) {
+        match d.shape {
+            Shape::Mesh(id) => {
+                if let Some(radius) = meshes.radius(id) {
+                    capture::push_mesh_draws(
+                        d,
+                        id,
+                        radius,
+                        volume,
+                        &mut self.draws,
+                        &mut self.draw_meshes,
+                    );
+                }
+            }
+            _ => capture::push_primitives(d, volume, &mut self.prims),
+        }
+    }
 }

@@ -26,6 +26,7 @@ fn inputs<'a>(
             let layout = SurfaceLayout::for_size_capped(desc.size, 512);
             let s = PlanSurface {
                 index,
+                id: SurfaceId(index as u32, 0),
                 desc,
                 layout,
                 heights_word: word,
@@ -36,6 +37,7 @@ fn inputs<'a>(
                 deformers,
                 settle: Default::default(),
                 ground: None,
+                ground_field: None,
             };
             word += layout.width * layout.height;
             s

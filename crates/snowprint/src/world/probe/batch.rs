@@ -170,26 +170,11 @@ impl SnowWorld {
         self.poll_probes_only();
     }
 
-    /// After an update is encoded: count the frame, note its footsteps (every layer's), read
-    /// what came back.
-    pub(in crate::world) fn probes_after_update(
-        &mut self,
-        layers: &[&[crate::world::SurfaceUpdate<'_>]],
-    ) {
+    /// After an update is encoded (its footsteps noted as its layers were planned): count the
+    /// frame, read what came back.
+    pub(in crate::world) fn probes_after_update(&mut self) {
         self.probes.frame += 1;
-        let mut steps = std::mem::take(&mut self.probes.footsteps);
-        let meshes = &self.probes.mesh_vertices;
-        let all: Vec<_> = layers.iter().flat_map(|l| l.iter().copied()).collect();
-        crate::world::footstep::footsteps(
-            &all,
-            |id| {
-                let s = self.state(id).ok()?;
-                Some((&s.desc, s.ground.as_ref().map(|g| &g.field)))
-            },
-            |m| meshes.get(m.0 as usize)?.as_deref(),
-            &mut steps,
-        );
-        self.probes.footsteps = steps;
+
         self.poll_probes_only();
     }
 

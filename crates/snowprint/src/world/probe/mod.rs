@@ -185,7 +185,7 @@ pub(super) struct Probes {
     pub(super) footsteps: Vec<Footstep>,
     /// A CPU copy of each mesh deformer's vertices (as last posed), by mesh index: footsteps
     /// find a mesh's lowest point from them.
-    mesh_vertices: Vec<Option<Vec<Vec3>>>,
+    pub(super) mesh_vertices: Vec<Option<Vec<Vec3>>>,
 }
 
 impl Probes {
