@@ -67,6 +67,20 @@ pub enum SnowError {
         "a snow frame was encoded and not reported submitted: call SnowWorld::submitted with its PendingFrame after queue.submit (or SnowWorld::abandon_pending if its encoder was dropped) before encoding another"
     )]
     FramePending,
+    /// The frame's update needs a per-frame buffer larger than the device can bind.
+    #[error(
+        "this frame's update needs {bytes} bytes of {buffer} ({surfaces} surfaces updated), but this device binds at most {max} bytes: update fewer or smaller surfaces a frame (SnowWorld::encode_update with part of them, or a SnowManager's update budget)"
+    )]
+    FrameTooLarge {
+        /// Which per-frame buffer.
+        buffer: &'static str,
+        /// Bytes it would need.
+        bytes: u64,
+        /// The device's largest storage binding, bytes.
+        max: u64,
+        /// Surfaces in the update.
+        surfaces: usize,
+    },
     /// A surface description is not usable.
     #[error("surface {name:?}: {what} is {value}, but it must be {expected}")]
     InvalidSurface {

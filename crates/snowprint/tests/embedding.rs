@@ -529,3 +529,89 @@ fn an_abandoned_frame_keeps_no_replenishment() {
         twin.read_packed(twin_id).unwrap()
     );
 }
+
+/// An engine's device made with `required_limits` binds 128 MiB a storage buffer: a frame that
+/// would capture 129 surfaces of 512^2 whole at once (a slab pressed over each) needs 4 bytes a
+/// texel of capture, 135.3 MB. The step is refused in one sentence naming the buffer, its bytes
+/// and the limit (wgpu would panic binding it), nothing changes, and fewer surfaces a frame, as
+/// the sentence says, are pressed.
+#[test]
+fn a_frame_larger_than_the_device_binds_is_refused_and_can_be_split() {
+    let gpu = engine_gpu(false);
+    let max = gpu.device.limits().max_storage_buffer_binding_size;
+    // The compute capture (a GPU's path) captures every surface of a frame in one buffer.
+    let config = WorldConfig {
+        format: snowprint::PoolFormat::new(snowprint::Precision::Bits8),
+        capture_path: snowprint::CapturePath::Compute,
+        pool_bytes: 72 << 20,
+        ..WorldConfig::default()
+    };
+    let mut world = SnowWorld::new(&gpu, config).unwrap();
+    let side = 512.0 * 0.04;
+    let n = (max / (4 * 512 * 512) + 1) as usize;
+    let ids: Vec<_> = (0..n)
+        .map(|i| {
+            let c = [i as f32 * (side + 1.0), 0.0, 0.0];
+            let id = world
+                .add_surface(SurfaceDesc::new(&format!("s{i}"), c, [side, side], 0.3))
+                .unwrap();
+            (id, c)
+        })
+        .collect();
+    assert_eq!(world.layout(ids[0].0).unwrap().texels(), 512 * 512);
+    let feet: Vec<Deformer> = ids
+        .iter()
+        .map(|&(_, c)| {
+            // A slab over the whole surface: the capture reaches all of its texels.
+            let half = Vec3::new(side * 0.5, 0.05, side * 0.5);
+            Deformer::new(
+                Shape::Box { half_extents: half },
+                Pose::at([c[0], 0.25, 0.0]),
+            )
+        })
+        .collect();
+    let e = world.step(1.0 / 60.0, &feet).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SnowError::FrameTooLarge {
+                buffer: "capture",
+                bytes,
+                max: m,
+                surfaces,
+            } if bytes == n as u64 * 4 * 512 * 512 && m == max && surfaces == n
+        ),
+        "{e}"
+    );
+    println!("{e}");
+    assert!(
+        e.to_string()
+            .contains("update fewer or smaller surfaces a frame")
+    );
+    let untouched = |w: &SnowWorld, id| w.read_channels(id).unwrap().0.iter().all(|&v| v == 0);
+    for k in [0, n / 2, n - 1] {
+        assert!(
+            untouched(&world, ids[k].0),
+            "the refused frame changed the snow"
+        );
+    }
+    // Fewer surfaces a frame, as the sentence says: eight of them, each with its own slab.
+    let updates: Vec<snowprint::SurfaceUpdate> = ids[..8]
+        .iter()
+        .zip(&feet)
+        .map(|(&(id, _), foot)| snowprint::SurfaceUpdate {
+            surface: id,
+            elapsed: 1.0 / 60.0,
+            deformers: std::slice::from_ref(foot),
+        })
+        .collect();
+    world.update(&updates).unwrap();
+    for &(id, _) in &ids[..8] {
+        let (dep, _) = world.read_channels(id).unwrap();
+        assert!(
+            dep.iter().all(|&v| v > 0),
+            "a surface was not pressed whole"
+        );
+    }
+    assert!(untouched(&world, ids[8].0));
+}

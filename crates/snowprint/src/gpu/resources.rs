@@ -30,10 +30,16 @@ impl Growable {
         }
     }
 
-    /// Make sure the buffer holds at least `size` bytes.
+    /// Make sure the buffer holds at least `size` bytes: the next power of two, but no more than
+    /// the device can bind whole (the world refuses a frame that needs more, before this).
     pub(crate) fn ensure(&mut self, device: &wgpu::Device, size: u64) {
         if self.buffer.size() < size {
-            *self = Self::new(device, self.label, self.usage, size.next_power_of_two());
+            let limits = device.limits();
+            let most = limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size);
+            let grown = size.next_power_of_two().min(most).max(size);
+            *self = Self::new(device, self.label, self.usage, grown);
         }
     }
 }

@@ -234,7 +234,42 @@ impl SnowWorld {
             // Unreachable: what the quick check or the plan refuses, the whole check refuses.
             return Ok(None);
         }
+        if let Err(e) = self.check_sizes(&first, layers.get(1..).unwrap_or_default()) {
+            self.scratch_cpu.plan = first;
+            return Err(e);
+        }
         Ok(Some(first))
+    }
+
+    /// Refuse a frame whose per-frame buffers the device could not bind (wgpu would panic
+    /// binding them): the first layer by its plan, a later one (planned only as the frame is
+    /// recorded) by the capture it would need were every surface in it captured, 4 bytes a texel.
+    fn check_sizes(&self, first: &FramePlan, later: &[&[SurfaceUpdate<'_>]]) -> Result<()> {
+        let max = self.device.limits().max_storage_buffer_binding_size;
+        if let Some((buffer, bytes)) = first.sizes.first_over(max) {
+            return Err(SnowError::FrameTooLarge {
+                buffer,
+                bytes,
+                max,
+                surfaces: first.accumulate.records.len(),
+            });
+        }
+        for updates in later {
+            let bytes: u64 = updates
+                .iter()
+                .filter_map(|u| self.state(u.surface).ok())
+                .map(|s| 4 * s.layout.texels())
+                .sum();
+            if bytes > max {
+                return Err(SnowError::FrameTooLarge {
+                    buffer: "capture",
+                    bytes,
+                    max,
+                    surfaces: updates.len(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Keep the settle counters a layer leaves (remembering the first for an abandoned frame).

@@ -167,6 +167,29 @@ pub struct BufferSizes {
     pub relax_tiles: u64,
 }
 
+impl BufferSizes {
+    /// The first buffer (its name and bytes) larger than `max` bytes, the device's largest
+    /// storage binding, in the order the fields are declared.
+    pub fn first_over(&self, max: u64) -> Option<(&'static str, u64)> {
+        [
+            ("surface records", self.records),
+            ("capture views", self.views),
+            ("analytic primitives", self.prims),
+            ("mesh draws", self.draws),
+            ("blurred captures", self.scratch),
+            ("capture", self.capture),
+            ("mesh winding", self.winding),
+            ("tile flags", self.tiles),
+            ("tile list", self.tile_list),
+            ("relaxation records", self.relax_records),
+            ("relaxation scratch", self.relax_scratch),
+            ("relaxation tiles", self.relax_tiles),
+        ]
+        .into_iter()
+        .find(|&(_, bytes)| bytes > max)
+    }
+}
+
 /// One surface's work while the plan is built.
 #[derive(Clone, Debug)]
 struct Job {
