@@ -172,6 +172,9 @@ impl GpuContext {
         // An adapter that cannot give what the passes need is refused before asking for a device.
         limits::check(features, &limits)?;
         let mut required = required_features();
+        // Conservative depth lets the snow pass reject hidden fragments before tracing them
+        // (render/snow): used where the adapter has it.
+        required |= features & wgpu::Features::SHADER_EARLY_DEPTH_TEST;
         if features.contains(wgpu::Features::TIMESTAMP_QUERY) {
             required |= wgpu::Features::TIMESTAMP_QUERY;
             if features.contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {

@@ -614,6 +614,7 @@ impl Renderer {
             &surfaces,
             &self.heightfield,
             ground,
+            frame.camera.eye,
         );
         laps.mark("snow");
         self.last_surfaces = surfaces.iter().map(|s| s.view.id).collect();

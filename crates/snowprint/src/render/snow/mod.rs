@@ -22,7 +22,13 @@ use crate::view::GroundMaterial;
 pub(super) struct SnowPass {
     layout: wgpu::BindGroupLayout,
     basic: wgpu::RenderPipeline,
+    /// Both sides of the box: for a box the eye is in (or too near to tell).
     deformable: wgpu::RenderPipeline,
+    /// Front faces only: for a box the eye is outside of, whose back faces would all be
+    /// discarded (on GPUs with few graphics units, launching them costs).
+    deformable_outside: wgpu::RenderPipeline,
+    /// Per surface slot this frame: whether the eye is clearly outside its box.
+    outside: Vec<bool>,
     /// Per surface: `SurfaceUniform` in a uniform block (also bound by the tessellated draws).
     pub uniforms: Growable,
     /// This frame's group 1 per surface slot; `None` where the tessellated tier dices it.
@@ -69,6 +75,29 @@ impl SnowPass {
             pipeline::manual_filter(filterable),
             wgpu::PrimitiveState::default(),
         );
+        // Seen from outside, the ray enters at the rasterised face and the hit lies beyond it:
+        // the depth written is never less than the face's, which the device may be told
+        // (conservative depth), so that it rejects a fragment behind what is already drawn
+        // before tracing it.
+        let outside_module = device
+            .features()
+            .contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST)
+            .then(conservative_surface_wgsl)
+            .flatten()
+            .map(|text| pipeline::shader(device, "surface.wgsl (outside)", text));
+        let deformable_outside = pipeline::Raster {
+            label: "snow deformable (outside)",
+            module: outside_module.as_ref().unwrap_or(&module),
+            vs: "vs_surface_deformable",
+            fs: "fs_deformable",
+            buffers: &[],
+            groups: &[frame_layout, &layout],
+            primitive: pipeline::back_culled(),
+            depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
+            targets: &pipeline::hdr_target(),
+            constants: pipeline::manual_filter(filterable),
+        }
+        .build(device);
         Self {
             uniforms: Growable::new(
                 device,
@@ -79,6 +108,8 @@ impl SnowPass {
             layout,
             basic,
             deformable,
+            deformable_outside,
+            outside: Vec::new(),
             bind_groups: Vec::new(),
         }
     }
@@ -93,8 +124,10 @@ impl SnowPass {
         surfaces: &[FrameSurface<'_>],
         heightfields: &HeightfieldPass,
         ground: &wgpu::Buffer,
+        eye: glam::Vec3,
     ) {
         let search = cfg.search_settings();
+        self.outside.clear();
         let look = cfg.look;
         let stride = SURFACE_STRIDE as usize;
         let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
@@ -110,6 +143,7 @@ impl SnowPass {
                 macro_waves: surface.geometry.macro_waves,
             };
             let u = SurfaceUniform::shaded(surface.view, &shading);
+            self.outside.push(eye_outside_box(&u, eye));
             bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
                 .copy_from_slice(bytemuck::bytes_of(&u));
         }
@@ -164,18 +198,13 @@ impl SnowPass {
                 multiview_mask: None,
             });
             p.set_bind_group(0, frame, &[]);
-            for (pipeline, offset) in [
-                (&self.basic, STATE_BASIC_DRAW),
-                (&self.deformable, STATE_DEFORMABLE_DRAW),
-            ] {
-                p.set_pipeline(pipeline);
-                for (s, bg) in self.bind_groups.iter().enumerate() {
-                    if let Some(bg) = bg {
-                        p.set_bind_group(1, bg, &[]);
-                        p.draw_indirect(state, (s as u64 * STATE_WORDS + offset) * 4);
-                    }
-                }
-            }
+            p.set_pipeline(&self.basic);
+            self.draw_each(&mut p, state, STATE_BASIC_DRAW, |_| true);
+            // The deformable surfaces seen from outside their box, then those the eye is in.
+            p.set_pipeline(&self.deformable_outside);
+            self.draw_each(&mut p, state, STATE_DEFORMABLE_DRAW, |s| self.outside[s]);
+            p.set_pipeline(&self.deformable);
+            self.draw_each(&mut p, state, STATE_DEFORMABLE_DRAW, |s| !self.outside[s]);
         }
         let attachments = targets.color(wgpu::LoadOp::Load);
         let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -187,5 +216,72 @@ impl SnowPass {
             multiview_mask: None,
         });
         tess.draw(&mut p, frame, dice);
+    }
+
+    /// Each relief-mapped surface that `keep` takes: its group and its indirect draw at `offset`.
+    fn draw_each(
+        &self,
+        p: &mut wgpu::RenderPass<'_>,
+        state: &wgpu::Buffer,
+        offset: u64,
+        keep: impl Fn(usize) -> bool,
+    ) {
+        for (s, bg) in self.bind_groups.iter().enumerate() {
+            if let Some(bg) = bg.as_ref().filter(|_| keep(s)) {
+                p.set_bind_group(1, bg, &[]);
+                p.draw_indirect(state, (s as u64 * STATE_WORDS + offset) * 4);
+            }
+        }
+    }
+}
+
+/// Whether `eye` (world) is outside the box the deformable material draws for a surface, by more
+/// than a margin: then every back face of the box would be discarded (`fs_deformable` keeps the
+/// front faces of a box seen from outside), and drawing the front faces alone gives the same
+/// pixels. Near a face (within a centimetre and a millionth of the distance) it is not outside,
+/// and both sides are drawn as before.
+fn eye_outside_box(u: &SurfaceUniform, eye: glam::Vec3) -> bool {
+    let to_local = glam::Mat4::from_cols_array_2d(&u.world_to_local);
+    let e = to_local.transform_point3(eye);
+    let top = u.terrain_top + u.translucency[3];
+    let margin = 0.01 + 1e-6 * eye.length();
+    e.x.abs() > u.half_size[0] + margin
+        || e.z.abs() > u.half_size[1] + margin
+        || e.y < u.terrain_low - margin
+        || e.y > top + margin
+}
+
+/// The declaration of `fs_deformable` in `surface.wgsl`, and the same with conservative depth.
+const DEFORMABLE_FS: &str = "@fragment\nfn fs_deformable(";
+const DEFORMABLE_FS_GREATER: &str = "@fragment @early_depth_test(greater_equal)\nfn fs_deformable(";
+
+/// `surface.wgsl` with `fs_deformable` declaring that the depth it writes is never less than
+/// the rasterised one (`None` if its declaration is not found).
+fn conservative_surface_wgsl() -> Option<String> {
+    let text = crate::wgsl::SURFACE.wgsl();
+    text.contains(DEFORMABLE_FS)
+        .then(|| text.replacen(DEFORMABLE_FS, DEFORMABLE_FS_GREATER, 1))
+}
+
+#[cfg(test)]
+mod tests {
+    /// The conservative module is `surface.wgsl` with the attribute on `fs_deformable` alone,
+    /// and naga reads it as a fragment entry point whose depth may be tested early.
+    #[test]
+    fn the_outside_pipeline_declares_conservative_depth() {
+        let text = super::conservative_surface_wgsl().expect("fs_deformable's declaration");
+        assert_eq!(text.matches("@early_depth_test").count(), 1);
+        let module = naga::front::wgsl::parse_str(&text).expect("the conservative module parses");
+        let ep = module
+            .entry_points
+            .iter()
+            .find(|e| e.name == "fs_deformable")
+            .expect("fs_deformable");
+        assert_eq!(
+            ep.early_depth_test,
+            Some(naga::EarlyDepthTest::Allow {
+                conservative: naga::ConservativeDepth::GreaterEqual
+            })
+        );
     }
 }
