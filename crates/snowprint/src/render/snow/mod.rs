@@ -115,7 +115,9 @@ impl SnowPass {
     }
 
     /// Upload each surface's uniform (transform, grid, ground, search, look and its material's
-    /// look) and bind it with its heightfield textures and the world's ground fields.
+    /// look), bind it with its heightfield textures and the world's ground fields, and note
+    /// whether `eye` (world) is outside its box.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
