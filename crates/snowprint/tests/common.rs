@@ -54,16 +54,18 @@ pub fn nudged(deformers: &[snowprint::Deformer], by: glam::Vec3) -> Vec<snowprin
         .collect()
 }
 
-/// Per texel, the range of a CPU capture over the deformers at their place and nudged by
+/// Per texel, the range of a CPU capture over the deformers at their place (`at_place`, given)
+/// and nudged by
 /// [`POSITION_SLACK`] along world x and z each way: where a ray grazes a silhouette, the height
 /// it meets changes without bound as the ray moves, so a GPU's last-bit difference in where the
 /// ray is can only be judged against how much the height moves there.
 pub fn capture_envelope(
+    at_place: &[f32],
     deformers: &[snowprint::Deformer],
     capture: impl Fn(&[snowprint::Deformer]) -> Vec<f32>,
 ) -> Vec<(f32, f32)> {
     let s = POSITION_SLACK;
-    let mut env: Vec<(f32, f32)> = capture(deformers).iter().map(|&c| (c, c)).collect();
+    let mut env: Vec<(f32, f32)> = at_place.iter().map(|&c| (c, c)).collect();
     for by in [
         glam::Vec3::new(s, 0.0, 0.0),
         glam::Vec3::new(-s, 0.0, 0.0),

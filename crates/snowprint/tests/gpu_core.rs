@@ -175,24 +175,7 @@ fn every_stage_matches_its_cpu_reference() {
             let stats = w.step(dt, &deformers[frame..]).unwrap();
             assert_eq!(stats.updated, 1);
             let vol = volume(&desc);
-            let mut prims = vec![];
-            for d in &deformers[frame..] {
-                capture::push_primitives(d, &vol, &mut prims);
-            }
-            // Capture.
-            let gpu_cap = w
-                .read_last_capture(id)
-                .unwrap()
-                .expect("captured in the last batch");
-            let cpu_cap = cap_cpu::capture(
-                l.width,
-                l.height,
-                vol.half_size,
-                vol.frustum_height,
-                &prims,
-                &[],
-            );
-            let envelope = common::capture_envelope(&deformers[frame..], |ds| {
+            let cpu_of = |ds: &[Deformer]| {
                 let mut prims = vec![];
                 for d in ds {
                     capture::push_primitives(d, &vol, &mut prims);
@@ -205,7 +188,14 @@ fn every_stage_matches_its_cpu_reference() {
                     &prims,
                     &[],
                 )
-            });
+            };
+            // Capture.
+            let gpu_cap = w
+                .read_last_capture(id)
+                .unwrap()
+                .expect("captured in the last batch");
+            let cpu_cap = cpu_of(&deformers[frame..]);
+            let envelope = common::capture_envelope(&cpu_cap, &deformers[frame..], cpu_of);
             let mut coverage_mismatch = 0;
             for ((g, c), range) in gpu_cap.iter().zip(&cpu_cap).zip(&envelope) {
                 if (*g < 1.0) != (*c < 1.0) {

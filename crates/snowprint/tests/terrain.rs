@@ -145,24 +145,7 @@ fn assert_capture_matches_reference(
         frustum_height: DEPTH + ANKLE,
         ground: (low, high),
     };
-    let mut prims = vec![];
-    for d in prims_of {
-        capture::push_primitives(d, &vol, &mut prims);
-    }
-    let gpu = w.read_last_capture(id).unwrap().expect("captured");
-    let cpu = cap_cpu::capture_on_ground(
-        l.width,
-        l.height,
-        vol.half_size,
-        vol.frustum_height,
-        &prims,
-        &[],
-        Some(&field.columns),
-    );
-    // Judged against the heights the CPU gives with the deformers nudged by a GPU's last bits of
-    // position (`common::capture_envelope`): an H100 put a grazing texel 165 um from the height
-    // at its centre, within that range.
-    let envelope = common::capture_envelope(prims_of, |ds| {
+    let cpu_of = |ds: &[Deformer]| {
         let mut prims = vec![];
         for d in ds {
             capture::push_primitives(d, &vol, &mut prims);
@@ -176,7 +159,13 @@ fn assert_capture_matches_reference(
             &[],
             Some(&field.columns),
         )
-    });
+    };
+    let gpu = w.read_last_capture(id).unwrap().expect("captured");
+    let cpu = cpu_of(prims_of);
+    // Judged against the heights the CPU gives with the deformers nudged by a GPU's last bits of
+    // position (`common::capture_envelope`): an H100 put a grazing texel 165 um from the height
+    // at its centre, within that range.
+    let envelope = common::capture_envelope(&cpu, prims_of, cpu_of);
     let mut mismatched = 0;
     for ((g, c), range) in gpu.iter().zip(&cpu).zip(&envelope) {
         if (*g < 1.0) != (*c < 1.0) {
