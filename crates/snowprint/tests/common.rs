@@ -55,8 +55,7 @@ pub fn nudged(deformers: &[snowprint::Deformer], by: glam::Vec3) -> Vec<snowprin
 }
 
 /// Per texel, the range of a CPU capture over the deformers at their place (`at_place`, given)
-/// and nudged by
-/// [`POSITION_SLACK`] along world x and z each way: where a ray grazes a silhouette, the height
+/// and nudged by [`POSITION_SLACK`] along world x and z each way: where a ray grazes a silhouette, the height
 /// it meets changes without bound as the ray moves, so a GPU's last-bit difference in where the
 /// ray is can only be judged against how much the height moves there.
 pub fn capture_envelope(
