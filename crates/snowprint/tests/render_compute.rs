@@ -124,15 +124,16 @@ fn flip(reference: &RenderOutput, test: &RenderOutput) -> (f64, f64) {
 }
 
 /// The opaque meshes through the visibility buffer (depth and (instance, triangle) rasterised, the
-/// shading in compute) against the forward path, in every golden view of the scene: bricks, the
-/// ball, the bodies and their shadows, the lantern. The bound is each golden's own
+/// shading in compute), and the relief-mapped snow with them (its rays traced in the fragments,
+/// its hits shaded in compute), against the forward path, in the golden views of the scene:
+/// bricks, the ball, the bodies and their shadows, the lantern, the prints in relief and POM. The bound is each golden's own
 /// (`tolerances.toml`, the one in force on this driver), and the visibility renders pass the
 /// goldens themselves too. The pixels the two paths light differently are counted.
 #[test]
 fn the_visibility_buffer_draws_what_the_forward_path_draws() {
     let mut forward = scene();
     let mut visibility = scene_with(|c| c.opaque = OpaquePath::Visibility);
-    for name in ["relief", "relief_grazing", "tessellated"] {
+    for name in ["relief", "pom", "relief_grazing", "tessellated"] {
         let a = render_golden_view(&mut forward, name);
         let b = render_golden_view(&mut visibility, name);
         let (mean, p99) = flip(&a, &b);

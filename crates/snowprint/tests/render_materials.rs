@@ -12,7 +12,8 @@ mod golden_support;
 use glam::{Vec3, Vec4};
 use golden_support::{bless, check, score, tolerance};
 use snowprint::render::{
-    DebugView, Environment, PointLight, RenderConfig, RenderFrame, RenderOutput, Renderer, Tier,
+    DebugView, Environment, OpaquePath, PointLight, RenderConfig, RenderFrame, RenderOutput,
+    Renderer, Tier,
 };
 use snowprint::{
     Camera, Deformer, GroundMaterial, Material, Pose, Shape, SnowWorld, SurfaceDesc, SurfaceId,
@@ -125,6 +126,24 @@ fn each_material_matches_its_golden() {
         let mut scene = scene(material);
         let out = render(&mut scene);
         check(name, &out);
+    }
+}
+
+/// The materials drawn through the visibility buffer (the deformable material traced in its
+/// fragments and shaded in compute: sand's and mud's rims, mud's water, powder) pass their
+/// goldens as the forward path does.
+#[test]
+fn each_material_through_the_visibility_buffer_matches_its_golden() {
+    if bless() {
+        return;
+    }
+    for (name, material) in materials() {
+        let mut scene = scene(material);
+        let mut config = RenderConfig::new(WIDTH, HEIGHT, Tier::Relief);
+        config.shadow_map_size = 1024;
+        config.opaque = OpaquePath::Visibility;
+        scene.renderer = Renderer::new(common::gpu(), config).expect("renderer");
+        check(name, &render(&mut scene));
     }
 }
 

@@ -28,7 +28,7 @@ pub enum Resource {
     /// The moon's shadow map.
     ShadowMap,
     /// The visibility buffer: per pixel of the scene, the opaque instance and triangle seen and
-    /// the depth they wrote (`OpaquePath::Visibility`).
+    /// the depth they wrote, or the relief-mapped snow's hit (`OpaquePath::Visibility`).
     Visibility,
     /// The scene's HDR colour (supersampled).
     SceneColor,
@@ -95,23 +95,25 @@ pub mod pass {
     pub const OPAQUE: usize = 6;
     /// Snow surfaces.
     pub const SNOW: usize = 7;
+    /// The relief-mapped snow's hits in the visibility buffer shaded (empty on the forward path).
+    pub const SNOW_SHADE: usize = 8;
     /// The visibility buffer shaded where the snow left it visible (empty on the forward path).
-    pub const OPAQUE_SHADE: usize = 8;
+    pub const OPAQUE_SHADE: usize = 9;
     /// Sky.
-    pub const SKY: usize = 9;
+    pub const SKY: usize = 10;
     /// Falling snow.
-    pub const SNOWFALL: usize = 10;
+    pub const SNOWFALL: usize = 11;
     /// Kicked-up snow (the world's spray; empty without it).
-    pub const SPRAY: usize = 11;
+    pub const SPRAY: usize = 12;
     /// Resolve and tonemap.
-    pub const TONEMAP: usize = 12;
+    pub const TONEMAP: usize = 13;
 }
 
 /// The passes of a frame, in the order they run. The tessellated tier's passes (`dice`,
 /// `snow_shadow`) are encoded empty in the other tiers, `banks` too but for surfaces whose
 /// material throws rims, `spray` for a world without spray, and `opaque_shade` on the forward
 /// path, so every tier and path reports the same list.
-pub const PASSES: [PassInfo; 13] = [
+pub const PASSES: [PassInfo; 14] = [
     PassInfo {
         name: "classify",
         kind: PassKind::Compute,
@@ -182,7 +184,21 @@ pub const PASSES: [PassInfo; 13] = [
             R::ShadowMap,
             R::SceneDepth,
         ],
-        writes: &[R::SceneColor, R::SceneDepth],
+        writes: &[R::SceneColor, R::SceneDepth, R::Visibility],
+    },
+    PassInfo {
+        name: "snow_shade",
+        kind: PassKind::Compute,
+        reads: &[
+            R::SurfaceTable,
+            R::Heightfields,
+            R::Banks,
+            R::FrameUniforms,
+            R::ShadowMap,
+            R::Visibility,
+            R::SceneDepth,
+        ],
+        writes: &[R::SceneColor],
     },
     PassInfo {
         name: "opaque_shade",
@@ -260,6 +276,8 @@ mod tests {
         assert_eq!(PASSES[pass::SNOW_SHADOW].name, "snow_shadow");
         assert_eq!(PASSES[pass::OPAQUE].name, "opaque");
         assert_eq!(PASSES[pass::SNOW].name, "snow");
+        assert_eq!(PASSES[pass::SNOW_SHADE].name, "snow_shade");
+        assert_eq!(PASSES[pass::OPAQUE_SHADE].name, "opaque_shade");
         assert_eq!(PASSES[pass::SKY].name, "sky");
         assert_eq!(PASSES[pass::SNOWFALL].name, "snowfall");
         assert_eq!(PASSES[pass::SPRAY].name, "spray");

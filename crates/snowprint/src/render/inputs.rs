@@ -269,6 +269,13 @@ impl RenderFrame<'_> {
                 "a moon direction of non-zero length and an exposure above 0",
             );
         }
+        if frame.surfaces.len() > super::snow::SURFACES_MAX {
+            return bad(
+                "surfaces".into(),
+                frame.surfaces.len().to_string(),
+                "at most 131072 a frame (the visibility buffer's slots)",
+            );
+        }
         for (i, (id, _)) in frame.surfaces.iter().enumerate() {
             if frame.surfaces[..i].iter().any(|(other, _)| other == id) {
                 return bad(

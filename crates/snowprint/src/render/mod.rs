@@ -215,7 +215,7 @@ impl Renderer {
                 filterable,
             ),
             opaque: opaque::OpaquePass::new(&device, &mesh_module, &frame.layout, config.opaque),
-            snow: snow::SnowPass::new(&device, &frame.layout, filterable),
+            snow: snow::SnowPass::new(&device, &frame.layout, filterable, config.opaque),
             sky: sky::SkyPass::new(&device, &frame.layout),
             snowfall: snowfall::SnowfallPass::new(&device, &frame.layout),
             spray: spray::SprayPass::new(&device, &frame.layout),
@@ -614,7 +614,11 @@ impl Renderer {
             &surfaces,
             &self.heightfield,
             ground,
-            frame.camera.eye,
+            &self.targets,
+            (
+                frame.camera.eye,
+                glam::Mat4::from_cols_array_2d(&uniform.view_proj),
+            ),
         );
         laps.mark("snow");
         self.last_surfaces = surfaces.iter().map(|s| s.view.id).collect();
@@ -722,6 +726,7 @@ impl Renderer {
             pass::OPAQUE => self
                 .opaque
                 .encode(encoder, ts, slot, targets, frame, &self.meshes),
+            pass::SNOW_SHADE => self.snow.encode_shade(encoder, ts, slot, frame),
             pass::OPAQUE_SHADE => self.opaque.encode_shade(encoder, ts, slot, frame),
             pass::SNOW => self.snow.encode(
                 encoder,

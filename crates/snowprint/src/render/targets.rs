@@ -11,6 +11,8 @@ pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Fl
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The visibility buffer: instance, triangle, the depth written (as bits).
 pub(super) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// The snow's hits on the visibility path: surface-local position and distance along the ray.
+pub(super) const SNOW_HITS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub(super) const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) struct Targets {
@@ -19,6 +21,8 @@ pub(super) struct Targets {
     pub depth_view: wgpu::TextureView,
     /// The visibility buffer (only on `OpaquePath::Visibility`).
     pub visibility_view: Option<wgpu::TextureView>,
+    /// The snow's hits, beside the visibility buffer (only on `OpaquePath::Visibility`).
+    pub snow_hits_view: Option<wgpu::TextureView>,
     pub output: wgpu::Texture,
     pub output_view: wgpu::TextureView,
     pub readback: wgpu::Buffer,
@@ -76,6 +80,16 @@ impl Targets {
             )
             .create_view(&Default::default())
         });
+        let snow_hits_view = visibility.then(|| {
+            texture(
+                "snow hits",
+                iw,
+                ih,
+                SNOW_HITS_FORMAT,
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+            )
+            .create_view(&Default::default())
+        });
         let depth = texture(
             "scene depth",
             iw,
@@ -102,6 +116,7 @@ impl Targets {
             color_view: color.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
             visibility_view,
+            snow_hits_view,
             output_view: output.create_view(&Default::default()),
             output,
             readback,
@@ -123,6 +138,27 @@ impl Targets {
                 store: wgpu::StoreOp::Store,
             },
         })]
+    }
+
+    /// The visibility path's attachments of the deformable snow: the visibility buffer and the
+    /// snow's hits, loaded (a pixel's hit is read only where the snow wrote it this frame, which
+    /// its depth tells); `None` on the forward path.
+    pub(super) fn snow_visible(&self) -> Option<[Option<wgpu::RenderPassColorAttachment<'_>>; 2]> {
+        let load = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        match (&self.visibility_view, &self.snow_hits_view) {
+            (Some(v), Some(h)) => Some([load(v), load(h)]),
+            _ => None,
+        }
     }
 
     /// Begin a render pass over the scene colour (loaded as `color`) and depth (`depth`, `None`:

@@ -67,3 +67,10 @@ const RELAX_TILE: u32 = 32u;
 const RELAX_HALO: u32 = 4u;
 // Vertices a workgroup of the skinning pass (skin/skin.wgsl) skins.
 const SKIN_WORKGROUP: u32 = 64u;
+// Tag of a snow hit in the first word of the visibility buffer (`OpaquePath::Visibility`): the
+// deformable material's fragments write it, with the surface's slot above SNOW_SLOT_SHIFT; an
+// opaque triangle's instance never reaches it, and the cleared value (every bit set) is neither.
+const SNOW_VISIBLE: u32 = 0x80000000u;
+// First bit of a snow hit's surface slot in the visibility buffer's first word (below it: the box
+// face, the hit's side and water flags, and its taps).
+const SNOW_SLOT_SHIFT: u32 = 13u;

@@ -127,27 +127,27 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
     ("*", "linear_sampler", Override::FilterableIfSupported),
     // The snow passes' heightfield textures (Rgba16Float), filtered where the device can.
     ("surface", "heightfield", Override::FilterableIfSupported),
-    ("surface", "heightfield", Override::Stages(FRAGMENT)),
+    // (Compute too: the visibility path shades the deformable material in `shade_deformable`.)
+    ("surface", "heightfield", Override::Stages(FRAGMENT_COMPUTE)),
     (
         "surface",
         "heightfield_light",
         Override::FilterableIfSupported,
     ),
     ("surface", "heightfield_light", Override::Stages(FRAGMENT)),
+    // The visibility path's snow hits (Rgba32Float), read with textureLoad.
+    ("surface", "snow_hits", Override::NotFiltering),
     // Bank heights, read with textureLoad (bilinear by hand, as in the tessellated tier).
     ("surface", "bank_texture", Override::NotFiltering),
-    // The tessellated tier shares the snow pass's bindings with both stages.
-    ("tess_surface", "surface", Override::Stages(VERTEX_FRAGMENT)),
+    // The tessellated tier shares the snow pass's bindings with both stages (and `surface.wgsl`'s
+    // compute entry point comes with its import).
+    ("tess_surface", "surface", Override::Stages(ALL_STAGES)),
     (
         "tess_surface",
         "heightfield",
         Override::FilterableIfSupported,
     ),
-    (
-        "tess_surface",
-        "heightfield",
-        Override::Stages(VERTEX_FRAGMENT),
-    ),
+    ("tess_surface", "heightfield", Override::Stages(ALL_STAGES)),
     (
         "tess_surface",
         "heightfield_light",
@@ -159,11 +159,7 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
         Override::Stages(VERTEX_FRAGMENT),
     ),
     ("tess_surface", "bank_texture", Override::NotFiltering),
-    (
-        "tess_surface",
-        "bank_texture",
-        Override::Stages(VERTEX_FRAGMENT),
-    ),
+    ("tess_surface", "bank_texture", Override::Stages(ALL_STAGES)),
     (
         "tess_surface",
         "surface_state",
@@ -179,8 +175,8 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
     ("dice", "banks", Override::NotFiltering),
 ];
 
-const VERTEX_FRAGMENT: u32 = wgpu::ShaderStages::VERTEX_FRAGMENT.bits();
 const FRAGMENT: u32 = wgpu::ShaderStages::FRAGMENT.bits();
+const VERTEX_FRAGMENT: u32 = wgpu::ShaderStages::VERTEX_FRAGMENT.bits();
 const ALL_STAGES: u32 = wgpu::ShaderStages::VERTEX_FRAGMENT
     .union(wgpu::ShaderStages::COMPUTE)
     .bits();

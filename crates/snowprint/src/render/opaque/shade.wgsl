@@ -48,7 +48,8 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let ids = textureLoad(visibility, id.xy, 0).xyz;
-    if ids.x == NO_TRIANGLE || textureLoad(scene_depth, id.xy, 0) != bitcast<f32>(ids.z) {
+    // Nothing drawn here (NO_TRIANGLE), or the snow's hit (shaded by the snow pass).
+    if (ids.x & SNOW_VISIBLE) != 0u || textureLoad(scene_depth, id.xy, 0) != bitcast<f32>(ids.z) {
         return;
     }
     let inst = instances[ids.x];

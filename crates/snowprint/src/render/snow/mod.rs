@@ -2,9 +2,16 @@
 //! box of its slab, with indirect draws written by `classify`: the basic material for untouched
 //! snow, the deformable one (relief mapping or POM through the heightfield) for the rest. In the
 //! tessellated tier the diced surfaces are drawn after, in a second render pass (see
-//! [`TessSurface`]); the pass's timestamps span both.
+//! [`TessSurface`]); the pass's timestamps span both. On the visibility path the relief-mapped
+//! surfaces' fragments only trace, and the `snow_shade` pass shades their hits in compute
+//! ([`visible`]).
 
-use super::config::RenderConfig;
+mod visible;
+
+/// Most surfaces a frame may draw ([`super::RenderFrame`]'s check refuses more).
+pub(super) const SURFACES_MAX: usize = visible::SLOTS;
+
+use super::config::{OpaquePath, RenderConfig};
 use super::frame::FrameSurface;
 use super::gpu::{
     STATE_BASIC_DRAW, STATE_DEFORMABLE_DRAW, STATE_WORDS, SURFACE_STRIDE, Shading, SurfaceUniform,
@@ -33,6 +40,8 @@ pub(super) struct SnowPass {
     pub uniforms: Growable,
     /// This frame's group 1 per surface slot; `None` where the tessellated tier dices it.
     bind_groups: Vec<Option<wgpu::BindGroup>>,
+    /// The pipelines of the visibility path (only on `OpaquePath::Visibility`).
+    visible: Option<visible::VisiblePath>,
 }
 
 impl SnowPass {
@@ -40,6 +49,7 @@ impl SnowPass {
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
         filterable: bool,
+        path: OpaquePath,
     ) -> Self {
         let layout =
             crate::wgsl::SURFACE.bind_group_layout_for(device, "snow surface", 1, filterable);
@@ -85,9 +95,10 @@ impl SnowPass {
             .then(conservative_surface_wgsl)
             .flatten()
             .map(|text| pipeline::shader(device, "surface.wgsl (outside)", text));
+        let outside_module = outside_module.as_ref().unwrap_or(&module);
         let deformable_outside = pipeline::Raster {
             label: "snow deformable (outside)",
-            module: outside_module.as_ref().unwrap_or(&module),
+            module: outside_module,
             vs: "vs_surface_deformable",
             fs: "fs_deformable",
             buffers: &[],
@@ -98,6 +109,18 @@ impl SnowPass {
             constants: pipeline::manual_filter(filterable),
         }
         .build(device);
+        let visible = (path == OpaquePath::Visibility).then(|| {
+            visible::VisiblePath::new(
+                device,
+                &visible::Modules {
+                    plain: &module,
+                    outside: outside_module,
+                    frame_layout,
+                    surface_layout: &layout,
+                    constants: pipeline::manual_filter(filterable),
+                },
+            )
+        });
         Self {
             uniforms: Growable::new(
                 device,
@@ -111,12 +134,14 @@ impl SnowPass {
             deformable_outside,
             outside: Vec::new(),
             bind_groups: Vec::new(),
+            visible,
         }
     }
 
     /// Upload each surface's uniform (transform, grid, ground, search, look and its material's
     /// look), bind it with its heightfield textures and the world's ground fields, and note
-    /// whether `eye` (world) is outside its box.
+    /// whether `eye` (world) is outside its box; on the visibility path, where on the `targets`
+    /// each relief-mapped box lies under `view_proj`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn prepare(
         &mut self,
@@ -126,13 +151,15 @@ impl SnowPass {
         surfaces: &[FrameSurface<'_>],
         heightfields: &HeightfieldPass,
         ground: &wgpu::Buffer,
-        eye: glam::Vec3,
+        targets: &Targets,
+        (eye, view_proj): (glam::Vec3, glam::Mat4),
     ) {
         let search = cfg.search_settings();
         self.outside.clear();
         let look = cfg.look;
         let stride = SURFACE_STRIDE as usize;
         let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
+        let mut uniforms = Vec::with_capacity(surfaces.len());
         for (s, surface) in surfaces.iter().enumerate() {
             let shading = Shading {
                 search,
@@ -146,6 +173,7 @@ impl SnowPass {
             };
             let u = SurfaceUniform::shaded(surface.view, &shading);
             self.outside.push(eye_outside_box(&u, eye));
+            uniforms.push(u);
             bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
                 .copy_from_slice(bytemuck::bytes_of(&u));
         }
@@ -173,6 +201,25 @@ impl SnowPass {
                 ))
             })
             .collect();
+        if let Some(v) = &mut self.visible {
+            let shaded: Vec<bool> = self.bind_groups.iter().map(Option::is_some).collect();
+            v.prepare(device, queue, targets, &uniforms, &shaded, view_proj);
+        }
+    }
+
+    /// The `snow_shade` pass: on the visibility path, the relief-mapped surfaces' hits shaded in
+    /// compute (an empty compute pass on the forward path).
+    pub(super) fn encode_shade(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        ts: Option<&Timestamps>,
+        slot: usize,
+        frame: &wgpu::BindGroup,
+    ) {
+        match &self.visible {
+            Some(v) => v.encode_shade(encoder, ts, slot, frame, &self.bind_groups),
+            None => drop(super::readback::compute_pass(encoder, ts, slot)),
+        }
     }
 
     /// The relief-mapped surfaces (indirect draws of both materials), then the diced ones.
@@ -188,11 +235,12 @@ impl SnowPass {
         tess: &TessSurface,
         dice: &DicePass,
     ) {
+        let scene = targets.color(wgpu::LoadOp::Load);
+        let visible = self.visible.as_ref().zip(targets.snow_visible());
         {
-            let attachments = targets.color(wgpu::LoadOp::Load);
             let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(PASSES[slot].name),
-                color_attachments: &attachments,
+                color_attachments: &scene,
                 depth_stencil_attachment: targets.depth(KEEP),
                 // The pass's time spans this render pass and the tessellated one after it.
                 timestamp_writes: render_span(ts, slot, true, false),
@@ -202,22 +250,48 @@ impl SnowPass {
             p.set_bind_group(0, frame, &[]);
             p.set_pipeline(&self.basic);
             self.draw_each(&mut p, state, STATE_BASIC_DRAW, |_| true);
-            // The deformable surfaces seen from outside their box, then those the eye is in.
-            p.set_pipeline(&self.deformable_outside);
-            self.draw_each(&mut p, state, STATE_DEFORMABLE_DRAW, |s| self.outside[s]);
-            p.set_pipeline(&self.deformable);
-            self.draw_each(&mut p, state, STATE_DEFORMABLE_DRAW, |s| !self.outside[s]);
+            if visible.is_none() {
+                self.draw_deformable(&mut p, state, [&self.deformable_outside, &self.deformable]);
+            }
         }
-        let attachments = targets.color(wgpu::LoadOp::Load);
+        // On the visibility path the deformable material writes the visibility buffer and its
+        // hits, not the scene's colour: a render pass of its own (depth orders it against the
+        // basic material's pixels as in one pass: nothing blends).
+        if let Some((v, attachments)) = visible {
+            let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("snow (visibility)"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: targets.depth(KEEP),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            p.set_bind_group(0, frame, &[]);
+            self.draw_deformable(&mut p, state, [&v.deformable_outside, &v.deformable]);
+        }
         let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("snow (tessellated)"),
-            color_attachments: &attachments,
+            color_attachments: &scene,
             depth_stencil_attachment: targets.depth(KEEP),
             timestamp_writes: render_span(ts, slot, false, true),
             occlusion_query_set: None,
             multiview_mask: None,
         });
         tess.draw(&mut p, frame, dice);
+    }
+
+    /// The deformable surfaces seen from outside their box (`pipelines[0]`), then those the eye
+    /// is in (`pipelines[1]`).
+    fn draw_deformable(
+        &self,
+        p: &mut wgpu::RenderPass<'_>,
+        state: &wgpu::Buffer,
+        pipelines: [&wgpu::RenderPipeline; 2],
+    ) {
+        p.set_pipeline(pipelines[0]);
+        self.draw_each(p, state, STATE_DEFORMABLE_DRAW, |s| self.outside[s]);
+        p.set_pipeline(pipelines[1]);
+        self.draw_each(p, state, STATE_DEFORMABLE_DRAW, |s| !self.outside[s]);
     }
 
     /// Each relief-mapped surface that `keep` takes: its group and its indirect draw at `offset`.

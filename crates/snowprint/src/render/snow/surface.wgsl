@@ -266,6 +266,17 @@ struct SnowOut {
 fn fs_deformable(in: SurfaceVarying, @builtin(front_facing) front: bool) -> SnowOut {
     // Footprint of the pixel on the surface, before any non-uniform control flow.
     let pixel = length(fwidth(in.local));
+    let hit = trace_pixel(in, front);
+    var out: SnowOut;
+    out.color = vec4<f32>(shade_hit(hit, in.face, pixel), 1.0);
+    out.depth = hit_depth(hit);
+    return out;
+}
+
+// The view ray of a fragment of the box traced through the heightfield; the fragment is
+// discarded where it meets no snow, or where a finer terrain window level draws instead
+// (`SnowSurface::hole`).
+fn trace_pixel(in: SurfaceVarying, front: bool) -> SnowHit {
     let eye = (surface.world_to_local * vec4<f32>(frame.eye.xyz, 1.0)).xyz;
     let top = snow_top(surface);
     let inside = all(abs(eye.xz) <= surface.half_size) && eye.y >= surface.terrain_low && eye.y <= top;
@@ -276,10 +287,22 @@ fn fs_deformable(in: SurfaceVarying, @builtin(front_facing) front: bool) -> Snow
     let d = normalize(in.local - eye);
     let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
     let hit = snow_trace(surface, o, d, frame.options.z, moon);
-    // Where a finer terrain window level draws, this one does not (`SnowSurface::hole`).
     if hit.found == 0u || snow_in_hole(surface, hit.position.xz) {
         discard;
     }
+    return hit;
+}
+
+// The depth of a hit, as the scene's depth target stores it.
+fn hit_depth(hit: SnowHit) -> f32 {
+    let world = surface.local_to_world * vec4<f32>(hit.position, 1.0);
+    let clip = frame.view_proj * world;
+    return clamp(clip.z / clip.w, 0.0, 1.0);
+}
+
+// The colour of a hit (`face`: the normal of the box face rasterised, `pixel`: the pixel's
+// footprint, metres): the deformable material sampled there and lit, or the frame's debug view.
+fn shade_hit(hit: SnowHit, face: vec3<f32>, pixel: f32) -> vec3<f32> {
     let uv = snow_uv(surface, hit.position.xz);
     var hf = snow_heightfield(surface, uv);
     if surface.translucency.w > 0.0 {
@@ -295,14 +318,88 @@ fn fs_deformable(in: SurfaceVarying, @builtin(front_facing) front: bool) -> Snow
         at = on.hit;
         hf = on.hf;
     }
-    let m = snow_deformable(surface, at, hf, in.face, sky_tint(), pixel);
-    let c = deformable_view(shade(m, hit.position, hit.shadow, pixel), m, hf.x, f32(hit.taps) / 48.0);
-    var out: SnowOut;
-    out.color = vec4<f32>(c, 1.0);
-    let world = surface.local_to_world * vec4<f32>(hit.position, 1.0);
-    let clip = frame.view_proj * world;
-    out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
+    let m = snow_deformable(surface, at, hf, face, sky_tint(), pixel);
+    return deformable_view(shade(m, hit.position, hit.shadow, pixel), m, hf.x, f32(hit.taps) / 48.0);
+}
+
+// The deformable material on the visibility path (`OpaquePath::Visibility`): the fragment only
+// traces, and writes its hit into the visibility buffer; `shade_deformable` shades it in compute
+// (on GPUs with few graphics units, the shading costs far more in a fragment than in compute).
+struct SnowVisible {
+    // (SNOW_VISIBLE | slot << SNOW_SLOT_SHIFT | taps << 5 | water << 4 | side << 3 | face,
+    // depth bits, pixel footprint bits, self-shadow bits)
+    @location(0) visibility: vec4<u32>,
+    // The hit, surface-local, and its distance along the ray.
+    @location(1) hit: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+@fragment
+fn fs_deformable_visible(in: SurfaceVarying, @builtin(front_facing) front: bool) -> SnowVisible {
+    let pixel = length(fwidth(in.local));
+    let hit = trace_pixel(in, front);
+    var out: SnowVisible;
+    out.depth = hit_depth(hit);
+    let flags = min(hit.taps, 255u) << 5u | (hit.water & 1u) << 4u | (hit.side & 1u) << 3u | face_code(in.face);
+    out.visibility = vec4<u32>(
+        snow_visible_id(surface.index) | flags,
+        bitcast<u32>(out.depth),
+        bitcast<u32>(pixel),
+        bitcast<u32>(hit.shadow),
+    );
+    out.hit = vec4<f32>(hit.position, hit.t);
     return out;
+}
+
+// The high bits of a snow pixel's first visibility word: the tag and the surface's slot.
+fn snow_visible_id(slot: u32) -> u32 {
+    return SNOW_VISIBLE | slot << SNOW_SLOT_SHIFT;
+}
+
+// A box face's normal as three bits (its axis, and its sign in the third bit), and back.
+fn face_code(n: vec3<f32>) -> u32 {
+    let axis = select(select(2u, 1u, n.y != 0.0), 0u, n.x != 0.0);
+    return axis | select(0u, 4u, n.x + n.y + n.z < 0.0);
+}
+
+fn face_normal(code: u32) -> vec3<f32> {
+    var n = vec3<f32>(0.0);
+    n[code & 3u] = select(1.0, -1.0, (code & 4u) != 0u);
+    return n;
+}
+
+@group(2) @binding(0) var visibility: texture_2d<u32>;
+@group(2) @binding(1) var snow_hits: texture_2d<f32>;
+@group(2) @binding(2) var scene_color: texture_storage_2d<rgba16float, write>;
+@group(2) @binding(3) var scene_depth: texture_depth_2d;
+// Per surface slot: the rectangle of pixels [x0, x1) x [y0, y1) its box covers on screen.
+@group(2) @binding(4) var<storage, read> shade_rects: array<vec4<u32>>;
+
+// The visibility buffer's snow, shaded: one dispatch per relief-mapped surface over the
+// rectangle its box covers, each pixel shaded only where the visibility buffer holds this
+// surface's hit and the scene's depth is still the depth that hit wrote.
+@compute @workgroup_size(8, 8, 1)
+fn shade_deformable(@builtin(global_invocation_id) id: vec3<u32>) {
+    let rect = shade_rects[surface.index];
+    let p = rect.xy + id.xy;
+    if p.x >= rect.z || p.y >= rect.w {
+        return;
+    }
+    let v = textureLoad(visibility, p, 0);
+    let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
+    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) != bitcast<f32>(v.y) {
+        return;
+    }
+    let h = textureLoad(snow_hits, p, 0);
+    var hit: SnowHit;
+    hit.position = h.xyz;
+    hit.t = h.w;
+    hit.found = 1u;
+    hit.taps = (v.x >> 5u) & 255u;
+    hit.water = (v.x >> 4u) & 1u;
+    hit.side = (v.x >> 3u) & 1u;
+    hit.shadow = bitcast<f32>(v.w);
+    textureStore(scene_color, p, vec4<f32>(shade_hit(hit, face_normal(v.x & 7u), bitcast<f32>(v.z)), 1.0));
 }
 
 struct OnGround {
