@@ -130,21 +130,27 @@ fn each_material_matches_its_golden() {
 }
 
 /// The materials drawn through the visibility buffer (the deformable material traced in its
-/// fragments and shaded in compute: sand's and mud's rims, mud's water, powder) pass their
-/// goldens as the forward path does.
+/// fragments, or diced, and shaded in compute: sand's and mud's rims, mud's water in both tiers,
+/// powder) pass their goldens as the forward path does.
 #[test]
 fn each_material_through_the_visibility_buffer_matches_its_golden() {
     if bless() {
         return;
     }
-    for (name, material) in materials() {
-        let mut scene = scene(material);
-        let mut config = RenderConfig::new(WIDTH, HEIGHT, Tier::Relief);
+    let visible = |tier| {
+        let mut config = RenderConfig::new(WIDTH, HEIGHT, tier);
         config.shadow_map_size = 1024;
         config.opaque = OpaquePath::Visibility;
-        scene.renderer = Renderer::new(common::gpu(), config).expect("renderer");
+        Renderer::new(common::gpu(), config).expect("renderer")
+    };
+    for (name, material) in materials() {
+        let mut scene = scene(material);
+        scene.renderer = visible(Tier::Relief);
         check(name, &render(&mut scene));
     }
+    let mut mud = scene_in(Material::mud(), Tier::Tessellated);
+    mud.renderer = visible(Tier::Tessellated);
+    check("material_mud_tessellated", &render(&mut mud));
 }
 
 /// Screen rectangle (pixels, min and max corners) of a print's sole scaled by `scale`, at height

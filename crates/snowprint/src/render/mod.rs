@@ -203,19 +203,23 @@ impl Renderer {
             config.shadow_map_size,
         );
         let frame = FrameResources::new(&device, layouts, &shadow.view, filterable);
+        let snow = snow::SnowPass::new(&device, &frame.layout, filterable, config.opaque);
+        // On the visibility path the diced snow's shading binds the snow pass's targets.
+        let tess_surface = TessSurface::new(
+            &device,
+            &frame.layout,
+            &frame.shadow_layout,
+            filterable,
+            snow.shade_targets_layout(),
+        );
         let renderer = Self {
             classify: classify::ClassifyPass::new(&device),
             heightfield: heightfield::HeightfieldPass::new(&device),
             banks: BanksPass::new(&device),
             dice: DicePass::new(&device),
-            tess_surface: TessSurface::new(
-                &device,
-                &frame.layout,
-                &frame.shadow_layout,
-                filterable,
-            ),
+            tess_surface,
             opaque: opaque::OpaquePass::new(&device, &mesh_module, &frame.layout, config.opaque),
-            snow: snow::SnowPass::new(&device, &frame.layout, filterable, config.opaque),
+            snow,
             sky: sky::SkyPass::new(&device, &frame.layout),
             snowfall: snowfall::SnowfallPass::new(&device, &frame.layout),
             spray: spray::SprayPass::new(&device, &frame.layout),
@@ -726,7 +730,10 @@ impl Renderer {
             pass::OPAQUE => self
                 .opaque
                 .encode(encoder, ts, slot, targets, frame, &self.meshes),
-            pass::SNOW_SHADE => self.snow.encode_shade(encoder, ts, slot, frame),
+            pass::SNOW_SHADE => {
+                self.snow
+                    .encode_shade(encoder, ts, slot, frame, &self.tess_surface)
+            }
             pass::OPAQUE_SHADE => self.opaque.encode_shade(encoder, ts, slot, frame),
             pass::SNOW => self.snow.encode(
                 encoder,

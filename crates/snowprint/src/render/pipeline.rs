@@ -131,6 +131,23 @@ pub(super) fn hdr_target() -> [Option<wgpu::ColorTargetState>; 1] {
     })]
 }
 
+/// The targets of the snow's draws on the visibility path: the visibility buffer and the hits
+/// (without the scene's colour: the three would pass the bytes a sample may have in every
+/// device's limits).
+pub(super) fn visibility_targets() -> [Option<wgpu::ColorTargetState>; 2] {
+    let target = |format| {
+        Some(wgpu::ColorTargetState {
+            format,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        })
+    };
+    [
+        target(super::targets::VISIBILITY_FORMAT),
+        target(super::targets::SNOW_HITS_FORMAT),
+    ]
+}
+
 /// Back faces culled.
 pub(super) fn back_culled() -> wgpu::PrimitiveState {
     wgpu::PrimitiveState {

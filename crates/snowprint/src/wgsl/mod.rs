@@ -139,8 +139,8 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
     ("surface", "snow_hits", Override::NotFiltering),
     // Bank heights, read with textureLoad (bilinear by hand, as in the tessellated tier).
     ("surface", "bank_texture", Override::NotFiltering),
-    // The tessellated tier shares the snow pass's bindings with both stages (and `surface.wgsl`'s
-    // compute entry point comes with its import).
+    // The tessellated tier shares the snow pass's bindings with both stages, and with compute
+    // (its `shade_tess`, and `surface.wgsl`'s `shade_deformable`, which comes with the import).
     ("tess_surface", "surface", Override::Stages(ALL_STAGES)),
     (
         "tess_surface",
@@ -163,7 +163,7 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
     (
         "tess_surface",
         "surface_state",
-        Override::Stages(VERTEX_FRAGMENT),
+        Override::Stages(ALL_STAGES),
     ),
     // Read with textureLoad only.
     ("tonemap", "scene_color", Override::NotFiltering),

@@ -202,22 +202,41 @@ impl SnowPass {
             })
             .collect();
         if let Some(v) = &mut self.visible {
-            let shaded: Vec<bool> = self.bind_groups.iter().map(Option::is_some).collect();
+            let shaded: Vec<Option<f32>> = surfaces
+                .iter()
+                .zip(&self.bind_groups)
+                .zip(&uniforms)
+                .map(|((surface, group), u)| match (surface.tessellated, group) {
+                    (true, _) => heightfields
+                        .texture(surface.view.id)
+                        .map(|_| tessellated_rise(u)),
+                    (false, Some(_)) => Some(0.0),
+                    (false, None) => None,
+                })
+                .collect();
             v.prepare(device, queue, targets, &uniforms, &shaded, view_proj);
         }
     }
 
-    /// The `snow_shade` pass: on the visibility path, the relief-mapped surfaces' hits shaded in
-    /// compute (an empty compute pass on the forward path).
+    /// The layout of the visibility path's shading targets (`None` on the forward path).
+    pub(super) fn shade_targets_layout(&self) -> Option<&wgpu::BindGroupLayout> {
+        self.visible
+            .as_ref()
+            .map(visible::VisiblePath::targets_layout)
+    }
+
+    /// The `snow_shade` pass: on the visibility path, the snow's hits shaded in compute, the
+    /// relief-mapped surfaces' and the diced ones' (an empty compute pass on the forward path).
     pub(super) fn encode_shade(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
         slot: usize,
         frame: &wgpu::BindGroup,
+        tess: &TessSurface,
     ) {
         match &self.visible {
-            Some(v) => v.encode_shade(encoder, ts, slot, frame, &self.bind_groups),
+            Some(v) => v.encode_shade(encoder, ts, slot, frame, &self.bind_groups, tess),
             None => drop(super::readback::compute_pass(encoder, ts, slot)),
         }
     }
@@ -257,10 +276,10 @@ impl SnowPass {
         // On the visibility path the deformable material writes the visibility buffer and its
         // hits, not the scene's colour: a render pass of its own (depth orders it against the
         // basic material's pixels as in one pass: nothing blends).
-        if let Some((v, attachments)) = visible {
+        if let Some((v, attachments)) = &visible {
             let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("snow (visibility)"),
-                color_attachments: &attachments,
+                color_attachments: attachments,
                 depth_stencil_attachment: targets.depth(KEEP),
                 timestamp_writes: None,
                 occlusion_query_set: None,
@@ -269,15 +288,19 @@ impl SnowPass {
             p.set_bind_group(0, frame, &[]);
             self.draw_deformable(&mut p, state, [&v.deformable_outside, &v.deformable]);
         }
+        let attachments: &[_] = match &visible {
+            Some((_, attachments)) => attachments,
+            None => &scene,
+        };
         let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("snow (tessellated)"),
-            color_attachments: &scene,
+            color_attachments: attachments,
             depth_stencil_attachment: targets.depth(KEEP),
             timestamp_writes: render_span(ts, slot, false, true),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        tess.draw(&mut p, frame, dice);
+        tess.draw(&mut p, frame, dice, visible.is_some());
     }
 
     /// The deformable surfaces seen from outside their box (`pipelines[0]`), then those the eye
@@ -309,6 +332,14 @@ impl SnowPass {
             }
         }
     }
+}
+
+/// How far above its box's top (the untouched snow top and the room for rims) the diced snow of a
+/// surface may rise, metres: its banks, built of the snow its prints displaced, stay under the
+/// snow's depth, and its macro waves under a tenth of their strength (`snow.wgsl`'s
+/// `snow_macro_height` stays within 0.062 m of 0, less `tess_surface.wgsl`'s 0.025 m mean).
+fn tessellated_rise(u: &SurfaceUniform) -> f32 {
+    u.snow_depth + 0.1 * u.pattern[3].abs()
 }
 
 /// Whether `eye` (world) is outside the box the deformable material draws for a surface, by more

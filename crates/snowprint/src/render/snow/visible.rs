@@ -13,7 +13,8 @@ use glam::{Mat4, Vec3, Vec4Swizzles};
 use super::super::gpu::SurfaceUniform;
 use super::super::pipeline;
 use super::super::readback::{Timestamps, compute_pass};
-use super::super::targets::{SNOW_HITS_FORMAT, Targets, VISIBILITY_FORMAT};
+use super::super::targets::Targets;
+use super::super::tessellate::snow_shadow::TessSurface;
 use crate::gpu::resources::{Growable, bind_group};
 
 /// Pixels a workgroup of `shade_deformable` covers along each axis.
@@ -52,16 +53,7 @@ pub(super) struct Modules<'a> {
 impl VisiblePath {
     pub(super) fn new(device: &wgpu::Device, m: &Modules<'_>) -> Self {
         let groups = [m.frame_layout, m.surface_layout];
-        // The visibility buffer and the hits, without the scene's colour (the three would pass the
-        // bytes a sample may have in every device's limits).
-        let target = |format| {
-            Some(wgpu::ColorTargetState {
-                format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })
-        };
-        let targets = [target(VISIBILITY_FORMAT), target(SNOW_HITS_FORMAT)];
+        let targets = pipeline::visibility_targets();
         let raster = |label, module, primitive| {
             pipeline::Raster {
                 label,
@@ -121,15 +113,22 @@ impl VisiblePath {
         }
     }
 
-    /// Each relief-mapped surface's rectangle of the screen (`shaded[s]`: surface slot `s` is
-    /// drawn by the relief pipelines this frame), uploaded, and the targets' group.
+    /// The layout of the shading's targets (group 2), shared with the tessellated tier's shading.
+    pub(super) fn targets_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.targets_layout
+    }
+
+    /// Each shaded surface's rectangle of the screen, uploaded, and the targets' group.
+    /// `shaded[s]`: `None` where surface slot `s` is not drawn into the visibility buffer this
+    /// frame, else how far above its box's top its snow may rise (metres: the tessellated tier's
+    /// banks and waves; 0 for the relief tier, whose trace never leaves the box).
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         targets: &Targets,
         uniforms: &[SurfaceUniform],
-        shaded: &[bool],
+        shaded: &[Option<f32>],
         view_proj: Mat4,
     ) {
         let (Some(visibility), Some(hits)) = (&targets.visibility_view, &targets.snow_hits_view)
@@ -141,8 +140,8 @@ impl VisiblePath {
         let size = (t.width(), t.height());
         let mut rects = vec![[0u32; 4]; uniforms.len().max(1)];
         self.dispatches.clear();
-        for (s, (u, &on)) in uniforms.iter().zip(shaded).enumerate() {
-            let rect = on.then(|| screen_rect(u, view_proj, size)).flatten();
+        for (s, (u, &rise)) in uniforms.iter().zip(shaded).enumerate() {
+            let rect = rise.and_then(|rise| screen_rect(u, rise, view_proj, size));
             if let Some(r) = rect {
                 rects[s] = r;
             }
@@ -170,7 +169,8 @@ impl VisiblePath {
         ));
     }
 
-    /// The `snow_shade` pass: each surface's dispatch with its group (`surface_groups`, by slot).
+    /// The `snow_shade` pass: each relief-mapped surface's dispatch with its group
+    /// (`surface_groups`, by slot), then the diced ones'.
     pub(super) fn encode_shade(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -178,6 +178,7 @@ impl VisiblePath {
         slot: usize,
         frame: &wgpu::BindGroup,
         surface_groups: &[Option<wgpu::BindGroup>],
+        tess: &TessSurface,
     ) {
         let mut p = compute_pass(encoder, ts, slot);
         let Some(targets) = &self.current else {
@@ -192,21 +193,23 @@ impl VisiblePath {
                 p.dispatch_workgroups(*x, *y, 1);
             }
         }
+        tess.encode_shade(&mut p, &self.dispatches);
     }
 }
 
 /// The rectangle of pixels `[x0, x1) x [y0, y1)` of a `size` target that the box a surface's
-/// deformable material draws (`surface.wgsl`'s `box_vertex`, raised by the room for rims) can
-/// cover under `view_proj`, a pixel wider on every side; the whole target where a corner lies
-/// behind the eye (or on its plane), and `None` where the box is off screen.
+/// deformable material draws (`surface.wgsl`'s `box_vertex`, raised by the room for rims, and by
+/// `rise` metres more) can cover under `view_proj`, a pixel wider on every side; the whole target
+/// where a corner lies behind the eye (or on its plane), and `None` where the box is off screen.
 pub(super) fn screen_rect(
     u: &SurfaceUniform,
+    rise: f32,
     view_proj: Mat4,
     size: (u32, u32),
 ) -> Option<[u32; 4]> {
     let to_clip = view_proj * Mat4::from_cols_array_2d(&u.local_to_world);
     let (hx, hz) = (u.half_size[0], u.half_size[1]);
-    let (low, top) = (u.terrain_low, u.terrain_top + u.translucency[3]);
+    let (low, top) = (u.terrain_low, u.terrain_top + u.translucency[3] + rise);
     let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
     for k in 0..8 {
         let corner = Vec3::new(
@@ -274,7 +277,7 @@ mod tests {
         let u = surface(facing, [1.0, 1.0], 0.3);
         let view_proj = view_proj(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO);
         assert_eq!(
-            screen_rect(&u, view_proj, (100, 100)),
+            screen_rect(&u, 0.0, view_proj, (100, 100)),
             Some([38, 38, 62, 62])
         );
     }
@@ -292,7 +295,7 @@ mod tests {
         let view_proj = view_proj(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, -1.0));
         let around = surface(Mat4::IDENTITY, [10.0, 10.0], 0.3);
         assert_eq!(
-            screen_rect(&around, view_proj, (64, 32)),
+            screen_rect(&around, 0.0, view_proj, (64, 32)),
             Some([0, 0, 64, 32])
         );
         let beside = surface(
@@ -300,6 +303,6 @@ mod tests {
             [1.0, 1.0],
             0.3,
         );
-        assert_eq!(screen_rect(&beside, view_proj, (64, 32)), None);
+        assert_eq!(screen_rect(&beside, 0.0, view_proj, (64, 32)), None);
     }
 }

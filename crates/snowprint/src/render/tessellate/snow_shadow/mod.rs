@@ -1,7 +1,9 @@
 //! The tessellated tier's snow (`tess_surface.wgsl`): the diced mesh displaced in the vertex
 //! stage and shaded with the snow material, drawn into the moon's shadow cascades by the
 //! `snow_shadow` pass and into the scene by the `snow` pass (after the relief-mapped surfaces).
-//! Both draws bind a surface's uniform, heightfield and bank textures and state as group 1.
+//! Both draws bind a surface's uniform, heightfield and bank textures and state as group 1. On
+//! the visibility path the scene's draw writes the visibility buffer, and `shade_tess` shades it
+//! in the `snow_shade` pass (as the relief tier's `snow/visible.rs`).
 
 use super::VERTEX_BYTES;
 use super::dice::DicePass;
@@ -20,7 +22,9 @@ pub(in crate::render) struct TessSurface {
     /// The tessellated snow into each shadow cascade.
     shadow: [wgpu::RenderPipeline; 2],
     /// This frame's group 1 per surface slot; `None` where it is not diced.
-    bind_groups: Vec<Option<wgpu::BindGroup>>,
+    pub bind_groups: Vec<Option<wgpu::BindGroup>>,
+    /// On the visibility path: the draw into the visibility buffer, and its shading.
+    visible: Option<(wgpu::RenderPipeline, wgpu::ComputePipeline)>,
 }
 
 impl TessSurface {
@@ -29,6 +33,7 @@ impl TessSurface {
         frame_layout: &wgpu::BindGroupLayout,
         shadow_layout: &wgpu::BindGroupLayout,
         filterable: bool,
+        visible_targets: Option<&wgpu::BindGroupLayout>,
     ) -> Self {
         let layout = crate::wgsl::TESS_SURFACE.bind_group_layout_for(
             device,
@@ -48,20 +53,47 @@ impl TessSurface {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &VERTEX,
         })];
-        let draw = pipeline::Raster {
-            label: "snow tessellated",
-            module: &module,
-            vs: "vs_tess",
-            fs: "fs_tess",
-            buffers: &buffers,
-            groups: &[frame_layout, &layout],
-            // Skirts face outwards whichever way a mesh is wound: no culling.
-            primitive: wgpu::PrimitiveState::default(),
-            depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
-            targets: &pipeline::hdr_target(),
-            constants: pipeline::manual_filter(filterable),
-        }
-        .build(device);
+        let raster = |label, fs, targets: &[Option<wgpu::ColorTargetState>]| {
+            pipeline::Raster {
+                label,
+                module: &module,
+                vs: "vs_tess",
+                fs,
+                buffers: &buffers,
+                groups: &[frame_layout, &layout],
+                // Skirts face outwards whichever way a mesh is wound: no culling.
+                primitive: wgpu::PrimitiveState::default(),
+                depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
+                targets,
+                constants: pipeline::manual_filter(filterable),
+            }
+            .build(device)
+        };
+        let draw = raster("snow tessellated", "fs_tess", &pipeline::hdr_target());
+        let visible = visible_targets.map(|targets_layout| {
+            let draw = raster(
+                "snow tessellated (visibility)",
+                "fs_tess_visible",
+                &pipeline::visibility_targets(),
+            );
+            let layout = pipeline::layout(
+                device,
+                "snow shade (tessellated)",
+                &[frame_layout, &layout, targets_layout],
+            );
+            let shade = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("snow shade (tessellated)"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("shade_tess"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: pipeline::manual_filter(filterable),
+                    ..Default::default()
+                },
+                cache: None,
+            });
+            (draw, shade)
+        });
         let shadow_pipeline_layout =
             pipeline::layout(device, "snow shadow", &[shadow_layout, &layout]);
         let shadow = pipeline::shadow_caster(
@@ -78,6 +110,7 @@ impl TessSurface {
             draw,
             shadow,
             bind_groups: Vec::new(),
+            visible,
         }
     }
 
@@ -143,17 +176,41 @@ impl TessSurface {
         }
     }
 
-    /// The tessellated snow into the scene (within the `snow` pass).
+    /// The tessellated snow into the scene (within the `snow` pass): into the visibility buffer
+    /// where `visible` (the pass's attachments are then the visibility buffer and the hits).
     pub(crate) fn draw(
         &self,
         p: &mut wgpu::RenderPass<'_>,
         frame: &wgpu::BindGroup,
         dice: &DicePass,
+        visible: bool,
     ) {
         if dice.any() {
-            p.set_pipeline(&self.draw);
+            match (&self.visible, visible) {
+                (Some((draw, _)), true) => p.set_pipeline(draw),
+                _ => p.set_pipeline(&self.draw),
+            }
             p.set_bind_group(0, frame, &[]);
             dice.draw(p, &self.bind_groups);
+        }
+    }
+
+    /// The diced surfaces' dispatches of the `snow_shade` pass (`dispatches`: workgroups per
+    /// surface slot, `None` where it is not shaded), with the shading's targets bound as group 2.
+    pub(crate) fn encode_shade(
+        &self,
+        p: &mut wgpu::ComputePass<'_>,
+        dispatches: &[Option<(u32, u32)>],
+    ) {
+        let Some((_, shade)) = &self.visible else {
+            return;
+        };
+        p.set_pipeline(shade);
+        for (group, dispatch) in self.bind_groups.iter().zip(dispatches) {
+            if let (Some(group), Some((x, y))) = (group, dispatch) {
+                p.set_bind_group(1, group, &[]);
+                p.dispatch_workgroups(*x, *y, 1);
+            }
         }
     }
 }

@@ -109,19 +109,25 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
     if snow_in_hole(surface, in.local.xz) {
         discard;
     }
+    return vec4<f32>(tess_shade(in.local, in.outward, pixel), 1.0);
+}
+
+// The colour of the diced snow at `local` (`outward`: the varying of that name, `pixel`: the
+// pixel's footprint, metres).
+fn tess_shade(local: vec3<f32>, outward: vec4<f32>, pixel: f32) -> vec3<f32> {
     var m: SnowSample;
     var hf = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-    if in.outward.w > 0.5 {
+    if outward.w > 0.5 {
         // A skirt: the cut through the snow at an open edge, as the relief tier's box sides.
-        let face = normalize(vec3<f32>(in.outward.x, 0.0, in.outward.z));
-        var cut = in.local;
-        cut.y -= ground_at_uv(snow_uv(surface, in.local.xz)).x;
+        let face = normalize(vec3<f32>(outward.x, 0.0, outward.z));
+        var cut = local;
+        cut.y -= ground_at_uv(snow_uv(surface, local.xz)).x;
         m = snow_basic(surface, cut, face, sky_tint(), pixel);
     } else {
-        let uv = snow_uv(surface, in.local.xz);
+        let uv = snow_uv(surface, local.xz);
         // The snow top's slope: the base mesh's (a pitched roof), plus the heightmap's and the
         // banks' where something pressed the snow.
-        var g = in.outward.xz;
+        var g = outward.xz;
         if tess_touched() {
             hf = snow_heightfield(surface, uv);
             let ny = max(sqrt(max(1.0 - hf.y * hf.y - hf.z * hf.z, 0.0)), 1e-3);
@@ -138,16 +144,63 @@ fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
         hf = vec4<f32>(hf.x, n.x, n.z, hf.w);
         var hit: SnowHit;
         // The depression drives the stages; the height of the hit is the filtered one.
-        hit.position = vec3<f32>(in.local.x, surface.snow_depth, in.local.z);
+        hit.position = vec3<f32>(local.x, surface.snow_depth, local.z);
         hit.found = 1u;
         hit.side = 0u;
         hit.shadow = 1.0;
         hit.taps = 0u;
         hit.t = 0.0;
         // Water: the diced top is the flat water surface where the material lies under it.
-        hit.water = select(0u, 1u, tess_under_water(in.local.xz));
+        hit.water = select(0u, 1u, tess_under_water(local.xz));
         m = snow_deformable(surface, hit, hf, vec3<f32>(0.0, 1.0, 0.0), sky_tint(), pixel);
     }
     // No search in this tier: no taps.
-    return vec4<f32>(deformable_view(shade(m, in.local, 1.0, pixel), m, hf.x, 0.0), 1.0);
+    return deformable_view(shade(m, local, 1.0, pixel), m, hf.x, 0.0);
+}
+
+// The diced snow on the visibility path (`OpaquePath::Visibility`): the fragment writes what
+// `tess_shade` reads into the visibility buffer (as surface.wgsl's `SnowVisible`: the tag and
+// slot, bit 3 set on skirts; the depth; the footprint; `outward.x`) and the hits target
+// (`local`, `outward.z`), and `shade_tess` shades it in compute.
+struct TessVisible {
+    @location(0) visibility: vec4<u32>,
+    @location(1) hit: vec4<f32>,
+}
+
+@fragment
+fn fs_tess_visible(in: TessVarying) -> TessVisible {
+    let pixel = length(fwidth(in.local));
+    if snow_in_hole(surface, in.local.xz) {
+        discard;
+    }
+    // The depth is the rasterised one (written by the fixed function, as the forward path's).
+    var out: TessVisible;
+    let skirt = select(0u, 8u, in.outward.w > 0.5);
+    out.visibility = vec4<u32>(
+        snow_visible_id(surface.index) | skirt,
+        bitcast<u32>(in.clip.z),
+        bitcast<u32>(pixel),
+        bitcast<u32>(in.outward.x),
+    );
+    out.hit = vec4<f32>(in.local, in.outward.z);
+    return out;
+}
+
+// The visibility buffer's diced snow of this surface, shaded (as surface.wgsl's
+// `shade_deformable`, over the same rectangles and targets).
+@compute @workgroup_size(8, 8, 1)
+fn shade_tess(@builtin(global_invocation_id) id: vec3<u32>) {
+    let rect = shade_rects[surface.index];
+    let p = rect.xy + id.xy;
+    if p.x >= rect.z || p.y >= rect.w {
+        return;
+    }
+    let v = textureLoad(visibility, p, 0);
+    let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
+    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) != bitcast<f32>(v.y) {
+        return;
+    }
+    let h = textureLoad(snow_hits, p, 0);
+    let outward = vec4<f32>(bitcast<f32>(v.w), 0.0, h.w, select(0.0, 1.0, (v.x & 8u) != 0u));
+    textureStore(scene_color, p, vec4<f32>(tess_shade(h.xyz, outward, bitcast<f32>(v.z)), 1.0));
 }
