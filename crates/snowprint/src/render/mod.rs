@@ -9,7 +9,8 @@
 //! | `heightfield` (compute, indirect) | pool, surface state | per deformed surface: depression, normal, AO texture |
 //! | `shadow` | instances | the moon's shadow map |
 //! | `opaque` | instances in view, shadow map | scene colour (HDR), depth; or depth and the visibility buffer ([`OpaquePath::Visibility`]) |
-//! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth |
+//! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth (on the visibility path: the deformable and diced snow's hits into the visibility buffer) |
+//! | `snow_shade` (compute) | visibility buffer, hits, heightfields, shadow map, depth | scene colour where the snow's hit is visible (empty on the forward path) |
 //! | `opaque_shade` (compute) | visibility buffer, instances, shadow map, depth | scene colour where the snow left the opaque visible (empty on the forward path) |
 //! | `sky` | depth | scene colour |
 //! | `snowfall` | depth | scene colour |
