@@ -20,6 +20,17 @@ pub fn frames(s: &str) -> Result<u32, String> {
     }
 }
 
+/// Bits of a depth format the renderer offers: 16 or 32.
+pub fn depth_bits(s: &str) -> Result<u32, String> {
+    match s.trim() {
+        "16" => Ok(16),
+        "32" => Ok(32),
+        _ => Err(format!(
+            "{s:?} is not a depth the shadow map offers; give 16 or 32"
+        )),
+    }
+}
+
 /// A number that must be finite as a 32-bit float (parsed wide, so that `1e39` is named as it was
 /// written rather than as "inf").
 fn finite(s: &str) -> Result<f32, String> {
@@ -77,5 +88,7 @@ mod tests {
         assert!(frames("0").unwrap_err().contains("at least 1"));
         assert!(frames("-2").unwrap_err().contains("below 0"));
         assert!(moment("-1").unwrap_err().contains("before the start"));
+        assert_eq!((depth_bits("16"), depth_bits("32")), (Ok(16), Ok(32)));
+        assert!(depth_bits("24").unwrap_err().contains("give 16 or 32"));
     }
 }

@@ -112,6 +112,12 @@ pub struct Args {
     /// one.
     #[arg(long)]
     pub shadow_map_size: Option<u32>,
+    /// Bits of the shadow map's depth, 16 or 32 (`RenderConfig::shadow_depth_bits`). Default: 16
+    /// on a GPU (half the bytes the shadow pass clears and writes; the goldens' views stay within
+    /// their bounds), 32 on a software adapter (the goldens' setting). The report's
+    /// `shadow_depth_bits` says which.
+    #[arg(long, value_parser = crate::args::depth_bits)]
+    pub shadow_depth_bits: Option<u32>,
 }
 
 /// Statistics of one pass over the frames.
@@ -268,6 +274,9 @@ impl Settings {
         if let Some(size) = args.shadow_map_size {
             config.shadow_map_size = size;
         }
+        config.shadow_depth_bits =
+            args.shadow_depth_bits
+                .unwrap_or(if self.software { 32 } else { 16 });
         config
     }
 
@@ -610,6 +619,7 @@ impl Demo<'_> {
             "instances_last_frame": m.instances_count,
             "instances_culled_last_frame": m.culled_last,
             "shadow_map_size": self.renderer.config().shadow_map_size,
+            "shadow_depth_bits": self.renderer.config().shadow_depth_bits,
             "shadow_last_frame": m.shadow_last,
             "search": renderer.config().search_settings(),
             "passes": renderer.passes(),
@@ -660,6 +670,7 @@ mod tests {
             compare_tiers: false,
             no_spray: false,
             shadow_map_size: None,
+            shadow_depth_bits: None,
         }
     }
 
@@ -739,6 +750,13 @@ mod tests {
         assert_eq!(report["tier"], "pom");
         assert_eq!(report["camera"], "closeup");
         assert!(report["adapter"]["name"].is_string());
+        // The goldens' 32-bit shadow depth on a software adapter, half the bytes on a GPU.
+        let software = report["adapter"]["software"].as_bool().unwrap();
+        assert_eq!(
+            report["shadow_depth_bits"],
+            if software { 32 } else { 16 },
+            "{software}"
+        );
         // Nobody walks on the street (surface 0) of the demo world: the basic material.
         let basic = report["basic_material_surfaces_last_frame"]
             .as_array()

@@ -157,6 +157,42 @@ fn the_visibility_buffer_draws_what_the_forward_path_draws() {
     }
 }
 
+/// A shadow map of 16-bit depth draws every golden view within the golden's bound (half the
+/// bytes the shadow pass clears and writes: `RenderConfig::shadow_depth_bits`); the pixels it
+/// changes against the 32-bit map are counted. A width the renderer cannot make is refused.
+#[test]
+fn a_16_bit_shadow_map_draws_the_goldens() {
+    let mut full = scene();
+    let mut half = scene_with(|c| c.shadow_depth_bits = 16);
+    for name in [
+        "relief",
+        "pom",
+        "relief_grazing",
+        "tessellated",
+        "tessellated_grazing",
+    ] {
+        let a = render_golden_view(&mut full, name);
+        let b = render_golden_view(&mut half, name);
+        let (mean, p99) = flip(&a, &b);
+        let differing = a.rgba8.iter().zip(&b.rgba8).filter(|(x, y)| x != y).count();
+        eprintln!(
+            "{name}: 16-bit shadow depth against 32-bit FLIP mean {mean:.5}, p99 {p99:.5}, {differing} of {} bytes differ",
+            a.rgba8.len()
+        );
+        check(name, &b);
+    }
+    let mut config = snowprint::render::RenderConfig::new(64, 64, Tier::Relief);
+    config.shadow_depth_bits = 24;
+    let refused = match snowprint::render::Renderer::new(common::gpu(), config) {
+        Ok(_) => panic!("a 24-bit shadow map was made"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        refused.contains("shadow_depth_bits") && refused.contains("16 or 32"),
+        "{refused}"
+    );
+}
+
 /// Instances outside the view's frustum are culled from the opaque pass and change no pixel: the
 /// overview with a second ball behind the camera and one far to the side draws the overview's
 /// bytes, and reports both culled.

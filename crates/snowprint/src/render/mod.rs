@@ -201,7 +201,7 @@ impl Renderer {
             &device,
             &mesh_module,
             &layouts.shadow_layout,
-            config.shadow_map_size,
+            (config.shadow_map_size, config.shadow_depth_format()),
         );
         let frame = FrameResources::new(&device, layouts, &shadow.view, filterable);
         let snow = snow::SnowPass::new(&device, &frame.layout, filterable, config.opaque);
@@ -209,7 +209,7 @@ impl Renderer {
         let tess_surface = TessSurface::new(
             &device,
             &frame.layout,
-            &frame.shadow_layout,
+            (&frame.shadow_layout, shadow.format),
             filterable,
             snow.shade_targets_layout(),
         );

@@ -87,39 +87,43 @@ impl Raster<'_> {
     }
 }
 
-/// A depth-only pipeline drawing into one of the moon's shadow cascades: the cascade is the
-/// override constant `constant` of the vertex stage.
-pub(super) fn shadow_caster(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    buffers: &[Option<wgpu::VertexBufferLayout>],
-    constant: &str,
-) -> [wgpu::RenderPipeline; 2] {
-    [0.0, 1.0].map(|cascade| {
-        let constants = [(constant, cascade)];
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
+/// The depth-only pipelines drawing into the moon's shadow cascades, one a cascade: the cascade
+/// is the override constant `constant` of the vertex stage, the map's depth `format`.
+pub(super) struct ShadowCaster<'a> {
+    pub label: &'a str,
+    pub layout: &'a wgpu::PipelineLayout,
+    pub module: &'a wgpu::ShaderModule,
+    pub entry: &'a str,
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    pub constant: &'a str,
+    pub format: wgpu::TextureFormat,
+}
+
+impl ShadowCaster<'_> {
+    pub(super) fn build(&self, device: &wgpu::Device) -> [wgpu::RenderPipeline; 2] {
+        [0.0, 1.0].map(|cascade| {
+            let constants = [(self.constant, cascade)];
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(self.label),
+                layout: Some(self.layout),
+                vertex: wgpu::VertexState {
+                    module: self.module,
+                    entry_point: Some(self.entry),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    buffers: self.buffers,
                 },
-                buffers,
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: shadow_depth_state(),
-            multisample: wgpu::MultisampleState::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: shadow_depth_state(self.format),
+                multisample: wgpu::MultisampleState::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
         })
-    })
+    }
 }
 
 /// Render target of the scene's HDR colour, unblended.
@@ -180,8 +184,9 @@ pub(super) fn depth_state(
 
 /// Depth state of everything drawn into the moon's shadow cascades (meshes, and the tessellated
 /// tier's snow): nearest wins, biased against acne by slope.
-pub(super) fn shadow_depth_state() -> Option<wgpu::DepthStencilState> {
+pub(super) fn shadow_depth_state(format: wgpu::TextureFormat) -> Option<wgpu::DepthStencilState> {
     depth_state(wgpu::CompareFunction::Less, true).map(|d| wgpu::DepthStencilState {
+        format,
         bias: wgpu::DepthBiasState {
             constant: 2,
             slope_scale: 2.0,

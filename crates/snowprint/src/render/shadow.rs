@@ -4,7 +4,6 @@
 
 use super::meshes::{DrawSet, MeshSet};
 use super::readback::{Timestamps, render_span};
-use super::targets::DEPTH_FORMAT;
 use super::{gpu, pipeline};
 
 pub(super) struct ShadowPass {
@@ -16,6 +15,8 @@ pub(super) struct ShadowPass {
     pub cascade_views: [wgpu::TextureView; 2],
     /// Side of the shadow map, texels.
     pub size: u32,
+    /// Its depth format (`RenderConfig::shadow_depth_bits`).
+    pub format: wgpu::TextureFormat,
 }
 
 impl ShadowPass {
@@ -23,32 +24,34 @@ impl ShadowPass {
         device: &wgpu::Device,
         mesh_module: &wgpu::ShaderModule,
         shadow_layout: &wgpu::BindGroupLayout,
-        size: u32,
+        (size, format): (u32, wgpu::TextureFormat),
     ) -> Self {
         let buffers: Vec<Option<wgpu::VertexBufferLayout>> =
             gpu::mesh_vertex_layouts().into_iter().map(Some).collect();
         let layout = pipeline::layout(device, "shadow", &[shadow_layout]);
-        let pipelines = pipeline::shadow_caster(
-            device,
-            "shadow",
-            &layout,
-            mesh_module,
-            "vs_shadow",
-            &buffers,
-            "SHADOW_CASCADE",
-        );
-        let (view, cascade_views) = cascade_maps(device, size);
+        let pipelines = pipeline::ShadowCaster {
+            label: "shadow",
+            layout: &layout,
+            module: mesh_module,
+            entry: "vs_shadow",
+            buffers: &buffers,
+            constant: "SHADOW_CASCADE",
+            format,
+        }
+        .build(device);
+        let (view, cascade_views) = cascade_maps(device, size, format);
         Self {
             pipelines,
             view,
             cascade_views,
             size,
+            format,
         }
     }
 
     /// A new map of `size` texels a side in place of the old one (the pipelines stay).
     pub(super) fn resize(&mut self, device: &wgpu::Device, size: u32) {
-        (self.view, self.cascade_views) = cascade_maps(device, size);
+        (self.view, self.cascade_views) = cascade_maps(device, size, self.format);
         self.size = size;
     }
 
@@ -109,9 +112,13 @@ impl ShadowPass {
     }
 }
 
-/// The two cascades' depth map of `size` texels a side: the view that samples both and one view
-/// each to render into.
-fn cascade_maps(device: &wgpu::Device, size: u32) -> (wgpu::TextureView, [wgpu::TextureView; 2]) {
+/// The two cascades' depth map of `size` texels a side in `format`: the view that samples both
+/// and one view each to render into.
+fn cascade_maps(
+    device: &wgpu::Device,
+    size: u32,
+    format: wgpu::TextureFormat,
+) -> (wgpu::TextureView, [wgpu::TextureView; 2]) {
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("moon shadow cascades"),
         size: wgpu::Extent3d {
@@ -122,7 +129,7 @@ fn cascade_maps(device: &wgpu::Device, size: u32) -> (wgpu::TextureView, [wgpu::
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_FORMAT,
+        format,
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         view_formats: &[],
     });

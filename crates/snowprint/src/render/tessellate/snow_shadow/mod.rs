@@ -31,7 +31,7 @@ impl TessSurface {
     pub(crate) fn new(
         device: &wgpu::Device,
         frame_layout: &wgpu::BindGroupLayout,
-        shadow_layout: &wgpu::BindGroupLayout,
+        (shadow_layout, shadow_format): (&wgpu::BindGroupLayout, wgpu::TextureFormat),
         filterable: bool,
         visible_targets: Option<&wgpu::BindGroupLayout>,
     ) -> Self {
@@ -96,15 +96,16 @@ impl TessSurface {
         });
         let shadow_pipeline_layout =
             pipeline::layout(device, "snow shadow", &[shadow_layout, &layout]);
-        let shadow = pipeline::shadow_caster(
-            device,
-            "snow shadow",
-            &shadow_pipeline_layout,
-            &module,
-            "vs_tess_shadow",
-            &buffers,
-            "TESS_SHADOW_CASCADE",
-        );
+        let shadow = pipeline::ShadowCaster {
+            label: "snow shadow",
+            layout: &shadow_pipeline_layout,
+            module: &module,
+            entry: "vs_tess_shadow",
+            buffers: &buffers,
+            constant: "TESS_SHADOW_CASCADE",
+            format: shadow_format,
+        }
+        .build(device);
         Self {
             layout,
             draw,
