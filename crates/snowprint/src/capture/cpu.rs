@@ -1,5 +1,7 @@
 //! CPU reference of the capture: the same maths as `write.wgsl` (both capture paths), evaluated at every texel centre.
 //! Depth 0 is the ground, 1 the top of the frustum; 1 also means "nothing captured" (the clear value).
+//! The capture covers a surface's capture region (its texels and the apron around them,
+//! [`super::region`]): [`capture_region`] gives it whole, [`capture`] the surface's own texels.
 
 use glam::{Vec2, Vec3, Vec3Swizzles};
 
@@ -9,8 +11,24 @@ const BIG: f32 = 1e30;
 
 /// Local `(x, z)` of the centre of texel `(column, row)`.
 pub fn texel_center(column: u32, row: u32, width: u32, height: u32, half_size: Vec2) -> Vec2 {
-    // Same operations, in the same order, as `texel_center` in capture.wgsl.
+    // Same operations, in the same order, as `texel_center_of` in write.wgsl.
     let cell = Vec2::new(column as f32 + 0.5, row as f32 + 0.5);
+    -half_size + cell / Vec2::new(width as f32, height as f32) * 2.0 * half_size
+}
+
+/// Local `(x, z)` of the centre of texel `(column, row)` of the capture region of a `width x
+/// height` surface ([`super::region`]: the surface's texel `(column - 1, row - 1)`, one texel
+/// beyond its sides in the apron).
+pub fn region_texel_center(
+    column: u32,
+    row: u32,
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+) -> Vec2 {
+    // The region's cell centre less the apron, as `texel_center_of` in write.wgsl (exact in f32).
+    let apron = super::APRON as f32;
+    let cell = Vec2::new(column as f32 + 0.5 - apron, row as f32 + 0.5 - apron);
     -half_size + cell / Vec2::new(width as f32, height as f32) * 2.0 * half_size
 }
 
@@ -161,7 +179,8 @@ pub fn triangles_depth(
     lowest.map(|y| y / frustum_height)
 }
 
-/// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen.
+/// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen
+/// (its capture region without the apron: [`capture_region`]).
 pub fn capture(
     width: u32,
     height: u32,
@@ -171,6 +190,28 @@ pub fn capture(
     triangles: &[LocalTriangle],
 ) -> Vec<f32> {
     capture_on_ground(
+        width,
+        height,
+        half_size,
+        frustum_height,
+        primitives,
+        triangles,
+        None,
+    )
+}
+
+/// Reference capture of a surface's capture region ([`super::region`]: `(width + 2) x (height +
+/// 2)` depths, row-major, the surface's texels and the apron of one texel around them), what the
+/// update's blur reads ([`crate::accumulate::cpu::blur`]).
+pub fn capture_region(
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+    frustum_height: f32,
+    primitives: &[GpuPrimitive],
+    triangles: &[LocalTriangle],
+) -> Vec<f32> {
+    capture_on_ground_region(
         width,
         height,
         half_size,
@@ -210,13 +251,39 @@ pub fn capture_on_ground(
     triangles: &[LocalTriangle],
     columns: Option<&[[f32; 2]]>,
 ) -> Vec<f32> {
-    let mut out = vec![1.0f32; (width * height) as usize];
-    for row in 0..height {
-        for col in 0..width {
-            let i = (row * width + col) as usize;
-            let c = texel_center(col, row, width, height, half_size);
+    let region = capture_on_ground_region(
+        width,
+        height,
+        half_size,
+        frustum_height,
+        primitives,
+        triangles,
+        columns,
+    );
+    super::strip_apron(width, height, &region)
+}
+
+/// [`capture_region`] on a ground field: `columns` holds `[base, bare]` per texel of the surface
+/// (`width * height`; the apron's are extrapolated from them, [`crate::ground::region_columns`]),
+/// `None` for flat ground.
+pub fn capture_on_ground_region(
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+    frustum_height: f32,
+    primitives: &[GpuPrimitive],
+    triangles: &[LocalTriangle],
+    columns: Option<&[[f32; 2]]>,
+) -> Vec<f32> {
+    let columns = columns.map(|c| crate::ground::region_columns(c, width, height));
+    let (rw, rh) = super::region(width, height);
+    let mut out = vec![1.0f32; (rw * rh) as usize];
+    for row in 0..rh {
+        for col in 0..rw {
+            let i = (row * rw + col) as usize;
+            let c = region_texel_center(col, row, width, height, half_size);
             let mut d = 1.0f32;
-            let Some(columns) = columns else {
+            let Some(columns) = columns.as_deref() else {
                 for p in primitives {
                     if let Some(v) = primitive_depth(p, c.x, c.y, frustum_height) {
                         d = d.min(v);
