@@ -201,13 +201,14 @@ mod tests {
             snow_depth: 0.3,
             frustum_height: 0.55,
         };
+        // The capture covers the region: 11 x 9, the surface's texel (x, y) at (x + 1, y + 1).
         // Ground everywhere: depression 1, blurred 1.
-        let flat = vec![0.0; 63];
+        let flat = vec![0.0; 99];
         assert!(blur(&inp, &flat).iter().all(|&v| (v - 1.0).abs() < 1e-6));
         // One pressed texel in the middle: the blur keeps its mass and spreads it over the 3x3
         // neighbourhood only.
-        let mut one = vec![1.0; 63];
-        one[3 * 9 + 4] = 0.0;
+        let mut one = vec![1.0; 99];
+        one[4 * 11 + 5] = 0.0;
         let b = blur(&inp, &one);
         let total: f32 = b.iter().sum();
         assert!((total - 1.0).abs() < 1e-5, "{total}");
@@ -235,6 +236,39 @@ mod tests {
                 "({x},{y}): {} / 64, expected {w}",
                 at(x, y)
             );
+        }
+    }
+
+    /// A texel pressed one beyond the surface's edge (in the apron only) reaches the edge column
+    /// through the blur with the kernel's weights, as on one wider surface: 10/64 beside it, 3/64
+    /// on the two diagonals, nothing further in. Clamping at the edge would leave it nothing.
+    #[test]
+    fn blur_reads_the_apron_beyond_the_edge() {
+        let inp = BlurInput {
+            width: 9,
+            height: 7,
+            mode: CaptureMode::Depth,
+            mask_fraction: 1.0,
+            snow_depth: 0.3,
+            frustum_height: 0.55,
+        };
+        // Region texel (0, 4): the surface's (-1, 3), left of column 0.
+        let mut beyond = vec![1.0; 99];
+        beyond[4 * 11] = 0.0;
+        let b = blur(&inp, &beyond);
+        for y in 0..7 {
+            for x in 0..9 {
+                let expected = match (x, y) {
+                    (0, 3) => 10.0,
+                    (0, 2) | (0, 4) => 3.0,
+                    _ => 0.0,
+                };
+                let got = b[y * 9 + x] * 64.0;
+                assert!(
+                    (got - expected).abs() < 1e-4,
+                    "({x},{y}): {got} / 64, expected {expected}"
+                );
+            }
         }
     }
 

@@ -238,10 +238,10 @@ proptest! {
         if raster {
             s.capture_path = capture::CapturePath::Raster;
         }
-        // The world caps heightmaps at the atlas side.
+        // The world caps heightmaps at the atlas side less the capture's apron.
         let mut input = inputs(&descs, &deformers, 0.1);
         for p in &mut input {
-            p.layout = SurfaceLayout::for_size_capped(p.desc.size, atlas_side);
+            p.layout = SurfaceLayout::for_size_capped(p.desc.size, atlas_side - 2 * capture::APRON);
         }
         let plan = FramePlan::build(&s, input, no_meshes);
         let c = &plan.capture;
