@@ -955,7 +955,10 @@ fn a_level_on_hills_moves_its_ground_as_laying_it_whole_would() {
         );
         bare += moved.columns.iter().filter(|c| c[1] == DEPTH).count();
         if by == [2, 0] || by == [-2, 0] {
-            let field_bytes = texels[0] as u64 * texels[1] as u64 * (8 + 4);
+            // The field's columns (8 bytes a texel) and its capture codes (4 bytes a texel of
+            // its capture region, the level and the apron of a texel around it).
+            let field_bytes = texels[0] as u64 * texels[1] as u64 * 8
+                + (texels[0] as u64 + 2) * (texels[1] as u64 + 2) * 4;
             assert_eq!(a.ground_bytes_written() - written, field_bytes);
         }
     }

@@ -264,8 +264,8 @@ pub fn capture_on_ground(
 }
 
 /// [`capture_region`] on a ground field: `columns` holds `[base, bare]` per texel of the surface
-/// (`width * height`; the apron's are extrapolated from them, [`crate::ground::region_columns`]),
-/// `None` for flat ground.
+/// (`width * height`; the apron's are extrapolated from them, [`apron_columns`]), `None` for flat
+/// ground.
 pub fn capture_on_ground_region(
     width: u32,
     height: u32,
@@ -275,7 +275,7 @@ pub fn capture_on_ground_region(
     triangles: &[LocalTriangle],
     columns: Option<&[[f32; 2]]>,
 ) -> Vec<f32> {
-    let columns = columns.map(|c| crate::ground::region_columns(c, width, height));
+    let columns = columns.map(|c| apron_columns(c, width, height));
     let (rw, rh) = super::region(width, height);
     let mut out = vec![1.0f32; (rw * rh) as usize];
     for row in 0..rh {
@@ -311,6 +311,44 @@ pub fn capture_on_ground_region(
                 d = d.min(v);
             }
             out[i] = d;
+        }
+    }
+    out
+}
+
+/// The `[base, bare]` columns of a surface's capture region from its own `width * height`: the
+/// apron's ground one texel beyond each side, extrapolated linearly from the two texels at that
+/// side (`2 a - b`, along x first, then along z, from the x-extended rows), the bare depth kept at
+/// 0 or more; a side of one texel repeats it. Written on its own from `ground_of` in `write.wgsl`
+/// (and `GroundField::region_columns`, which lays the ground's capture codes out the same way).
+pub fn apron_columns(columns: &[[f32; 2]], width: u32, height: u32) -> Vec<[f32; 2]> {
+    let (w, h) = (width as usize, height as usize);
+    let beyond = |p: f32, q: f32| 2.0 * p - q;
+    // One line of a field extended by a texel at both ends.
+    let extend = |line: &[[f32; 2]]| -> Vec<[f32; 2]> {
+        let n = line.len();
+        let (first, last) = if n > 1 {
+            (
+                [beyond(line[0][0], line[1][0]), beyond(line[0][1], line[1][1])],
+                [
+                    beyond(line[n - 1][0], line[n - 2][0]),
+                    beyond(line[n - 1][1], line[n - 2][1]),
+                ],
+            )
+        } else {
+            (line[0], line[0])
+        };
+        std::iter::once(first)
+            .chain(line.iter().copied())
+            .chain(std::iter::once(last))
+            .collect()
+    };
+    let rows: Vec<Vec<[f32; 2]>> = columns.chunks(w).take(h).map(extend).collect();
+    let mut out = vec![[0.0f32; 2]; (w + 2) * (h + 2)];
+    for x in 0..w + 2 {
+        let column: Vec<[f32; 2]> = rows.iter().map(|r| r[x]).collect();
+        for (y, c) in extend(&column).into_iter().enumerate() {
+            out[y * (w + 2) + x] = [c[0], c[1].max(0.0)];
         }
     }
     out
@@ -401,6 +439,45 @@ mod tests {
             (lo - (1.0 - s)).abs() < 1e-5 && (hi - (1.0 + s)).abs() < 1e-5,
             "{lo} {hi}"
         );
+    }
+
+    /// The apron's ground on a plane is the plane one texel beyond (to rounding), the bare depth
+    /// held; the production layout of the ground's codes (`GroundField::region_columns`) extends
+    /// a field as this reference does, bit for bit, on a plane and on a bumpy field.
+    #[test]
+    fn the_apron_extends_a_plane_and_matches_the_ground_codes_layout() {
+        let (w, h) = (5u32, 4u32);
+        let plane = |x: f32, y: f32| [0.3 * x - 0.2 * y, 0.05];
+        let bumpy = |x: f32, y: f32| [(x * 1.3).sin() + (y * 0.7).cos(), 0.04 * (x + y).sin().abs()];
+        for f in [plane, bumpy] {
+            let columns: Vec<[f32; 2]> = (0..h)
+                .flat_map(|y| (0..w).map(move |x| f(x as f32, y as f32)))
+                .collect();
+            let ours = apron_columns(&columns, w, h);
+            let field = crate::GroundField {
+                width: w,
+                height: h,
+                ground: vec![0.0; (w * h) as usize],
+                columns: columns.clone(),
+            };
+            let bits = |v: &[[f32; 2]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&ours), bits(&field.region_columns()));
+            assert_eq!(crate::capture::strip_apron(w, h, &ours), columns);
+        }
+        let columns: Vec<[f32; 2]> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| plane(x as f32, y as f32)))
+            .collect();
+        let ours = apron_columns(&columns, w, h);
+        for y in 0..h + 2 {
+            for x in 0..w + 2 {
+                let want = plane(x as f32 - 1.0, y as f32 - 1.0);
+                let got = ours[(y * (w + 2) + x) as usize];
+                assert!(
+                    (got[0] - want[0]).abs() < 1e-6 && (got[1] - want[1]).abs() < 1e-6,
+                    "({x}, {y}): {got:?} against {want:?}"
+                );
+            }
+        }
     }
 
     #[test]

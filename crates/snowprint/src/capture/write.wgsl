@@ -47,7 +47,7 @@ fn region_of(v: CaptureView) -> vec2<u32> {
 // The ground field's column (base, bare) at logical texel `x` of row `y` (within the field),
 // extended past the field's side by linear extrapolation from the two texels there (exact on a
 // plane; the edge texel's own value on a field one texel wide). `2 a - b` rounds once whether or
-// not it is fused, as the CPU's (`GroundField::apron_column`).
+// not it is fused, as the CPU's (`GroundField::region_columns`).
 fn ground_row(v: CaptureView, x: i32, y: u32) -> vec2<f32> {
     let w = i32(v.texels.x);
     let n = u32(w);

@@ -341,8 +341,8 @@ impl GroundField {
 /// so its bare depth; on curved ground off by the curvature over a texel). The same maths as
 /// `ground_of` in `capture/write.wgsl`, operation for operation (`2 a - b` rounds once, fused or
 /// not); a field one texel wide or high repeats its edge.
-pub fn region_columns(columns: &[[f32; 2]], width: u32, height: u32) -> Vec<[f32; 2]> {
-    let a = crate::capture::APRON as i32;
+fn region_columns(columns: &[[f32; 2]], width: u32, height: u32) -> Vec<[f32; 2]> {
+    let a = crate::wgsl::consts::APRON as i32;
     let (w, h) = (width as i32, height as i32);
     let at = |x: i32, y: i32| columns[(y * w + x) as usize];
     let ext = |p: [f32; 2], q: [f32; 2]| [2.0 * p[0] - q[0], 2.0 * p[1] - q[1]];

@@ -126,7 +126,7 @@ pub struct PlanGround {
     pub offset: u32,
     /// First of its capture codes in the ground codes buffer, one per texel of the surface's
     /// capture region ([`capture::region`]: the apron's ground extrapolated,
-    /// [`GroundField::apron_column`]).
+    /// [`GroundField::region_columns`]).
     pub codes: u32,
     /// The lowest base and the highest ground of the field, local metres
     /// ([`crate::GroundField::range`]).
