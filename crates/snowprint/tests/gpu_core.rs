@@ -1021,7 +1021,10 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
             let stats = fused.step(0.1, d).unwrap();
             separate.step(0.1, d).unwrap();
             assert_eq!(stats.updated, 1);
-            let capture = fused.read_last_capture_region(a).unwrap().expect("captured");
+            let capture = fused
+                .read_last_capture_region(a)
+                .unwrap()
+                .expect("captured");
             let inp = blur_input(&desc, CaptureMode::Depth);
             // rate x 0.1 s x channel_max a frame, the fraction carried.
             let per_frame = rate as f64 * 0.1 * precision.channel_max() as f64;

@@ -4,7 +4,8 @@
 //! presses only the right surface's edge column (nothing of the left surface's own texels): on
 //! both capture paths the GPU gives the CPU reference's heights, and both give, texel for texel,
 //! what the one wider surface holds, the line's columns included; on flat ground and on a 45
-//! degree plane (whose apron's ground is extrapolated from the field, exact on a plane).
+//! degree plane (whose apron's ground is extrapolated from the field, exact on a plane). Under
+//! the manager, a print pressing only the right surface's edge is queued on the left one too.
 
 mod common;
 
@@ -69,7 +70,11 @@ fn held(slope: f32) -> f32 {
 
 /// A ball of `radius` at world (x, z), its bottom `press` below the snow top there.
 fn ball(x: f32, z: f32, radius: f32, press: f32, slope: f32) -> Pose {
-    Pose::at([x, 1.0 + ground_at(x, slope) + held(slope) - press + radius, z])
+    Pose::at([
+        x,
+        1.0 + ground_at(x, slope) + held(slope) - press + radius,
+        z,
+    ])
 }
 
 /// Frame `f`'s deformers: a ball straddling the line, moving along z, and a small ball over the
@@ -187,7 +192,12 @@ fn run(path: CapturePath, slope: f32) {
     let (mut two, mut one) = (world(path), world(path));
     let mut left = Tracked::new(&mut two, surface("left", 0.0, LEFT), LEFT, slope);
     let mut right = Tracked::new(&mut two, surface("right", LINE, RIGHT), RIGHT, slope);
-    let mut wide = Tracked::new(&mut one, surface("one", 0.0, LEFT + RIGHT), LEFT + RIGHT, slope);
+    let mut wide = Tracked::new(
+        &mut one,
+        surface("one", 0.0, LEFT + RIGHT),
+        LEFT + RIGHT,
+        slope,
+    );
     let size = |w: &SnowWorld, t: &Tracked| {
         let l = w.layout(t.id).unwrap();
         (l.width, l.height)
@@ -213,22 +223,41 @@ fn run(path: CapturePath, slope: f32) {
             ("right", &gr, &right, RIGHT),
             ("one", &gw, &wide, LEFT + RIGHT),
         ] {
-            for (channel, a, b) in [("depression", &g.0, &t.cpu.0), ("displaced", &g.1, &t.cpu.1)]
-            {
+            for (channel, a, b) in [
+                ("depression", &g.0, &t.cpu.0),
+                ("displaced", &g.1, &t.cpu.1),
+            ] {
                 let (d, texel) = worst(a, b, columns);
                 assert!(
                     d <= 1,
                     "{}",
-                    at(&format!("{name}'s {channel} is {d} from the CPU's at {texel:?}"), f)
+                    at(
+                        &format!("{name}'s {channel} is {d} from the CPU's at {texel:?}"),
+                        f
+                    )
                 );
             }
         }
         // The two against the one, on the GPU and on the CPU.
         let columns = LEFT + RIGHT;
         let (d, texel) = worst(&joined(&gl.0, &gr.0), &gw.0, columns);
-        assert!(d <= 1, "{}", at(&format!("the GPU's two differ from the one by {d} at {texel:?}"), f));
+        assert!(
+            d <= 1,
+            "{}",
+            at(
+                &format!("the GPU's two differ from the one by {d} at {texel:?}"),
+                f
+            )
+        );
         let (d, texel) = worst(&joined(&left.cpu.0, &right.cpu.0), &wide.cpu.0, columns);
-        assert!(d <= 1, "{}", at(&format!("the CPU's two differ from the one by {d} at {texel:?}"), f));
+        assert!(
+            d <= 1,
+            "{}",
+            at(
+                &format!("the CPU's two differ from the one by {d} at {texel:?}"),
+                f
+            )
+        );
         // The small ball pressed the right surface's first column only, yet the left surface's
         // last column took its share through the blur (10/64 of it beside it), as on the one.
         let row = (16 + f) as usize;
@@ -240,7 +269,14 @@ fn run(path: CapturePath, slope: f32) {
         assert!(
             pressed.abs_diff(units(12.0)) <= 1 && beside.abs_diff(units(10.0)) <= 1,
             "{}",
-            at(&format!("the edge ball left {pressed} and {beside} beside it, by hand {} and {}", units(12.0), units(10.0)), f)
+            at(
+                &format!(
+                    "the edge ball left {pressed} and {beside} beside it, by hand {} and {}",
+                    units(12.0),
+                    units(10.0)
+                ),
+                f
+            )
         );
         println!(
             "{path:?}, slope {slope}, frame {f}: edge column {pressed}, the left surface's column beside it {beside} (the one surface: {})",
@@ -261,6 +297,55 @@ fn two_surfaces_on_one_plane_update_as_the_one_surface_over_both() {
     for path in [CapturePath::Raster, CapturePath::Compute] {
         run(path, 1.0);
     }
+}
+
+/// Under the surface manager a ball over the right surface's first column, its bounds clear of
+/// the left surface's rectangle (1.5 cm across, 2.5 cm past the line), is queued on the left
+/// surface too (its touch volume is its capture region): flushed, both heightmaps are what a plain
+/// world leaves, the left surface's last column holding its share through the blur.
+#[test]
+fn the_manager_queues_an_edge_print_on_the_neighbour_too() {
+    use snowprint::manager::{ManagedDeformer, ManagerConfig, SnowManager, ZoneId};
+    let mut m = SnowManager::new(common::gpu(), ManagerConfig::default()).unwrap();
+    let mut plain = world(CapturePath::Auto);
+    let mut ids = Vec::new();
+    for (name, from, columns) in [("left", 0.0, LEFT), ("right", LINE, RIGHT)] {
+        let d = surface(name, from, columns);
+        ids.push((
+            m.add_surface(d.clone(), ZoneId(0)).unwrap(),
+            plain.add_surface(d).unwrap(),
+        ));
+    }
+    let row = -(ROWS as f32) * TEXEL * 0.5 + 16.5 * TEXEL;
+    let edge_ball = Deformer::new(
+        Shape::Sphere { radius: 0.015 },
+        ball(LINE + 0.025, row, 0.015, 0.15, 0.0),
+    );
+    m.tick(1.0 / 30.0, None, &[ManagedDeformer::new(edge_ball)])
+        .unwrap();
+    m.flush().unwrap();
+    plain.step(1.0 / 30.0, &[edge_ball]).unwrap();
+    for (&(managed, world_id), name) in ids.iter().zip(["left", "right"]) {
+        let (a, b) = (
+            m.read_heightmap(managed).unwrap(),
+            plain.read_heightmap(world_id).unwrap(),
+        );
+        let differ = (a.depression.iter().zip(&b.depression))
+            .chain(a.displaced.iter().zip(&b.displaced))
+            .filter(|(x, y)| x != y)
+            .count();
+        assert_eq!(
+            differ, 0,
+            "the managed {name} surface differs from the plain world's"
+        );
+    }
+    let left = m.read_heightmap(ids[0].0).unwrap();
+    let beside = left.depression[16 * LEFT as usize + LEFT as usize - 1];
+    // About 10/64 of half the depth (5,120 units) less the ball's curve 5 mm off the centre.
+    assert!(
+        (5000..=5120).contains(&beside),
+        "the left surface's last column holds {beside}"
+    );
 }
 
 /// The largest heightmap a world allows is the atlas side less the apron, so that its capture

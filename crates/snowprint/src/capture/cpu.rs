@@ -329,7 +329,10 @@ pub fn apron_columns(columns: &[[f32; 2]], width: u32, height: u32) -> Vec<[f32;
         let n = line.len();
         let (first, last) = if n > 1 {
             (
-                [beyond(line[0][0], line[1][0]), beyond(line[0][1], line[1][1])],
+                [
+                    beyond(line[0][0], line[1][0]),
+                    beyond(line[0][1], line[1][1]),
+                ],
                 [
                     beyond(line[n - 1][0], line[n - 2][0]),
                     beyond(line[n - 1][1], line[n - 2][1]),
@@ -448,7 +451,12 @@ mod tests {
     fn the_apron_extends_a_plane_and_matches_the_ground_codes_layout() {
         let (w, h) = (5u32, 4u32);
         let plane = |x: f32, y: f32| [0.3 * x - 0.2 * y, 0.05];
-        let bumpy = |x: f32, y: f32| [(x * 1.3).sin() + (y * 0.7).cos(), 0.04 * (x + y).sin().abs()];
+        let bumpy = |x: f32, y: f32| {
+            [
+                (x * 1.3).sin() + (y * 0.7).cos(),
+                0.04 * (x + y).sin().abs(),
+            ]
+        };
         for f in [plane, bumpy] {
             let columns: Vec<[f32; 2]> = (0..h)
                 .flat_map(|y| (0..w).map(move |x| f(x as f32, y as f32)))

@@ -110,10 +110,18 @@ impl SnowWorld {
             return Ok(None);
         };
         let texels = capture::region_texels(r.width, r.height);
-        let bytes = self.download(&self.capture.buffer, r.scratch as u64 * 4, texels as u64 * 4)?;
+        let bytes = self.download(
+            &self.capture.buffer,
+            r.scratch as u64 * 4,
+            texels as u64 * 4,
+        )?;
         // The winding buffer holds this surface's texels only when meshes were drawn over it.
         let winding = if r.mode & crate::pool::MODE_MESHES != 0 {
-            self.download(&self.winding.buffer, r.scratch as u64 * 4, texels as u64 * 4)?
+            self.download(
+                &self.winding.buffer,
+                r.scratch as u64 * 4,
+                texels as u64 * 4,
+            )?
         } else {
             vec![0; texels as usize * 4]
         };

@@ -90,7 +90,11 @@ fn surface(i: usize, (c, size, yaw, depth): SurfaceSeed) -> SurfaceDesc {
 fn volume(desc: &SurfaceDesc) -> CaptureVolume {
     CaptureVolume {
         world_to_local: desc.world_to_local(),
-        half_size: CaptureVolume::of_region(desc.size * 0.5, desc.layout().width, desc.layout().height),
+        half_size: CaptureVolume::of_region(
+            desc.size * 0.5,
+            desc.layout().width,
+            desc.layout().height,
+        ),
         frustum_height: desc.snow_depth + WorldConfig::default().capture.ankle_height,
         ground: (0.0, 0.0),
     }
