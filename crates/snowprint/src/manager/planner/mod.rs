@@ -232,7 +232,7 @@ impl Planner {
         let top = desc.snow_depth + self.config.capture.ankle_height;
         // The surface's capture region, grown by the apron: a deformer that presses only a
         // neighbour's edge column reaches this surface's blur too, and is queued here.
-        let half = region_half(&desc);
+        let half = region_half(desc);
         let rot = desc.rotation();
         let ext = (rot * Vec3::new(half.x, 0.0, half.y))
             .abs()
