@@ -4,7 +4,9 @@
 //! shared depth atlas, looking up from the ground. The frustum runs from the ground (depth 0) to the
 //! snow top plus an ankle height (depth 1); the depth test keeps the lowest point of any deformer per
 //! texel, the talk's minimum-height field. Surfaces are packed into the atlas so that one render pass
-//! captures many of them, each in its own viewport.
+//! captures many of them, each in its own viewport. What is captured is a surface's capture
+//! [`region`]: its texels and an apron of one texel beyond each side, which the update's blur
+//! reads, so that two surfaces on one texel grid update the line where they meet as one would.
 //!
 //! Analytic deformers (spheres, capsules, boxes) are drawn as one bounding rectangle each and
 //! ray-cast exactly in the fragment shader; a moving sphere is swept into a capsule, other shapes
