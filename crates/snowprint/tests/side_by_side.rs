@@ -3,7 +3,8 @@
 //! the line reads the same field on either side. A ball straddles the line and a small one
 //! presses only the right surface's edge column (nothing of the left surface's own texels): on
 //! both capture paths the GPU gives the CPU reference's heights, and both give, texel for texel,
-//! what the one wider surface holds, the line's columns included; on flat ground and on a 45
+//! what the one wider surface holds, the line's columns included, whether the update runs over its
+//! grid, over the capture's tile list or as separate passes; on flat ground and on a 45
 //! degree plane (whose apron's ground is extrapolated from the field, exact on a plane). Under
 //! the manager, a print pressing only the right surface's edge is queued on the left one too.
 
@@ -13,8 +14,8 @@ use snowprint::low_level::capture::{self, CaptureVolume};
 use snowprint::reference::accumulate::{self as acc_cpu, BlurInput};
 use snowprint::reference::capture as cap_cpu;
 use snowprint::{
-    CaptureMode, CapturePath, Deformer, Ground, HeightGrid, PoolFormat, Pose, Precision, Shape,
-    SlopeRule, SnowWorld, SurfaceDesc, SurfaceId, WorldConfig,
+    CaptureMode, CapturePath, Deformer, Ground, HeightGrid, PassMode, PoolFormat, Pose, Precision,
+    Shape, SlopeRule, SnowWorld, SurfaceDesc, SurfaceId, WorldConfig,
 };
 
 const DEPTH: f32 = 0.3;
@@ -27,10 +28,27 @@ const ROWS: u32 = 24;
 /// World x of the line where the two meet.
 const LINE: f32 = LEFT as f32 * TEXEL;
 
-fn world(path: CapturePath) -> SnowWorld {
+/// How the update runs: the fused pass over its grid (tiles the capture did not flag skipped),
+/// over the capture's tile list, or blur and merge as separate passes.
+#[derive(Clone, Copy, Debug)]
+enum Update {
+    Grid,
+    Listed,
+    Separate,
+}
+
+fn world(path: CapturePath, update: Update) -> SnowWorld {
     let config = WorldConfig {
         capture_path: path,
         format: PoolFormat::new(Precision::Bits16),
+        passes: match update {
+            Update::Separate => PassMode::Separate,
+            _ => PassMode::Fused,
+        },
+        list_tiles_from: match update {
+            Update::Listed => 0,
+            _ => u32::MAX,
+        },
         ..WorldConfig::default()
     };
     SnowWorld::new(common::gpu(), config).expect("world")
@@ -188,8 +206,8 @@ fn worst(a: &[u32], b: &[u32], columns: u32) -> (u32, (u32, u32)) {
         .unwrap_or((0, (0, 0)))
 }
 
-fn run(path: CapturePath, slope: f32) {
-    let (mut two, mut one) = (world(path), world(path));
+fn run(path: CapturePath, update: Update, slope: f32) {
+    let (mut two, mut one) = (world(path, update), world(path, update));
     let mut left = Tracked::new(&mut two, surface("left", 0.0, LEFT), LEFT, slope);
     let mut right = Tracked::new(&mut two, surface("right", LINE, RIGHT), RIGHT, slope);
     let mut wide = Tracked::new(
@@ -207,7 +225,7 @@ fn run(path: CapturePath, slope: f32) {
         [(LEFT, ROWS), (RIGHT, ROWS), (LEFT + RIGHT, ROWS)],
         "the surfaces lie on one grid of {TEXEL} m texels"
     );
-    let at = |what: &str, f: u32| format!("{path:?}, slope {slope}, frame {f}: {what}");
+    let at = |what: &str, f: u32| format!("{path:?}, {update:?}, slope {slope}, frame {f}: {what}");
     for f in 0..3 {
         let ds = deformers(f, slope);
         two.step(1.0 / 30.0, &ds).unwrap();
@@ -279,7 +297,7 @@ fn run(path: CapturePath, slope: f32) {
             )
         );
         println!(
-            "{path:?}, slope {slope}, frame {f}: edge column {pressed}, the left surface's column beside it {beside} (the one surface: {})",
+            "{path:?}, {update:?}, slope {slope}, frame {f}: edge column {pressed}, the left surface's column beside it {beside} (the one surface: {})",
             gw.0[row * columns as usize + LEFT as usize - 1]
         );
     }
@@ -288,14 +306,16 @@ fn run(path: CapturePath, slope: f32) {
 #[test]
 fn two_surfaces_on_one_grid_update_as_the_one_surface_over_both_on_both_capture_paths() {
     for path in [CapturePath::Raster, CapturePath::Compute] {
-        run(path, 0.0);
+        for update in [Update::Grid, Update::Listed, Update::Separate] {
+            run(path, update, 0.0);
+        }
     }
 }
 
 #[test]
 fn two_surfaces_on_one_plane_update_as_the_one_surface_over_both() {
     for path in [CapturePath::Raster, CapturePath::Compute] {
-        run(path, 1.0);
+        run(path, Update::Listed, 1.0);
     }
 }
 
@@ -307,7 +327,7 @@ fn two_surfaces_on_one_plane_update_as_the_one_surface_over_both() {
 fn the_manager_queues_an_edge_print_on_the_neighbour_too() {
     use snowprint::manager::{ManagedDeformer, ManagerConfig, SnowManager, ZoneId};
     let mut m = SnowManager::new(common::gpu(), ManagerConfig::default()).unwrap();
-    let mut plain = world(CapturePath::Auto);
+    let mut plain = world(CapturePath::Auto, Update::Grid);
     let mut ids = Vec::new();
     for (name, from, columns) in [("left", 0.0, LEFT), ("right", LINE, RIGHT)] {
         let d = surface(name, from, columns);
