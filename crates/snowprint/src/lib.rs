@@ -110,9 +110,11 @@ pub use world::{
 /// CPU references of the GPU passes: the same maths on the same inputs and layouts, written for
 /// clarity, against which the tests compare the GPU's results texel by texel.
 pub mod reference {
-    /// The capture's ray cast from below: depth of capsules, boxes and triangle meshes per texel.
+    /// The capture's ray cast from below: depth of capsules, boxes and triangle meshes per texel,
+    /// over a surface's capture region (its texels and the apron around them).
     pub mod capture {
         pub use crate::capture::cpu::*;
+        pub use crate::capture::{APRON, region, strip_apron};
     }
     /// The accumulation: blur, merge into the history, normals (also what the fused pass computes).
     pub mod accumulate {
@@ -163,11 +165,12 @@ pub mod low_level {
     /// The capture pass: pipelines, primitives, atlas packing and `encode`.
     pub mod capture {
         pub use crate::capture::{
-            ATLAS_FORMAT, AtlasPlacement, CaptureBuffers, CaptureMesh, CapturePipelines,
+            APRON, ATLAS_FORMAT, AtlasPlacement, CaptureBuffers, CaptureMesh, CapturePipelines,
             CapturePlan, CaptureView, CaptureVolume, CapturedSurface, GpuPrimitive,
             MAX_MESH_SUBSTEPS, MAX_SUBSTEPS, MESH_STEP, MeshDraw, NO_LIST, ONE_BITS, PRIM_BOX,
             PRIM_CAPSULE, decode_depth, encode, encode_depth, mesh_substeps, pack_atlas,
-            pack_atlas_compact, push_mesh_draws, push_primitives, substeps,
+            pack_atlas_compact, push_mesh_draws, push_primitives, region, region_texels,
+            strip_apron, substeps,
         };
     }
     /// The relaxation pass: its records, plan, pipelines and `encode`.

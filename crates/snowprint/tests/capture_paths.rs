@@ -3,7 +3,8 @@
 //! its viewport of the atlas, each primitive a rectangle of fragments). Random worlds of yawed
 //! surfaces, some on hills, pressed by moving spheres, capsules and boxes, are run through both,
 //! with the update dispatched over its grid and over the capture's list of tiles; every frame's
-//! capture of every surface is compared texel by texel, and the heightmaps at the end.
+//! capture of every surface's region (its texels and the apron around them) is compared texel by
+//! texel, and the heightmaps at the end.
 
 mod common;
 
@@ -130,8 +131,8 @@ fn compare(listed: bool, spots: &[Spot], per: u32, seed: f32) -> Compared {
             w.step(1.0 / 30.0, &ds).unwrap();
         }
         for (i, d) in descs.iter().enumerate() {
-            let raster = worlds[0].read_last_capture(ids[0][i]).unwrap();
-            let compute = worlds[1].read_last_capture(ids[1][i]).unwrap();
+            let raster = worlds[0].read_last_capture_region(ids[0][i]).unwrap();
+            let compute = worlds[1].read_last_capture_region(ids[1][i]).unwrap();
             let (Some(raster), Some(compute)) = (raster, compute) else {
                 assert_eq!(
                     worlds[0].read_last_capture(ids[0][i]).unwrap().is_some(),
@@ -167,11 +168,12 @@ fn compare(listed: bool, spots: &[Spot], per: u32, seed: f32) -> Compared {
     out
 }
 
-/// The CPU reference's capture of a flat surface pressed by `deformers`.
+/// The CPU reference's capture of a flat surface's region pressed by `deformers`.
 fn cpu_capture(d: &SurfaceDesc, deformers: &[Deformer]) -> Vec<f32> {
+    let l = d.layout();
     let volume = CaptureVolume {
         world_to_local: d.world_to_local(),
-        half_size: d.size * 0.5,
+        half_size: CaptureVolume::of_region(d.size * 0.5, l.width, l.height),
         frustum_height: d.snow_depth + 0.25,
         ground: (0.0, 0.0),
     };
@@ -179,11 +181,10 @@ fn cpu_capture(d: &SurfaceDesc, deformers: &[Deformer]) -> Vec<f32> {
     for x in deformers {
         capture::push_primitives(x, &volume, &mut prims);
     }
-    let l = d.layout();
-    cap_cpu::capture(
+    cap_cpu::capture_region(
         l.width,
         l.height,
-        volume.half_size,
+        d.size * 0.5,
         volume.frustum_height,
         &prims,
         &[],

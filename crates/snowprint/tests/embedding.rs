@@ -532,7 +532,8 @@ fn an_abandoned_frame_keeps_no_replenishment() {
 
 /// An engine's device made with `required_limits` binds 128 MiB a storage buffer: a frame that
 /// would capture 129 surfaces of 512^2 whole at once (a slab pressed over each) needs 4 bytes a
-/// texel of capture, 135.3 MB. The step is refused in one sentence naming the buffer, its bytes
+/// texel of capture over each surface's capture region (its texels and the apron of one around
+/// them: 514^2), 136.3 MB. The step is refused in one sentence naming the buffer, its bytes
 /// and the limit (wgpu would panic binding it), nothing changes, and fewer surfaces a frame, as
 /// the sentence says, are pressed.
 #[test]
@@ -579,7 +580,7 @@ fn a_frame_larger_than_the_device_binds_is_refused_and_can_be_split() {
                 bytes,
                 max: m,
                 surfaces,
-            } if bytes == n as u64 * 4 * 512 * 512 && m == max && surfaces == n
+            } if bytes == n as u64 * 4 * 514 * 514 && m == max && surfaces == n
         ),
         "{e}"
     );

@@ -216,7 +216,10 @@ fn every_stage_matches_its_cpu_reference() {
             // Stage 1.
             let inp = blur_input(&desc, CaptureMode::Depth);
             let gpu_blur = w.read_last_blurred(id).unwrap().unwrap();
-            let cpu_blur = acc_cpu::blur(&inp, &gpu_cap);
+            // The blur reads the capture's apron too: the GPU's region, the surface's texels and
+            // one around them.
+            let gpu_region = w.read_last_capture_region(id).unwrap().unwrap();
+            let cpu_blur = acc_cpu::blur(&inp, &gpu_region);
             for (g, c) in gpu_blur.iter().zip(&cpu_blur) {
                 assert!((g - c).abs() < 1e-5, "blur {g} vs {c}");
             }
@@ -1018,7 +1021,10 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
             let stats = fused.step(0.1, d).unwrap();
             separate.step(0.1, d).unwrap();
             assert_eq!(stats.updated, 1);
-            let capture = fused.read_last_capture(a).unwrap().expect("captured");
+            let capture = fused
+                .read_last_capture_region(a)
+                .unwrap()
+                .expect("captured");
             let inp = blur_input(&desc, CaptureMode::Depth);
             // rate x 0.1 s x channel_max a frame, the fraction carried.
             let per_frame = rate as f64 * 0.1 * precision.channel_max() as f64;

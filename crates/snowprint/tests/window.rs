@@ -568,10 +568,9 @@ mod render {
     /// edge's layers run on across the meeting line. (The outline of the snow against the sky is
     /// rasterised from other triangles, so a pixel on it may flip: in the tessellated tier on
     /// lavapipe, in both on an H100. Only pixels inside a smooth region of the one surface's image
-    /// count.) A walk across the line
-    /// leaves in each, texel for texel, what the one surface holds, within a unit, but for the
-    /// two columns along the line: there each blurs only its own texels (the update reads no
-    /// neighbour; `docs/RENDERING.md`, "Side by side", says what that leaves visible).
+    /// count.) A walk across the line leaves in each, texel for texel, what the one surface holds,
+    /// within a unit, the two columns along the line included: each surface's capture covers an
+    /// apron of one texel beyond its sides, so both blur what the one surface blurs there.
     #[test]
     fn a_window_and_a_surface_beside_it_meet_without_a_seam() {
         let (mut a, mut b) = (world(Precision::Bits16), world(Precision::Bits16));
@@ -648,6 +647,7 @@ mod render {
         );
         assert!(pressed > 100, "the walk pressed only {pressed} texels");
         assert!(inside <= 1, "off the line: {inside}");
+        assert!(edge <= 1, "on the line: {edge}");
         for tier in [Tier::Relief, Tier::Tessellated] {
             let two = shoot(&a, &[level, roof], tier, camera, size);
             save(&format!("beside_trodden_{tier:?}.png"), &two, size);
@@ -955,7 +955,10 @@ fn a_level_on_hills_moves_its_ground_as_laying_it_whole_would() {
         );
         bare += moved.columns.iter().filter(|c| c[1] == DEPTH).count();
         if by == [2, 0] || by == [-2, 0] {
-            let field_bytes = texels[0] as u64 * texels[1] as u64 * (8 + 4);
+            // The field's columns (8 bytes a texel) and its capture codes (4 bytes a texel of
+            // its capture region, the level and the apron of a texel around it).
+            let field_bytes = texels[0] as u64 * texels[1] as u64 * 8
+                + (texels[0] as u64 + 2) * (texels[1] as u64 + 2) * 4;
             assert_eq!(a.ground_bytes_written() - written, field_bytes);
         }
     }

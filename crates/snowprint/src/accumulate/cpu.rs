@@ -24,10 +24,23 @@ pub struct BlurInput {
     pub frustum_height: f32,
 }
 
-fn depression(inp: &BlurInput, capture: &[f32], x: i32, y: i32) -> f32 {
-    let cx = x.clamp(0, inp.width as i32 - 1) as usize;
-    let cy = y.clamp(0, inp.height as i32 - 1) as usize;
-    let z = capture[cy * inp.width as usize + cx];
+/// Depression of the surface's texel `(x, y)` from a capture of its region (its texels and the
+/// apron around them, [`crate::capture::region`]): `x` in `-1..=width`, `y` in `-1..=height`.
+fn depression(inp: &BlurInput, region: &[f32], x: i32, y: i32) -> f32 {
+    let a = crate::capture::APRON as i32;
+    let (rw, rh) = crate::capture::region(inp.width, inp.height);
+    assert!(
+        (-a..rw as i32 - a).contains(&x) && (-a..rh as i32 - a).contains(&y),
+        "texel ({x}, {y}) is beyond the apron of a {} x {} surface",
+        inp.width,
+        inp.height
+    );
+    let z = region[((y + a) as u32 * rw + (x + a) as u32) as usize];
+    depression_at(inp, z)
+}
+
+/// Depression of a captured depth `z` (1 = nothing).
+fn depression_at(inp: &BlurInput, z: f32) -> f32 {
     if inp.mode == CaptureMode::Mask {
         return if z < 1.0 { inp.mask_fraction } else { 0.0 };
     }
@@ -50,9 +63,17 @@ fn bilinear(inp: &BlurInput, capture: &[f32], px: f32, py: f32) -> f32 {
 }
 
 /// Stage 1: depression of a capture (depths, 1 = nothing) blurred by the 4-tap bilinear Poisson
-/// kernel.
+/// kernel, `width x height` of it. `capture` covers the surface's capture region
+/// ([`crate::capture::region`]: `(width + 2) x (height + 2)`, the apron of one texel around the
+/// surface, [`crate::capture::cpu::capture_region`]), so that the blur of an edge texel reads the
+/// capture one texel beyond the surface rather than the edge again.
 pub fn blur(inp: &BlurInput, capture: &[f32]) -> Vec<f32> {
-    let mut out = Vec::with_capacity(capture.len());
+    assert_eq!(
+        capture.len() as u32,
+        crate::capture::region_texels(inp.width, inp.height),
+        "the blur reads a capture of the surface's region, its texels and the apron"
+    );
+    let mut out = Vec::with_capacity((inp.width * inp.height) as usize);
     for y in 0..inp.height {
         for x in 0..inp.width {
             let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
@@ -66,12 +87,9 @@ pub fn blur(inp: &BlurInput, capture: &[f32]) -> Vec<f32> {
     out
 }
 
-/// The unblurred depression of a capture (used by analytic tests).
+/// The unblurred depression of a `width x height` capture (used by analytic tests).
 pub fn depression_of(inp: &BlurInput, capture: &[f32]) -> Vec<f32> {
-    (0..inp.height as i32)
-        .flat_map(|y| (0..inp.width as i32).map(move |x| (x, y)))
-        .map(|(x, y)| depression(inp, capture, x, y))
-        .collect()
+    capture.iter().map(|&z| depression_at(inp, z)).collect()
 }
 
 /// Quantize a depression fraction to channel units the way `maths.wgsl` does (`to_units`).
@@ -183,13 +201,14 @@ mod tests {
             snow_depth: 0.3,
             frustum_height: 0.55,
         };
+        // The capture covers the region: 11 x 9, the surface's texel (x, y) at (x + 1, y + 1).
         // Ground everywhere: depression 1, blurred 1.
-        let flat = vec![0.0; 63];
+        let flat = vec![0.0; 99];
         assert!(blur(&inp, &flat).iter().all(|&v| (v - 1.0).abs() < 1e-6));
         // One pressed texel in the middle: the blur keeps its mass and spreads it over the 3x3
         // neighbourhood only.
-        let mut one = vec![1.0; 63];
-        one[3 * 9 + 4] = 0.0;
+        let mut one = vec![1.0; 99];
+        one[4 * 11 + 5] = 0.0;
         let b = blur(&inp, &one);
         let total: f32 = b.iter().sum();
         assert!((total - 1.0).abs() < 1e-5, "{total}");
@@ -217,6 +236,39 @@ mod tests {
                 "({x},{y}): {} / 64, expected {w}",
                 at(x, y)
             );
+        }
+    }
+
+    /// A texel pressed one beyond the surface's edge (in the apron only) reaches the edge column
+    /// through the blur with the kernel's weights, as on one wider surface: 10/64 beside it, 3/64
+    /// on the two diagonals, nothing further in. Clamping at the edge would leave it nothing.
+    #[test]
+    fn blur_reads_the_apron_beyond_the_edge() {
+        let inp = BlurInput {
+            width: 9,
+            height: 7,
+            mode: CaptureMode::Depth,
+            mask_fraction: 1.0,
+            snow_depth: 0.3,
+            frustum_height: 0.55,
+        };
+        // Region texel (0, 4): the surface's (-1, 3), left of column 0.
+        let mut beyond = vec![1.0; 99];
+        beyond[4 * 11] = 0.0;
+        let b = blur(&inp, &beyond);
+        for y in 0..7 {
+            for x in 0..9 {
+                let expected = match (x, y) {
+                    (0, 3) => 10.0,
+                    (0, 2) | (0, 4) => 3.0,
+                    _ => 0.0,
+                };
+                let got = b[y * 9 + x] * 64.0;
+                assert!(
+                    (got - expected).abs() < 1e-4,
+                    "({x},{y}): {got} / 64, expected {expected}"
+                );
+            }
         }
     }
 

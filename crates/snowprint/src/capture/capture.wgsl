@@ -6,7 +6,8 @@
 //
 // Reads: `view` (one per surface, dynamic offset), `prims` (analytic deformers in surface-local
 // coordinates), mesh vertex buffers and `draw` (mesh-to-surface-local transform, dynamic offset).
-// Writes: `capture`, the surface's texels at `view.offset` (cleared to 0 = nothing before the pass),
+// The viewport is the surface's capture region: its texels and the apron around them (write.wgsl).
+// Writes: `capture`, the region's texels at `view.offset` (cleared to 0 = nothing before the pass),
 // and `winding` at the same texels (cleared to 0): how many mesh solids contain the ground point
 // under each texel; `tiles` at `view.tiles` (cleared to 0): 1 for every 16x16 tile of the update
 // whose blur reads a texel written here, so the fused update skips the tiles nothing touched; and
@@ -28,7 +29,7 @@
 // (the rock between the base and the ground, where a slope holds less snow).
 @group(0) @binding(6) var<storage, read> ground: array<vec2<f32>>;
 
-// The texel under a fragment of the surface's viewport.
+// The region texel under a fragment of the surface's viewport.
 fn cell_of(frag: vec2<f32>) -> vec2<u32> {
     return vec2<u32>(frag - view.origin);
 }
@@ -40,8 +41,10 @@ struct PrimOut {
 }
 
 fn to_clip(local_xz: vec2<f32>, depth: f32) -> vec4<f32> {
-    // Column 0 is the smallest x and row 0 the smallest z: NDC y is +1 at row 0.
-    return vec4<f32>(local_xz.x / view.half_size.x, -local_xz.y / view.half_size.y, depth, 1.0);
+    // Column 0 is the smallest x and row 0 the smallest z: NDC y is +1 at row 0. The viewport
+    // spans the region, the surface grown by the apron.
+    let reach = region_half_of(view);
+    return vec4<f32>(local_xz.x / reach.x, -local_xz.y / reach.y, depth, 1.0);
 }
 
 @vertex
@@ -50,11 +53,12 @@ fn vs_prim(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
     let f = prim_footprint(p);
     var lo = f.xy;
     var hi = f.zw;
-    // Only the surface is drawn: a footprint far larger than the surface would otherwise reach
+    // Only the region is drawn: a footprint far larger than the surface would otherwise reach
     // clip coordinates where rasterizers lose precision (a sphere of radius 1e8 over a 2 m surface
     // filled half of it).
-    lo = max(lo, -view.half_size);
-    hi = min(hi, view.half_size);
+    let reach = region_half_of(view);
+    lo = max(lo, -reach);
+    hi = min(hi, reach);
     // Two triangles covering the footprint's bounding rectangle.
     var corners = array<vec2<f32>, 6>(
         vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0),

@@ -1,5 +1,7 @@
 //! CPU reference of the capture: the same maths as `write.wgsl` (both capture paths), evaluated at every texel centre.
 //! Depth 0 is the ground, 1 the top of the frustum; 1 also means "nothing captured" (the clear value).
+//! The capture covers a surface's capture region (its texels and the apron around them,
+//! [`super::region`]): [`capture_region`] gives it whole, [`capture`] the surface's own texels.
 
 use glam::{Vec2, Vec3, Vec3Swizzles};
 
@@ -9,8 +11,24 @@ const BIG: f32 = 1e30;
 
 /// Local `(x, z)` of the centre of texel `(column, row)`.
 pub fn texel_center(column: u32, row: u32, width: u32, height: u32, half_size: Vec2) -> Vec2 {
-    // Same operations, in the same order, as `texel_center` in capture.wgsl.
+    // Same operations, in the same order, as `texel_center_of` in write.wgsl.
     let cell = Vec2::new(column as f32 + 0.5, row as f32 + 0.5);
+    -half_size + cell / Vec2::new(width as f32, height as f32) * 2.0 * half_size
+}
+
+/// Local `(x, z)` of the centre of texel `(column, row)` of the capture region of a `width x
+/// height` surface ([`super::region`]: the surface's texel `(column - 1, row - 1)`, one texel
+/// beyond its sides in the apron).
+pub fn region_texel_center(
+    column: u32,
+    row: u32,
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+) -> Vec2 {
+    // The region's cell centre less the apron, as `texel_center_of` in write.wgsl (exact in f32).
+    let apron = super::APRON as f32;
+    let cell = Vec2::new(column as f32 + 0.5 - apron, row as f32 + 0.5 - apron);
     -half_size + cell / Vec2::new(width as f32, height as f32) * 2.0 * half_size
 }
 
@@ -161,7 +179,8 @@ pub fn triangles_depth(
     lowest.map(|y| y / frustum_height)
 }
 
-/// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen.
+/// Reference capture of a surface: `width * height` depths, row-major, 1 where nothing was seen
+/// (its capture region without the apron: [`capture_region`]).
 pub fn capture(
     width: u32,
     height: u32,
@@ -171,6 +190,28 @@ pub fn capture(
     triangles: &[LocalTriangle],
 ) -> Vec<f32> {
     capture_on_ground(
+        width,
+        height,
+        half_size,
+        frustum_height,
+        primitives,
+        triangles,
+        None,
+    )
+}
+
+/// Reference capture of a surface's capture region ([`super::region`]: `(width + 2) x (height +
+/// 2)` depths, row-major, the surface's texels and the apron of one texel around them), what the
+/// update's blur reads ([`crate::accumulate::cpu::blur`]).
+pub fn capture_region(
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+    frustum_height: f32,
+    primitives: &[GpuPrimitive],
+    triangles: &[LocalTriangle],
+) -> Vec<f32> {
+    capture_on_ground_region(
         width,
         height,
         half_size,
@@ -210,13 +251,39 @@ pub fn capture_on_ground(
     triangles: &[LocalTriangle],
     columns: Option<&[[f32; 2]]>,
 ) -> Vec<f32> {
-    let mut out = vec![1.0f32; (width * height) as usize];
-    for row in 0..height {
-        for col in 0..width {
-            let i = (row * width + col) as usize;
-            let c = texel_center(col, row, width, height, half_size);
+    let region = capture_on_ground_region(
+        width,
+        height,
+        half_size,
+        frustum_height,
+        primitives,
+        triangles,
+        columns,
+    );
+    super::strip_apron(width, height, &region)
+}
+
+/// [`capture_region`] on a ground field: `columns` holds `[base, bare]` per texel of the surface
+/// (`width * height`; the apron's are extrapolated from them, [`apron_columns`]), `None` for flat
+/// ground.
+pub fn capture_on_ground_region(
+    width: u32,
+    height: u32,
+    half_size: Vec2,
+    frustum_height: f32,
+    primitives: &[GpuPrimitive],
+    triangles: &[LocalTriangle],
+    columns: Option<&[[f32; 2]]>,
+) -> Vec<f32> {
+    let columns = columns.map(|c| apron_columns(c, width, height));
+    let (rw, rh) = super::region(width, height);
+    let mut out = vec![1.0f32; (rw * rh) as usize];
+    for row in 0..rh {
+        for col in 0..rw {
+            let i = (row * rw + col) as usize;
+            let c = region_texel_center(col, row, width, height, half_size);
             let mut d = 1.0f32;
-            let Some(columns) = columns else {
+            let Some(columns) = columns.as_deref() else {
                 for p in primitives {
                     if let Some(v) = primitive_depth(p, c.x, c.y, frustum_height) {
                         d = d.min(v);
@@ -244,6 +311,47 @@ pub fn capture_on_ground(
                 d = d.min(v);
             }
             out[i] = d;
+        }
+    }
+    out
+}
+
+/// The `[base, bare]` columns of a surface's capture region from its own `width * height`: the
+/// apron's ground one texel beyond each side, extrapolated linearly from the two texels at that
+/// side (`2 a - b`, along x first, then along z, from the x-extended rows), the bare depth kept at
+/// 0 or more; a side of one texel repeats it. Written on its own from `ground_of` in `write.wgsl`
+/// (and `GroundField::region_columns`, which lays the ground's capture codes out the same way).
+pub fn apron_columns(columns: &[[f32; 2]], width: u32, height: u32) -> Vec<[f32; 2]> {
+    let (w, h) = (width as usize, height as usize);
+    let beyond = |p: f32, q: f32| 2.0 * p - q;
+    // One line of a field extended by a texel at both ends.
+    let extend = |line: &[[f32; 2]]| -> Vec<[f32; 2]> {
+        let n = line.len();
+        let (first, last) = if n > 1 {
+            (
+                [
+                    beyond(line[0][0], line[1][0]),
+                    beyond(line[0][1], line[1][1]),
+                ],
+                [
+                    beyond(line[n - 1][0], line[n - 2][0]),
+                    beyond(line[n - 1][1], line[n - 2][1]),
+                ],
+            )
+        } else {
+            (line[0], line[0])
+        };
+        std::iter::once(first)
+            .chain(line.iter().copied())
+            .chain(std::iter::once(last))
+            .collect()
+    };
+    let rows: Vec<Vec<[f32; 2]>> = columns.chunks(w).take(h).map(extend).collect();
+    let mut out = vec![[0.0f32; 2]; (w + 2) * (h + 2)];
+    for x in 0..w + 2 {
+        let column: Vec<[f32; 2]> = rows.iter().map(|r| r[x]).collect();
+        for (y, c) in extend(&column).into_iter().enumerate() {
+            out[y * (w + 2) + x] = [c[0], c[1].max(0.0)];
         }
     }
     out
@@ -334,6 +442,50 @@ mod tests {
             (lo - (1.0 - s)).abs() < 1e-5 && (hi - (1.0 + s)).abs() < 1e-5,
             "{lo} {hi}"
         );
+    }
+
+    /// The apron's ground on a plane is the plane one texel beyond (to rounding), the bare depth
+    /// held; the production layout of the ground's codes (`GroundField::region_columns`) extends
+    /// a field as this reference does, bit for bit, on a plane and on a bumpy field.
+    #[test]
+    fn the_apron_extends_a_plane_and_matches_the_ground_codes_layout() {
+        let (w, h) = (5u32, 4u32);
+        let plane = |x: f32, y: f32| [0.3 * x - 0.2 * y, 0.05];
+        let bumpy = |x: f32, y: f32| {
+            [
+                (x * 1.3).sin() + (y * 0.7).cos(),
+                0.04 * (x + y).sin().abs(),
+            ]
+        };
+        for f in [plane, bumpy] {
+            let columns: Vec<[f32; 2]> = (0..h)
+                .flat_map(|y| (0..w).map(move |x| f(x as f32, y as f32)))
+                .collect();
+            let ours = apron_columns(&columns, w, h);
+            let field = crate::GroundField {
+                width: w,
+                height: h,
+                ground: vec![0.0; (w * h) as usize],
+                columns: columns.clone(),
+            };
+            let bits = |v: &[[f32; 2]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&ours), bits(&field.region_columns()));
+            assert_eq!(crate::capture::strip_apron(w, h, &ours), columns);
+        }
+        let columns: Vec<[f32; 2]> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| plane(x as f32, y as f32)))
+            .collect();
+        let ours = apron_columns(&columns, w, h);
+        for y in 0..h + 2 {
+            for x in 0..w + 2 {
+                let want = plane(x as f32 - 1.0, y as f32 - 1.0);
+                let got = ours[(y * (w + 2) + x) as usize];
+                assert!(
+                    (got[0] - want[0]).abs() < 1e-6 && (got[1] - want[1]).abs() < 1e-6,
+                    "({x}, {y}): {got:?} against {want:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -24,16 +24,17 @@ pub struct CaptureMesh {
     pub radius: f32,
 }
 
-/// One captured surface: its rectangle of the atlas and what is drawn in it.
+/// One captured surface: its capture region's rectangle of the atlas ([`super::region`]: the
+/// surface's texels and the apron) and what is drawn in it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CapturedSurface {
     /// The surface's record in the frame's update.
     pub record: u32,
     /// Which pass over the atlas.
     pub batch: u32,
-    /// Left texel in the atlas.
+    /// Left texel of the region in the atlas.
     pub x: u32,
-    /// Top texel in the atlas.
+    /// Top texel of the region in the atlas.
     pub y: u32,
     /// Heightmap width, texels.
     pub width: u32,
@@ -69,12 +70,13 @@ pub struct CapturePlan {
     /// The compute path's work: `[view, tile y << 16 | tile x]` for every tile a surface's
     /// primitives reach (empty: no surface takes the compute path).
     pub work: Vec<[u32; 2]>,
-    /// Texels of the capture buffer (every captured surface, one after the other).
+    /// Texels of the capture buffer (every captured surface's region, one after the other).
     pub texels: u32,
     /// Tile flags of the captured surfaces.
     pub tile_flags: u32,
     /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
-    /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`):
+    /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`; the
+    /// codes are laid out as the capture regions, apron included):
     /// `(first code in the ground codes buffer, first word in the winding buffer, texels)`.
     pub ground_copies: Vec<(u32, u32, u32)>,
 }
@@ -212,15 +214,10 @@ pub fn encode(
             if s.compute || s.batch != batch {
                 continue;
             }
-            pass.set_viewport(
-                s.x as f32,
-                s.y as f32,
-                s.width as f32,
-                s.height as f32,
-                0.0,
-                1.0,
-            );
-            pass.set_scissor_rect(s.x, s.y, s.width, s.height);
+            // The viewport is the surface's capture region: its texels and the apron.
+            let (rw, rh) = super::region(s.width, s.height);
+            pass.set_viewport(s.x as f32, s.y as f32, rw as f32, rh as f32, 0.0, 1.0);
+            pass.set_scissor_rect(s.x, s.y, rw, rh);
             pass.set_bind_group(0, &view_bg, &[(k as u64 * UNIFORM_STRIDE) as u32]);
             if !s.prims.is_empty() {
                 pass.set_pipeline(&pipes.primitives);

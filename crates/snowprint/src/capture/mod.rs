@@ -4,7 +4,9 @@
 //! shared depth atlas, looking up from the ground. The frustum runs from the ground (depth 0) to the
 //! snow top plus an ankle height (depth 1); the depth test keeps the lowest point of any deformer per
 //! texel, the talk's minimum-height field. Surfaces are packed into the atlas so that one render pass
-//! captures many of them, each in its own viewport.
+//! captures many of them, each in its own viewport. What is captured is a surface's capture
+//! [`region`]: its texels and an apron of one texel beyond each side, which the update's blur
+//! reads, so that two surfaces on one texel grid update the line where they meet as one would.
 //!
 //! Analytic deformers (spheres, capsules, boxes) are drawn as one bounding rectangle each and
 //! ray-cast exactly in the fragment shader; a moving sphere is swept into a capsule, other shapes
@@ -84,11 +86,41 @@ pub fn decode_depth(code: u32) -> f32 {
 /// Most sub-steps an analytic deformer is split into along its motion in one update.
 pub const MAX_SUBSTEPS: u32 = 32;
 
+/// Texels of apron the capture covers beyond each side of a surface. The update's blur reads one
+/// texel around each texel, so a surface's capture is its rectangle grown by a texel on every side:
+/// two surfaces on one texel grid then blur the same field along the line where they meet, as one
+/// surface over both would, instead of each clamping at its own edge.
+pub const APRON: u32 = crate::wgsl::consts::APRON;
+
+/// The capture region of a `width` x `height` surface: its texels and the apron around them,
+/// `(width + 2 APRON, height + 2 APRON)`. Region texel `(c, r)` is the surface's logical texel
+/// `(c - APRON, r - APRON)`.
+pub fn region(width: u32, height: u32) -> (u32, u32) {
+    (width + 2 * APRON, height + 2 * APRON)
+}
+
+/// Texels of a surface's capture region ([`region`]).
+pub fn region_texels(width: u32, height: u32) -> u32 {
+    let (w, h) = region(width, height);
+    w * h
+}
+
+/// The surface's own `width` x `height` texels of a capture `region` laid out as [`region`] says
+/// (the apron left out), row-major.
+pub fn strip_apron<T: Copy>(width: u32, height: u32, region_values: &[T]) -> Vec<T> {
+    let (rw, _) = region(width, height);
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| ((y + APRON) * rw + x + APRON) as usize))
+        .map(|i| region_values[i])
+        .collect()
+}
+
 /// `record` of a [`CaptureView`] whose flagged tiles are not listed (the update runs its grid).
 pub const NO_LIST: u32 = crate::wgsl::consts::NO_LIST;
 
 /// One surface's capture view: a uniform block in `capture.wgsl`, 256-byte storage blocks in
-/// `prims.wgsl`. Must match `CaptureView` in `write.wgsl`.
+/// `prims.wgsl`. Must match `CaptureView` in `write.wgsl`. Its sizes are the surface's; what is
+/// captured is the surface's [`region`], the apron included.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct CaptureView {
@@ -96,9 +128,9 @@ pub struct CaptureView {
     pub half_size: [f32; 2],
     /// Snow depth plus ankle height, metres.
     pub frustum_height: f32,
-    /// First texel of the surface in the capture buffer.
+    /// First texel of the surface's capture region ([`region`]) in the capture buffer.
     pub offset: u32,
-    /// The surface's top-left texel in the atlas.
+    /// The region's top-left texel in the atlas.
     pub origin: [f32; 2],
     /// The surface's heightmap width and height, texels.
     pub texels: [f32; 2],
@@ -132,10 +164,11 @@ pub fn footprint(p: &GpuPrimitive) -> [f32; 4] {
     [p.p0[0] - ex, p.p0[2] - ez, p.p0[0] + ex, p.p0[2] + ez]
 }
 
-/// Append to `work` an entry `[view, tile y << 16 | tile x]` for every 16 x 16 tile of a
-/// `width` x `height` surface of half sides `half` that a footprint of `prims` reaches (a texel
-/// of margin around each, so that rounding never leaves out a texel the ray cast would hit);
-/// `seen` is scratch.
+/// Append to `work` an entry `[view, tile y << 16 | tile x]` for every 16 x 16 tile of the
+/// capture [`region`] of a `width` x `height` surface of half sides `half` that a footprint of
+/// `prims` reaches (a texel of margin around each, so that rounding never leaves out a texel the
+/// ray cast would hit); `seen` is scratch. The tiles are the region's (its first row and column
+/// are the apron), as the compute path's workgroups cover it.
 pub fn tiles_reached(
     prims: &[GpuPrimitive],
     (width, height): (u32, u32),
@@ -145,26 +178,33 @@ pub fn tiles_reached(
     work: &mut Vec<[u32; 2]>,
 ) {
     let tile = crate::pool::TILE_SIDE;
-    let (tx, ty) = (width.div_ceil(tile), height.div_ceil(tile));
+    let (rw, rh) = region(width, height);
+    let (tx, ty) = (rw.div_ceil(tile), rh.div_ceil(tile));
     seen.clear();
     seen.resize((tx * ty) as usize, false);
     let texel = half * 2.0 / glam::Vec2::new(width as f32, height as f32);
-    // Truncation is the floor here: it differs only between -1 and 0, which the clamp takes to 0
-    // either way (and `floor` is a libm call on the baseline x86-64 target).
-    let to_cell =
-        |v: f32, h: f32, t: f32, n: u32| (((v + h) / t) as i64).clamp(0, n as i64 - 1) as u32;
+    // The region reaches a texel beyond each side.
+    let reach = half + texel * APRON as f32;
+    // The region's cell of a local coordinate: the surface's cell, floored, plus the apron. Left
+    // of the surface's first texel the floor is -1 or less, which the clamp takes to the region's
+    // column 0 whatever it is (and `floor` is a libm call on the baseline x86-64 target).
+    let to_cell = |v: f32, h: f32, t: f32, n: u32| {
+        let q = (v + h) / t;
+        let cell = if q < 0.0 { 0 } else { q as i64 + APRON as i64 };
+        cell.clamp(0, n as i64 - 1) as u32
+    };
     for p in prims {
         let [x0, z0, x1, z1] = footprint(p);
-        if x1 < -half.x || z1 < -half.y || x0 > half.x || z0 > half.y {
+        if x1 < -reach.x || z1 < -reach.y || x0 > reach.x || z0 > reach.y {
             continue;
         }
         let (c0, c1) = (
-            to_cell(x0 - texel.x, half.x, texel.x, width),
-            to_cell(x1 + texel.x, half.x, texel.x, width),
+            to_cell(x0 - texel.x, half.x, texel.x, rw),
+            to_cell(x1 + texel.x, half.x, texel.x, rw),
         );
         let (r0, r1) = (
-            to_cell(z0 - texel.y, half.y, texel.y, height),
-            to_cell(z1 + texel.y, half.y, texel.y, height),
+            to_cell(z0 - texel.y, half.y, texel.y, rh),
+            to_cell(z1 + texel.y, half.y, texel.y, rh),
         );
         for r in r0 / tile..=r1 / tile {
             for c in c0 / tile..=c1 / tile {
@@ -286,7 +326,9 @@ impl GpuPrimitive {
 }
 
 /// The capture volume of a surface in its local frame: `|x| <= half.x`, `|z| <= half.z`,
-/// `ground.0 <= y <= ground.1 + frustum_height`.
+/// `ground.0 <= y <= ground.1 + frustum_height`. The world's plan culls against the surface's
+/// capture [`region`]: `half_size` is then half the surface's sides plus a texel
+/// ([`CaptureVolume::of_region`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaptureVolume {
     /// World to surface-local transform.
@@ -301,6 +343,13 @@ pub struct CaptureVolume {
 }
 
 impl CaptureVolume {
+    /// Half sides of the capture [`region`] of a surface of half sides `half` and `width` x
+    /// `height` texels: the surface's rectangle grown by [`APRON`] texels on every side.
+    pub fn of_region(half: glam::Vec2, width: u32, height: u32) -> glam::Vec2 {
+        let texel = half * 2.0 / glam::Vec2::new(width as f32, height as f32);
+        half + texel * APRON as f32
+    }
+
     /// Whether local bounds overlap the volume.
     pub fn overlaps(&self, lo: Vec3, hi: Vec3) -> bool {
         hi.x >= -self.half_size.x

@@ -1,5 +1,6 @@
-// The capture's compute path for analytic deformers: a workgroup per 16 x 16 tile that a surface's
-// primitives reach (the plan's work list), every invocation one texel. The workgroup first
+// The capture's compute path for analytic deformers: a workgroup per 16 x 16 tile of a surface's
+// capture region (its texels and the apron, write.wgsl) that its primitives reach (the plan's work
+// list), every invocation one texel. The workgroup first
 // gathers the primitives whose footprints reach its tile; each texel then ray-casts those whose
 // footprint holds its centre and keeps the lowest, as the raster path's fragments do
 // (`write.wgsl`, shared). Surfaces that meshes press, or with more
@@ -68,7 +69,7 @@ fn capture_prims(
     let v = view_at(table[list + 2u * entry]);
     let packed = table[list + 2u * entry + 1u];
     let tile = vec2<u32>(packed & 0xffffu, packed >> 16u);
-    let size = vec2<u32>(v.texels);
+    let size = region_of(v);
     let first = tile * TILE;
     let last = min(first + vec2<u32>(TILE - 1u), size - vec2<u32>(1u));
     // The tile's texel centres span [lo, hi] (local x, z).
@@ -95,10 +96,11 @@ fn capture_prims(
         let n = atomicLoad(&hit_count);
         for (var h = 0u; h < n && inside; h++) {
             let p = prims[hits[h]];
-            // The raster path draws only the footprint's rectangle (clipped to the surface): the
+            // The raster path draws only the footprint's rectangle (clipped to the region): the
             // same texels here, and the ray cast decides as there.
             let f = prim_footprint(p);
-            if any(x < max(f.xy, -v.half_size)) || any(x > min(f.zw, v.half_size)) {
+            let reach = region_half_of(v);
+            if any(x < max(f.xy, -reach)) || any(x > min(f.zw, reach)) {
                 continue;
             }
             capture_prim(v, p, cell, c);

@@ -51,9 +51,9 @@ proptest! {
 }
 
 proptest! {
-    /// The tiles listed are those whose cells the footprints (a texel wider) reach, cells
-    /// taken with `floor` as the compute shader's texels are: every tile once, in the order
-    /// the footprints reach them.
+    /// The tiles listed are those of the capture region (the surface and its apron) whose cells
+    /// the footprints (a texel wider) reach, cells taken with `floor` as the compute shader's
+    /// texels are: every tile once, in the order the footprints reach them.
     #[test]
     fn tiles_reached_are_the_tiles_the_footprints_cover(
         caps in prop::collection::vec(
@@ -72,13 +72,15 @@ proptest! {
         tiles_reached(&prims, (w, h), half, 7, &mut seen, &mut work);
         let tile = crate::pool::TILE_SIDE;
         let texel = half * 2.0 / glam::Vec2::new(w as f32, h as f32);
+        // Region cells: the surface's cell plus one, from column -1 (region 0) to w (region w + 1).
         let cell = |v: f32, h: f32, t: f32, n: u32| {
-            (((v + h) / t).floor() as i64).clamp(0, n as i64 - 1) as u32
+            (((v + h) / t).floor() as i64 + 1).clamp(0, n as i64 + 1) as u32
         };
+        let reach = half + texel;
         let mut expected: Vec<[u32; 2]> = Vec::new();
         for p in &prims {
             let [x0, z0, x1, z1] = footprint(p);
-            if x1 < -half.x || z1 < -half.y || x0 > half.x || z0 > half.y {
+            if x1 < -reach.x || z1 < -reach.y || x0 > reach.x || z0 > reach.y {
                 continue;
             }
             let (c0, c1) = (cell(x0 - texel.x, half.x, texel.x, w), cell(x1 + texel.x, half.x, texel.x, w));

@@ -5,6 +5,11 @@
 // and the compute path (`prims.wgsl`, a workgroup per 16 x 16 tile its primitives reach)
 // call the same functions on the same texel centres, so they write the same bits. The importer
 // declares `capture`, `tiles`, `tile_list` (read_write atomics) and `ground` (read).
+//
+// A surface's capture covers its capture region: its texels and an apron of APRON texels beyond
+// each side (capture::region), so that the update's blur reads the field one texel beyond the
+// surface as one surface over both would. A `cell` here is a texel of the region (cell - APRON is
+// the surface's logical texel); the view's sizes are the surface's.
 
 // import constants, ground_texel
 
@@ -34,18 +39,51 @@ struct Primitive {
 }
 // Must match `GpuPrimitive` in capture/mod.rs.
 
-// Base and bare depth under texel `cell` of a surface; flat ground is (0, 0), which leaves the
-// maths below exactly as on a flat surface.
+// The region's sides, texels.
+fn region_of(v: CaptureView) -> vec2<u32> {
+    return vec2<u32>(v.texels) + vec2<u32>(2u * APRON);
+}
+
+// The ground field's column (base, bare) at logical texel `x` of row `y` (within the field),
+// extended past the field's side by linear extrapolation from the two texels there (exact on a
+// plane; the edge texel's own value on a field one texel wide). `2 a - b` rounds once whether or
+// not it is fused, as the CPU's (`GroundField::region_columns`).
+fn ground_row(v: CaptureView, x: i32, y: u32) -> vec2<f32> {
+    let w = i32(v.texels.x);
+    let n = u32(w);
+    if x < 0 && w > 1 {
+        return 2.0 * ground_texel(v.ground, n, 0u, y) - ground_texel(v.ground, n, 1u, y);
+    }
+    if x >= w && w > 1 {
+        return 2.0 * ground_texel(v.ground, n, n - 1u, y) - ground_texel(v.ground, n, n - 2u, y);
+    }
+    return ground_texel(v.ground, n, u32(clamp(x, 0, w - 1)), y);
+}
+
+// Base and bare depth under region texel `cell` of a surface; flat ground is (0, 0), which leaves
+// the maths below exactly as on a flat surface. In the apron the field is extrapolated along x,
+// then along y (`ground_row`), and the bare depth kept at 0 or more.
 fn ground_of(v: CaptureView, cell: vec2<u32>) -> vec2<f32> {
     if v.ground == NO_GROUND {
         return vec2<f32>(0.0);
     }
-    return ground_texel(v.ground, u32(v.texels.x), cell.x, cell.y);
+    let l = vec2<i32>(cell) - vec2<i32>(i32(APRON));
+    let h = i32(v.texels.y);
+    var g: vec2<f32>;
+    if l.y < 0 && h > 1 {
+        g = 2.0 * ground_row(v, l.x, 0u) - ground_row(v, l.x, 1u);
+    } else if l.y >= h && h > 1 {
+        g = 2.0 * ground_row(v, l.x, u32(h - 1)) - ground_row(v, l.x, u32(h - 2));
+    } else {
+        g = ground_row(v, l.x, u32(clamp(l.y, 0, h - 1)));
+    }
+    return vec2<f32>(g.x, max(g.y, 0.0));
 }
 
-// Flag every tile holding a texel within one of `cell` (the blur's reach).
+// Flag every tile of the surface holding a texel within one of region texel `cell` (the blur's
+// reach): a texel of the apron flags the tile of the surface's texel beside it.
 fn mark_tiles_of(v: CaptureView, cell_u: vec2<u32>) {
-    let cell = vec2<i32>(cell_u);
+    let cell = vec2<i32>(cell_u) - vec2<i32>(i32(APRON));
     let last = vec2<i32>(v.texels) - vec2<i32>(1);
     let t0 = vec2<u32>(clamp(cell - vec2<i32>(1), vec2<i32>(0), last)) / TILE;
     let t1 = vec2<u32>(clamp(cell + vec2<i32>(1), vec2<i32>(0), last)) / TILE;
@@ -71,7 +109,7 @@ fn mark_tiles_of(v: CaptureView, cell_u: vec2<u32>) {
 // floats order like their bit patterns, so the code is exact and monotonic.
 
 fn texel_index_of(v: CaptureView, cell: vec2<u32>) -> u32 {
-    return v.offset + cell.y * u32(v.texels.x) + cell.x;
+    return v.offset + cell.y * region_of(v).x + cell.x;
 }
 
 fn keep_lowest_of(v: CaptureView, cell: vec2<u32>, depth: f32) {
@@ -170,14 +208,21 @@ fn box_interval(c: vec3<f32>, ax: vec4<f32>, ay: vec4<f32>, az: vec4<f32>, x: f3
     return vec2<f32>(lo, hi);
 }
 
-// The local (x, z) of the centre of texel `cell`, from `c` = cell + 0.5 (exact in f32, as a
-// fragment's position less the viewport's origin is), the same way the CPU reference computes
-// texel centres.
+// The local (x, z) of the centre of region texel `cell`, from `c` = cell + 0.5 (exact in f32, as
+// a fragment's position less the viewport's origin is), the same way the CPU reference computes
+// texel centres: `c - APRON` is the surface's logical texel centre (exact too), so the surface's
+// own texels have the centres they had before the apron.
 fn texel_center_of(v: CaptureView, c: vec2<f32>) -> vec2<f32> {
-    return -v.half_size + c / v.texels * 2.0 * v.half_size;
+    return -v.half_size + (c - vec2<f32>(f32(APRON))) / v.texels * 2.0 * v.half_size;
 }
 
-// Ray-cast primitive `p` under texel `cell` (its centre `c` = cell + 0.5) and keep what it presses.
+// Half the sides of the capture region, local metres: the surface's grown by the apron.
+fn region_half_of(v: CaptureView) -> vec2<f32> {
+    return v.half_size + 2.0 * v.half_size / v.texels * f32(APRON);
+}
+
+// Ray-cast primitive `p` under region texel `cell` (its centre `c` = cell + 0.5) and keep what it
+// presses.
 fn capture_prim(v: CaptureView, p: Primitive, cell: vec2<u32>, c: vec2<f32>) {
     let x = texel_center_of(v, c);
     var iv: vec2<f32>;

@@ -297,8 +297,27 @@ impl GroundField {
         true
     }
 
-    /// Lowest base and highest ground: the capture volume reaches from the first to the second plus
-    /// the snow depth and the ankle height.
+    /// The columns of the surface's capture region, the apron's extrapolated
+    /// ([`region_columns`]).
+    pub fn region_columns(&self) -> Vec<[f32; 2]> {
+        region_columns(&self.columns, self.width, self.height)
+    }
+
+    /// [`GroundField::range`] over the capture region ([`GroundField::region_columns`]): the
+    /// capture volume the plan culls against reaches from the first to the second plus the snow
+    /// depth and the ankle height.
+    pub fn region_range(&self) -> (f32, f32) {
+        let columns = self.region_columns();
+        let low = columns.iter().map(|c| c[0]).fold(f32::INFINITY, f32::min);
+        let high = columns
+            .iter()
+            .map(|c| c[0] + c[1])
+            .fold(f32::NEG_INFINITY, f32::max);
+        let (l, h) = self.range();
+        (low.min(l), high.max(h))
+    }
+
+    /// Lowest base and highest ground: the renderer's bounds of the surface's snow.
     pub fn range(&self) -> (f32, f32) {
         let low = self
             .columns
@@ -312,6 +331,44 @@ impl GroundField {
             .fold(f32::NEG_INFINITY, f32::max);
         (low, high)
     }
+}
+
+/// The `[base, bare]` columns of a surface's capture region ([`crate::capture::region`]: its
+/// texels and the apron around them, row-major) from its `width x height` `columns`. Past the
+/// field's sides the capture reads the ground one texel beyond the surface: a field knows no
+/// ground there, so it is extrapolated linearly from the two texels at the side, along `x` and
+/// then along `z`, the bare depth kept at 0 or more (exact on a plane, which holds its slope and
+/// so its bare depth; on curved ground off by the curvature over a texel). The same maths as
+/// `ground_of` in `capture/write.wgsl`, operation for operation (`2 a - b` rounds once, fused or
+/// not); a field one texel wide or high repeats its edge.
+fn region_columns(columns: &[[f32; 2]], width: u32, height: u32) -> Vec<[f32; 2]> {
+    let a = crate::wgsl::consts::APRON as i32;
+    let (w, h) = (width as i32, height as i32);
+    let at = |x: i32, y: i32| columns[(y * w + x) as usize];
+    let ext = |p: [f32; 2], q: [f32; 2]| [2.0 * p[0] - q[0], 2.0 * p[1] - q[1]];
+    let row = |x: i32, y: i32| {
+        if x < 0 && w > 1 {
+            ext(at(0, y), at(1, y))
+        } else if x >= w && w > 1 {
+            ext(at(w - 1, y), at(w - 2, y))
+        } else {
+            at(x.clamp(0, w - 1), y)
+        }
+    };
+    let mut out = Vec::with_capacity(((w + 2 * a) * (h + 2 * a)) as usize);
+    for y in -a..h + a {
+        for x in -a..w + a {
+            let [base, bare] = if y < 0 && h > 1 {
+                ext(row(x, 0), row(x, 1))
+            } else if y >= h && h > 1 {
+                ext(row(x, h - 1), row(x, h - 2))
+            } else {
+                row(x, y.clamp(0, h - 1))
+            };
+            out.push([base, bare.max(0.0)]);
+        }
+    }
+    out
 }
 
 /// Heights at the centres of a surface's texels from a grid.

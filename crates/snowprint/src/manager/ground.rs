@@ -39,7 +39,10 @@ impl SnowManager {
         id: ManagedId,
         ground: Option<ManagedGround>,
     ) -> Result<()> {
-        let range = ground.as_ref().map_or((0.0, 0.0), |g| g.field.range());
+        // Over the capture region, the apron's ground included, as the world's plan culls.
+        let range = ground
+            .as_ref()
+            .map_or((0.0, 0.0), |g| g.field.region_range());
         self.planner.set_ground_range(id, range)?;
         if let Some(w) = self.world_ids[id.0 as usize] {
             self.world

@@ -233,15 +233,17 @@ pub struct SurfaceRecord {
     pub heights: u32,
     /// Word offset of the normals region, or [`NO_NORMALS`].
     pub normals: u32,
-    /// Word offset into the per-frame capture buffers.
+    /// Word offset into the per-frame capture buffers: the first texel of the surface's capture
+    /// region ([`crate::capture::region`], the apron included); the separate blur's output starts
+    /// there too, `width * height` of it.
     pub scratch: u32,
     /// Texels along x.
     pub width: u32,
     /// Texels along z.
     pub height: u32,
-    /// Capture atlas x of the surface's rectangle.
+    /// Capture atlas x of the surface's capture region.
     pub atlas_x: u32,
-    /// Capture atlas y of the surface's rectangle.
+    /// Capture atlas y of the surface's capture region.
     pub atlas_y: u32,
     /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`]; bit 2: [`MODE_GROUND`].
     pub mode: u32,

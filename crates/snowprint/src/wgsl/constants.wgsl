@@ -8,6 +8,9 @@
 const ONE_BITS: u32 = 0x3f800000u;
 // Side of the update's tiles, the fused pass's workgroup side.
 const TILE: u32 = 16u;
+// Texels of apron a surface's capture covers beyond each of its sides: the blur reads one texel
+// around each texel, so two surfaces on one grid blur the same field where they meet.
+const APRON: u32 = 1u;
 // Workgroup side of the separate accumulation passes.
 const WORKGROUP: u32 = 8u;
 // Words before the entries of the capture's tile list: the dispatch arguments and the count.

@@ -558,7 +558,8 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
         }
     }
     let format = world.pool_format();
-    let side = world.config().atlas_side;
+    // A level's capture region (its texels and the apron) must fit the atlas.
+    let side = world.config().atlas_side - 2 * crate::capture::APRON;
     let mut bytes = 0u64;
     for (i, l) in desc.levels.iter().enumerate() {
         let [w, h] = l.texels;
@@ -567,7 +568,7 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
                 format!("level {i}'s texels"),
                 format!("[{w}, {h}]"),
                 format!(
-                    "between 1 and {side} a side (the capture atlas's side, WorldConfig.atlas_side)"
+                    "between 1 and {side} a side (the capture atlas's side, WorldConfig.atlas_side, less the capture's apron of a texel on each side)"
                 ),
             );
         }

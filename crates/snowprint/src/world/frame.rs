@@ -243,7 +243,8 @@ impl SnowWorld {
 
     /// Refuse a frame whose per-frame buffers the device could not bind (wgpu would panic
     /// binding them): the first layer by its plan, a later one (planned only as the frame is
-    /// recorded) by the capture it would need were every surface in it captured, 4 bytes a texel.
+    /// recorded) by the capture it would need were every surface in it captured, 4 bytes a texel
+    /// of each surface's capture region (its texels and the apron around them).
     fn check_sizes(&self, first: &FramePlan, later: &[&[SurfaceUpdate<'_>]]) -> Result<()> {
         let max = self.device.limits().max_storage_buffer_binding_size;
         if let Some((buffer, bytes)) = first.sizes.first_over(max) {
@@ -258,7 +259,7 @@ impl SnowWorld {
             let bytes: u64 = updates
                 .iter()
                 .filter_map(|u| self.state(u.surface).ok())
-                .map(|s| 4 * s.layout.texels())
+                .map(|s| 4 * crate::capture::region_texels(s.layout.width, s.layout.height) as u64)
                 .sum();
             if bytes > max {
                 return Err(SnowError::FrameTooLarge {

@@ -16,8 +16,13 @@ pub(crate) struct SurfaceGround {
     pub field: GroundField,
     /// First texel in the ground buffer.
     pub offset: u32,
-    /// [`GroundField::range`], kept: the plan and the renderer read it every frame.
+    /// First of its capture codes in the ground codes buffer, one per texel of its capture region
+    /// (`capture::region`).
+    pub codes: u32,
+    /// [`GroundField::range`], kept: the renderer reads it every frame.
     pub range: (f32, f32),
+    /// [`GroundField::region_range`], kept: the plan culls against it every frame.
+    pub region_range: (f32, f32),
 }
 
 impl SurfaceGround {
@@ -25,7 +30,8 @@ impl SurfaceGround {
     pub fn plan(&self) -> PlanGround {
         PlanGround {
             offset: self.offset,
-            range: self.range,
+            codes: self.codes,
+            range: self.region_range,
         }
     }
 }
@@ -124,8 +130,10 @@ impl SnowWorld {
             .expect("checked live above")
             .ground = field.map(|field| SurfaceGround {
             range: field.range(),
+            region_range: field.region_range(),
             field,
             offset: 0,
+            codes: 0,
         });
         self.upload_grounds();
         Ok(())
@@ -161,20 +169,15 @@ impl SnowWorld {
             return Ok(false);
         }
         g.range = g.field.range();
+        g.region_range = g.field.region_range();
         let frustum = s.desc.snow_depth + ankle;
-        let codes: Vec<u32> = g
-            .field
-            .columns
-            .iter()
-            .map(|c| encode_depth(c[1] / frustum))
-            .collect();
-        let offset = g.offset as u64;
+        let codes = ground_codes(&g.field, frustum);
         let columns: &[u8] = bytemuck::cast_slice(&g.field.columns);
         let codes: &[u8] = bytemuck::cast_slice(&codes);
         self.queue
-            .write_buffer(&self.grounds.buffer, offset * 8, columns);
+            .write_buffer(&self.grounds.buffer, g.offset as u64 * 8, columns);
         self.queue
-            .write_buffer(&self.ground_codes.buffer, offset * 4, codes);
+            .write_buffer(&self.ground_codes.buffer, g.codes as u64 * 4, codes);
         self.ground_bytes_written += (columns.len() + codes.len()) as u64;
         Ok(true)
     }
@@ -217,11 +220,9 @@ impl SnowWorld {
         for s in self.surfaces.iter_mut().flatten() {
             if let Some(g) = s.ground.as_mut() {
                 g.offset = columns.len() as u32;
+                g.codes = codes.len() as u32;
                 columns.extend_from_slice(&g.field.columns);
-                // Where a mesh solid holds the ground point the snow is pressed to the ground:
-                // the bare depth above the base, as a capture code (`capture::encode_depth`).
-                let frustum = s.desc.snow_depth + ankle;
-                codes.extend(g.field.columns.iter().map(|c| encode_depth(c[1] / frustum)));
+                codes.extend(ground_codes(&g.field, s.desc.snow_depth + ankle));
             }
         }
         if columns.is_empty() {
@@ -236,4 +237,16 @@ impl SnowWorld {
         self.queue.write_buffer(&self.ground_codes.buffer, 0, bytes);
         self.ground_bytes_written += bytes.len() as u64;
     }
+}
+
+/// Where a mesh solid holds the ground point the snow is pressed to the ground: the bare depth
+/// above the base, as a capture code (`capture::encode_depth`), at every texel of the surface's
+/// capture region (the apron's ground extrapolated, [`GroundField::region_columns`]), laid out as
+/// the capture region so that one copy puts them beside the winding counts.
+fn ground_codes(field: &GroundField, frustum_height: f32) -> Vec<u32> {
+    field
+        .region_columns()
+        .iter()
+        .map(|c| encode_depth(c[1] / frustum_height))
+        .collect()
 }

@@ -17,14 +17,15 @@ impl SnowWorld {
         layout: SurfaceLayout,
     ) -> Result<SurfaceId> {
         desc.validate()?;
-        let side = self.config.atlas_side;
+        // The level's capture region (its texels and the apron) must fit the atlas.
+        let side = self.config.atlas_side - 2 * crate::capture::APRON;
         if layout.width > side || layout.height > side || layout.texels() == 0 {
             return Err(SnowError::InvalidTerrain {
                 name: desc.name.clone(),
                 what: "a level's texels".into(),
                 value: format!("{} x {}", layout.width, layout.height),
                 expected: format!(
-                    "between 1 and the capture atlas's {side} a side (WorldConfig.atlas_side)"
+                    "between 1 and {side} a side (the capture atlas's side, WorldConfig.atlas_side, less the capture's apron of a texel on each side)"
                 ),
             });
         }

@@ -228,7 +228,9 @@ impl SnowWorld {
         if config.passes == PassMode::Auto {
             config.passes = PassMode::Fused;
         }
-        config.max_resolution = config.max_resolution.clamp(1, config.atlas_side);
+        // A surface's capture region (its texels and the apron) must fit the atlas.
+        let largest = config.atlas_side - 2 * crate::capture::APRON;
+        config.max_resolution = config.max_resolution.clamp(1, largest);
         if let Some(spray) = &config.spray {
             spray.validate()?;
         }

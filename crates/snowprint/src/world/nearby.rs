@@ -43,10 +43,10 @@ pub(crate) fn deformer_square(d: &Deformer) -> Option<GroundRect> {
     square.iter().all(|v| v.is_finite()).then_some(square)
 }
 
-/// The ground-plane rectangle holding a surface's (yawed) rectangle, with a margin for rounding.
-pub(crate) fn surface_rect(desc: &SurfaceDesc) -> GroundRect {
+/// The ground-plane rectangle holding a surface's (yawed) rectangle of half sides `h` (in a plan,
+/// its capture region's: the surface grown by the apron), with a margin for rounding.
+pub(crate) fn surface_rect(desc: &SurfaceDesc, h: Vec2) -> GroundRect {
     let m = desc.local_to_world();
-    let h = desc.size * 0.5;
     let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
     for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
         let p = m.transform_point3(Vec3::new(sx * h.x, 0.0, sz * h.y));

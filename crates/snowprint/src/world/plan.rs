@@ -124,6 +124,10 @@ pub struct PlanSurface<'a> {
 pub struct PlanGround {
     /// First texel of the field in the ground buffer.
     pub offset: u32,
+    /// First of its capture codes in the ground codes buffer, one per texel of the surface's
+    /// capture region ([`capture::region`]: the apron's ground extrapolated,
+    /// [`GroundField::region_columns`]).
+    pub codes: u32,
     /// The lowest base and the highest ground of the field, local metres
     /// ([`crate::GroundField::range`]).
     pub range: (f32, f32),
@@ -198,6 +202,9 @@ struct Job {
     half_size: Vec2,
     /// First texel of the ground field, or [`capture::NO_GROUND`].
     ground_offset: u32,
+    /// First of its capture codes (one per texel of its capture region) in the ground codes
+    /// buffer (0 on flat ground: never read).
+    ground_codes: u32,
     prims: Range<u32>,
     draws: Range<u32>,
     /// Whether the compute path captures it.
@@ -326,9 +333,12 @@ impl FramePlan {
         );
         self.carries.push((s.index, carry));
         let frustum_height = s.desc.snow_depth + settings.capture.ankle_height;
+        let half_size = s.desc.size * 0.5;
+        // Deformers are culled against the capture region, the surface grown by the apron: one
+        // that presses only a neighbour's edge column still reaches this surface's blur.
         let volume = CaptureVolume {
             world_to_local: s.desc.world_to_local(),
-            half_size: s.desc.size * 0.5,
+            half_size: CaptureVolume::of_region(half_size, s.layout.width, s.layout.height),
             frustum_height,
             ground: s.ground.map_or((0.0, 0.0), |g| g.range),
         };
@@ -345,7 +355,8 @@ impl FramePlan {
             // A long list (every deformer of the world): only those in the grid's cells near the
             // surface, in the list's order.
             self.nearby.index(s.deformers);
-            self.nearby.near(surface_rect(s.desc), &mut self.near);
+            self.nearby
+                .near(surface_rect(s.desc, volume.half_size), &mut self.near);
             for &i in &self.near {
                 visit(i as usize, &s.deformers[i as usize]);
             }
@@ -376,7 +387,7 @@ impl FramePlan {
                 y1: h,
             }
         } else {
-            pressed_rect(&prims[p0 as usize..p1 as usize], &volume, s.layout)
+            pressed_rect(&prims[p0 as usize..p1 as usize], half_size, s.layout)
         };
         let (relaxes, settle) = match (material.slumps(), captured) {
             (false, _) => (false, 0),
@@ -438,8 +449,9 @@ impl FramePlan {
                 tiles: 0,
                 wrap: s.wrap,
             },
-            half_size: volume.half_size,
+            half_size,
             ground_offset: s.ground.map_or(capture::NO_GROUND, |g| g.offset),
+            ground_codes: s.ground.map_or(0, |g| g.codes),
             prims: p0..p1,
             draws: d0..d1,
             compute: computed(settings, p1 - p0, d1 > d0),
@@ -459,7 +471,7 @@ impl FramePlan {
             self.jobs
                 .iter()
                 .filter(|j| rendered(j))
-                .map(|j| (j.record.width, j.record.height)),
+                .map(|j| capture::region(j.record.width, j.record.height)),
         );
         // The atlas is cleared whole every pass, so keep it as small as the frame allows: the
         // smallest power-of-two side that holds every rectangle in one batch, up to the limit.
@@ -478,13 +490,15 @@ impl FramePlan {
                 r.atlas_y = p.y;
                 r.batch = p.batch;
             }
+            // The surface's capture region: its texels and the apron around them.
+            let region = capture::region_texels(r.width, r.height);
             r.scratch = c.texels;
-            c.texels += r.width * r.height;
+            c.texels += region;
             if r.mode & MODE_GROUND != 0 {
-                // The winding region's second half: the ground's codes, copied before the capture.
-                c.ground_copies
-                    .push((job.ground_offset, c.texels, r.width * r.height));
-                c.texels += r.width * r.height;
+                // The winding region's second half: the ground's codes (laid out as the region),
+                // copied before the capture.
+                c.ground_copies.push((job.ground_codes, c.texels, region));
+                c.texels += region;
             }
             r.tiles = c.tile_flags;
             c.tile_flags += r.tile_count();
@@ -614,16 +628,12 @@ impl FramePlan {
     }
 }
 
-/// The texels a surface's primitives (in its local frame) can press, with a margin for the
-/// capture's blur.
-fn pressed_rect(
-    prims: &[capture::GpuPrimitive],
-    volume: &CaptureVolume,
-    layout: SurfaceLayout,
-) -> Rect {
+/// The texels a surface (of half sides `half_size`) that its primitives (in its local frame) can
+/// press, with a margin for the capture's blur.
+fn pressed_rect(prims: &[capture::GpuPrimitive], half_size: Vec2, layout: SurfaceLayout) -> Rect {
     const BLUR_MARGIN: f32 = 3.0;
     let (w, h) = (layout.width, layout.height);
-    let texel = volume.half_size * 2.0 / Vec2::new(w as f32, h as f32);
+    let texel = half_size * 2.0 / Vec2::new(w as f32, h as f32);
     let mut lo = Vec2::splat(f32::INFINITY);
     let mut hi = Vec2::splat(f32::NEG_INFINITY);
     for p in prims {
@@ -644,7 +654,7 @@ fn pressed_rect(
     if !(lo.is_finite() && hi.is_finite()) {
         return Rect::default();
     }
-    let to_texel = |v: Vec2| (v + volume.half_size) / texel;
+    let to_texel = |v: Vec2| (v + half_size) / texel;
     let (a, b) = (to_texel(lo) - BLUR_MARGIN, to_texel(hi) + BLUR_MARGIN);
     let clamp = |v: f32, n: u32| v.clamp(0.0, n as f32) as u32;
     Rect {

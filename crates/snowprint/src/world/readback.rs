@@ -90,27 +90,40 @@ impl SnowWorld {
             .collect())
     }
 
-    /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing), when
-    /// it was captured in that step; `None` otherwise.
+    /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing,
+    /// `width x height` of them), when it was captured in that step; `None` otherwise. The apron
+    /// the capture also covers is left out ([`SnowWorld::read_last_capture_region`] keeps it).
     pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
+        let layout = self.state(id)?.layout;
+        Ok(self
+            .read_last_capture_region(id)?
+            .map(|r| capture::strip_apron(layout.width, layout.height, &r)))
+    }
+
+    /// [`SnowWorld::read_last_capture`] over the surface's whole capture region: its texels and
+    /// the apron of one texel around them that the update's blur reads
+    /// ([`crate::capture::region`]: `(width + 2) x (height + 2)`, row-major, region texel
+    /// `(c, r)` the surface's `(c - 1, r - 1)`).
+    pub fn read_last_capture_region(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
         self.state(id)?;
         let Some(&(_, r)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
             return Ok(None);
         };
+        let texels = capture::region_texels(r.width, r.height);
         let bytes = self.download(
             &self.capture.buffer,
             r.scratch as u64 * 4,
-            (r.width * r.height) as u64 * 4,
+            texels as u64 * 4,
         )?;
         // The winding buffer holds this surface's texels only when meshes were drawn over it.
         let winding = if r.mode & crate::pool::MODE_MESHES != 0 {
             self.download(
                 &self.winding.buffer,
                 r.scratch as u64 * 4,
-                (r.width * r.height) as u64 * 4,
+                texels as u64 * 4,
             )?
         } else {
-            vec![0; (r.width * r.height) as usize * 4]
+            vec![0; texels as usize * 4]
         };
         let codes: &[u32] = bytemuck::cast_slice(&bytes);
         let winding: &[i32] = bytemuck::cast_slice(&winding);
@@ -120,11 +133,11 @@ impl SnowWorld {
         let ground = if on_ground {
             self.download(
                 &self.winding.buffer,
-                (r.scratch + r.width * r.height) as u64 * 4,
-                (r.width * r.height) as u64 * 4,
+                (r.scratch + texels) as u64 * 4,
+                texels as u64 * 4,
             )?
         } else {
-            vec![0; (r.width * r.height) as usize * 4]
+            vec![0; texels as usize * 4]
         };
         let ground: &[u32] = bytemuck::cast_slice(&ground);
         Ok(Some(

@@ -230,7 +230,9 @@ impl Planner {
         })?;
         let zone = self.zone_index(zone);
         let top = desc.snow_depth + self.config.capture.ankle_height;
-        let half = desc.size * 0.5;
+        // The surface's capture region, grown by the apron: a deformer that presses only a
+        // neighbour's edge column reaches this surface's blur too, and is queued here.
+        let half = region_half(desc);
         let rot = desc.rotation();
         let ext = (rot * Vec3::new(half.x, 0.0, half.y))
             .abs()
@@ -275,7 +277,7 @@ impl Planner {
         let zone = self.volumes[i].zone;
         // The volume's test starts at local y = 0: shift the frame down to the lowest base.
         let to_local = Mat4::from_translation(Vec3::new(0.0, -lo, 0.0)) * desc.world_to_local();
-        self.volumes[i] = TouchVolume::new(to_local, desc.size * 0.5, hi - lo + top, zone);
+        self.volumes[i] = TouchVolume::new(to_local, region_half(&desc), hi - lo + top, zone);
         let b = &mut self.status[i].bounds;
         b.min.y = desc.center.y + lo;
         b.max.y = desc.center.y + hi + top;
@@ -666,4 +668,11 @@ impl Planner {
             index,
         }
     }
+}
+
+/// Half the sides of a surface's capture region: its rectangle grown by the capture's apron
+/// (`capture::region`), what the world's plan culls against.
+fn region_half(desc: &crate::SurfaceDesc) -> glam::Vec2 {
+    let layout = desc.layout();
+    crate::capture::CaptureVolume::of_region(desc.size * 0.5, layout.width, layout.height)
 }

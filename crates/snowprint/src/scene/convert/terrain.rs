@@ -14,8 +14,9 @@ use crate::window::{LevelDesc, TerrainDesc, TerrainGround};
 
 use super::{number, required, unique, vector};
 
-/// Largest side of a level, texels (the default capture atlas's side).
-const MAX_LEVEL_TEXELS: f32 = 2048.0;
+/// Largest side of a level, texels: the default capture atlas's side less the capture's apron of
+/// a texel on each side (`capture::APRON`), so that the level's capture region fits the atlas.
+const MAX_LEVEL_TEXELS: f32 = 2046.0;
 
 pub(super) fn terrain(
     src: &Source<'_>,
@@ -173,7 +174,7 @@ fn levels(
             "texels",
             "[columns, rows]",
             |x| (1.0..=MAX_LEVEL_TEXELS).contains(&x) && x.fract() == 0.0,
-            "a level's texels must be whole numbers from 1 to 2048 (a level of zero texels holds no snow)",
+            "a level's texels must be whole numbers from 1 to 2046 (a level of zero texels holds no snow)",
         )?;
         let size = required(
             src,

@@ -90,7 +90,11 @@ fn surface(i: usize, (c, size, yaw, depth): SurfaceSeed) -> SurfaceDesc {
 fn volume(desc: &SurfaceDesc) -> CaptureVolume {
     CaptureVolume {
         world_to_local: desc.world_to_local(),
-        half_size: desc.size * 0.5,
+        half_size: CaptureVolume::of_region(
+            desc.size * 0.5,
+            desc.layout().width,
+            desc.layout().height,
+        ),
         frustum_height: desc.snow_depth + WorldConfig::default().capture.ankle_height,
         ground: (0.0, 0.0),
     }
@@ -145,7 +149,7 @@ proptest! {
         for (k, seed) in surfaces.into_iter().enumerate() {
             let desc = surface(k, seed);
             let vol = volume(&desc);
-            grid.near(surface_rect(&desc), &mut near);
+            grid.near(surface_rect(&desc, vol.half_size), &mut near);
             prop_assert!(near.windows(2).all(|w| w[0] < w[1]), "not ascending once: {near:?}");
             prop_assert!(near.last().is_none_or(|&i| (i as usize) < deformers.len()));
             let m = desc.world_to_local();
@@ -161,7 +165,7 @@ proptest! {
             let all: Vec<u32> = (0..deformers.len()).filter(|&i| kept(i)).map(|i| i as u32).collect();
             // What the grid rests on, without its cells (which would hide a square too small):
             // the square of every deformer kept overlaps the surface's rectangle.
-            let [x0, z0, x1, z1] = surface_rect(&desc);
+            let [x0, z0, x1, z1] = surface_rect(&desc, vol.half_size);
             for &i in &all {
                 if let Some([a0, b0, a1, b1]) = deformer_square(&deformers[i as usize]) {
                     prop_assert!(a1 >= x0 && a0 <= x1 && b1 >= z0 && b0 <= z1, "deformer {}", i);
@@ -267,11 +271,11 @@ fn a_surface_far_from_every_deformer_is_offered_only_the_meshes() {
     grid.index(&deformers);
     let mut near = Vec::new();
     let far = SurfaceDesc::new("far", [0.0, 0.0, 500.0], [4.0, 4.0], 0.3);
-    grid.near(surface_rect(&far), &mut near);
+    grid.near(surface_rect(&far, far.size * 0.5), &mut near);
     assert_eq!(near, vec![INDEX_FROM as u32]);
     // Over the spheres 10 to 12 (a 4 m square at x = 11, their balls 0.2 m and a margin).
     let over = SurfaceDesc::new("over", [11.0, 0.0, 0.0], [2.0, 2.0], 0.3);
-    grid.near(surface_rect(&over), &mut near);
+    grid.near(surface_rect(&over, over.size * 0.5), &mut near);
     assert!([10, 11, 12].iter().all(|i| near.contains(i)), "{near:?}");
     assert!(near.len() <= 8, "{near:?}");
     assert_eq!(near.last(), Some(&(INDEX_FROM as u32)));

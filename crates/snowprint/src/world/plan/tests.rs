@@ -238,10 +238,10 @@ proptest! {
         if raster {
             s.capture_path = capture::CapturePath::Raster;
         }
-        // The world caps heightmaps at the atlas side.
+        // The world caps heightmaps at the atlas side less the capture's apron.
         let mut input = inputs(&descs, &deformers, 0.1);
         for p in &mut input {
-            p.layout = SurfaceLayout::for_size_capped(p.desc.size, atlas_side);
+            p.layout = SurfaceLayout::for_size_capped(p.desc.size, atlas_side - 2 * capture::APRON);
         }
         let plan = FramePlan::build(&s, input, no_meshes);
         let c = &plan.capture;
@@ -268,30 +268,34 @@ proptest! {
                 unique.sort();
                 unique.dedup();
                 prop_assert_eq!(unique.len(), mine.len());
+                // Tiles of the capture region, the surface and its apron.
+                let (rw, rh) = capture::region(a.width, a.height);
                 for t in mine {
-                    prop_assert!((t & 0xffff) < v.tiles_x);
-                    prop_assert!((t >> 16) * TILE_SIDE < a.height);
+                    prop_assert!((t & 0xffff) < rw.div_ceil(TILE_SIDE));
+                    prop_assert!((t >> 16) * TILE_SIDE < rh);
                 }
                 prop_assert_eq!((r.scratch, r.tiles), (texels, flags));
-                texels += r.width * r.height;
+                texels += rw * rh;
                 flags += r.tile_count();
                 continue;
             }
             prop_assert!(a.batch < c.batches);
-            prop_assert!(a.x + a.width <= c.atlas_side && a.y + a.height <= c.atlas_side);
+            let (aw, ah) = capture::region(a.width, a.height);
+            prop_assert!(a.x + aw <= c.atlas_side && a.y + ah <= c.atlas_side);
             let r = &plan.accumulate.records[a.record as usize];
             prop_assert_eq!((r.atlas_x, r.atlas_y, r.batch), (a.x, a.y, a.batch));
             prop_assert_eq!((r.width, r.height), (a.width, a.height));
             prop_assert_eq!((r.scratch, r.tiles), (texels, flags));
             prop_assert_eq!(c.views[k].offset, r.scratch);
-            texels += r.width * r.height;
+            texels += aw * ah;
             flags += r.tile_count();
             for b in &c.surfaces[k + 1..] {
+                let (bw, bh) = capture::region(b.width, b.height);
                 let apart = a.batch != b.batch
-                    || a.x + a.width <= b.x
-                    || b.x + b.width <= a.x
-                    || a.y + a.height <= b.y
-                    || b.y + b.height <= a.y;
+                    || a.x + aw <= b.x
+                    || b.x + bw <= a.x
+                    || a.y + ah <= b.y
+                    || b.y + bh <= a.y;
                 prop_assert!(apart, "{:?} and {:?} overlap", a, b);
             }
         }
