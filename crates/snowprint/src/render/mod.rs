@@ -406,7 +406,7 @@ impl Renderer {
             },
         );
         self.copy_stats(&mut encoder, surfaces);
-        let mut laps = Laps::start();
+        let mut laps = report::Laps::start();
         let commands = encoder.finish();
         laps.mark("finish");
         self.queue.submit([commands]);
@@ -588,7 +588,7 @@ impl Renderer {
         format: wgpu::TextureFormat,
     ) -> RenderResult<Vec<SurfaceId>> {
         frame.check(self.meshes.meshes.len())?;
-        let mut laps = Laps::start();
+        let mut laps = report::Laps::start();
         let view = world.frame_view();
         let tessellated_tier = self.config.tier == Tier::Tessellated;
         let surfaces = frame_surfaces(
@@ -779,28 +779,4 @@ fn frame_surfaces<'a>(
             })
         })
         .collect()
-}
-
-/// CPU steps of a frame, each timed from the end of the one before.
-struct Laps {
-    phases: Vec<CpuPhase>,
-    last: Instant,
-}
-
-impl Laps {
-    fn start() -> Self {
-        Self {
-            phases: Vec::with_capacity(12),
-            last: Instant::now(),
-        }
-    }
-
-    fn mark(&mut self, name: &'static str) {
-        let now = Instant::now();
-        self.phases.push(CpuPhase {
-            name,
-            ms: (now - self.last).as_secs_f64() * 1e3,
-        });
-        self.last = now;
-    }
 }

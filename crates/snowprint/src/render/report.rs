@@ -118,3 +118,27 @@ pub struct ShadowStats {
     /// texel the view would need there for one texel a pixel.
     pub view_pixel_m: f32,
 }
+
+/// CPU steps of a frame, each timed from the end of the one before.
+pub(super) struct Laps {
+    pub phases: Vec<CpuPhase>,
+    last: std::time::Instant,
+}
+
+impl Laps {
+    pub(super) fn start() -> Self {
+        Self {
+            phases: Vec::with_capacity(12),
+            last: std::time::Instant::now(),
+        }
+    }
+
+    pub(super) fn mark(&mut self, name: &'static str) {
+        let now = std::time::Instant::now();
+        self.phases.push(CpuPhase {
+            name,
+            ms: (now - self.last).as_secs_f64() * 1e3,
+        });
+        self.last = now;
+    }
+}
