@@ -97,6 +97,8 @@ pub(super) struct ShadowCaster<'a> {
     pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
     pub constant: &'a str,
     pub format: wgpu::TextureFormat,
+    /// Which faces are drawn.
+    pub primitive: wgpu::PrimitiveState,
 }
 
 impl ShadowCaster<'_> {
@@ -115,7 +117,7 @@ impl ShadowCaster<'_> {
                     },
                     buffers: self.buffers,
                 },
-                primitive: wgpu::PrimitiveState::default(),
+                primitive: self.primitive,
                 depth_stencil: shadow_depth_state(self.format),
                 multisample: wgpu::MultisampleState::default(),
                 fragment: None,

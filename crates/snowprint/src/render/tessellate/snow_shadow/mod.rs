@@ -104,6 +104,8 @@ impl TessSurface {
             buffers: &buffers,
             constant: "TESS_SHADOW_CASCADE",
             format: shadow_format,
+            // Skirts face outwards whichever way a mesh is wound: no culling.
+            primitive: wgpu::PrimitiveState::default(),
         }
         .build(device);
         Self {
