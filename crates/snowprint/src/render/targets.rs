@@ -140,6 +140,27 @@ impl Targets {
         })]
     }
 
+    /// The visibility path's attachments of the basic snow: the scene colour and the visibility
+    /// buffer, loaded; `None` on the forward path.
+    pub(super) fn snow_basic_visible(
+        &self,
+    ) -> Option<[Option<wgpu::RenderPassColorAttachment<'_>>; 2]> {
+        let v = self.visibility_view.as_ref()?;
+        let [color] = self.color(wgpu::LoadOp::Load);
+        Some([
+            color,
+            Some(wgpu::RenderPassColorAttachment {
+                view: v,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                },
+            }),
+        ])
+    }
+
     /// The visibility path's attachments of the deformable snow: the visibility buffer and the
     /// snow's hits, loaded (a pixel's hit is read only where the snow wrote it this frame, which
     /// its depth tells); `None` on the forward path.

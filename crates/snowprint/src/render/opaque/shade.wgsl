@@ -48,8 +48,10 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let ids = textureLoad(visibility, id.xy, 0).xyz;
-    // Nothing drawn here (NO_TRIANGLE), or the snow's hit (shaded by the snow pass).
-    if (ids.x & SNOW_VISIBLE) != 0u || textureLoad(scene_depth, id.xy, 0) != bitcast<f32>(ids.z) {
+    // Nothing to shade here (NO_TRIANGLE), or the snow's hit (shaded by the snow pass); where
+    // nothing was drawn (depth 1) the buffer holds an earlier frame's words.
+    let depth = textureLoad(scene_depth, id.xy, 0);
+    if (ids.x & SNOW_VISIBLE) != 0u || depth != bitcast<f32>(ids.z) || depth >= 1.0 {
         return;
     }
     let inst = instances[ids.x];

@@ -111,7 +111,10 @@ impl VisibilityPass {
         self.current = Some(([raster, shade, outputs], (t.width(), t.height())));
     }
 
-    /// Clear depth and the visibility target, then draw every instance into them.
+    /// Clear depth, then draw every instance into it and the visibility target. The visibility
+    /// target is not cleared (on the H100 that took 0.6 ms at 1080p): every fragment that writes
+    /// the scene's depth before the shading passes writes it too (the snow's basic material a
+    /// word that nothing is to be shaded), and where nothing was drawn the depth says so.
     pub(super) fn encode_raster(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -124,7 +127,6 @@ impl VisibilityPass {
         let Some(visibility) = &targets.visibility_view else {
             return;
         };
-        let none = u32::MAX as f64;
         let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(PASSES[slot].name),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -132,12 +134,7 @@ impl VisibilityPass {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: none,
-                        g: none,
-                        b: none,
-                        a: none,
-                    }),
+                    load: wgpu::LoadOp::Load,
                     store: wgpu::StoreOp::Store,
                 },
             })],

@@ -257,9 +257,15 @@ impl SnowPass {
         let scene = targets.color(wgpu::LoadOp::Load);
         let visible = self.visible.as_ref().zip(targets.snow_visible());
         {
+            // On the visibility path the basic material tells the visibility buffer too.
+            let basic_visible = visible.as_ref().zip(targets.snow_basic_visible());
+            let (attachments, basic): (&[_], _) = match &basic_visible {
+                Some(((v, _), attachments)) => (attachments, &v.basic),
+                None => (&scene, &self.basic),
+            };
             let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(PASSES[slot].name),
-                color_attachments: &scene,
+                color_attachments: attachments,
                 depth_stencil_attachment: targets.depth(KEEP),
                 // The pass's time spans this render pass and the tessellated one after it.
                 timestamp_writes: render_span(ts, slot, true, false),
@@ -267,7 +273,7 @@ impl SnowPass {
                 multiview_mask: None,
             });
             p.set_bind_group(0, frame, &[]);
-            p.set_pipeline(&self.basic);
+            p.set_pipeline(basic);
             self.draw_each(&mut p, state, STATE_BASIC_DRAW, |_| true);
             if visible.is_none() {
                 self.draw_deformable(&mut p, state, [&self.deformable_outside, &self.deformable]);

@@ -387,7 +387,9 @@ fn shade_deformable(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let v = textureLoad(visibility, p, 0);
     let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
-    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) != bitcast<f32>(v.y) {
+    let depth = textureLoad(scene_depth, p, 0);
+    // Where nothing was drawn (depth 1) the buffer holds an earlier frame's words.
+    if (v.x & id_bits) != snow_visible_id(surface.index) || depth != bitcast<f32>(v.y) || depth >= 1.0 {
         return;
     }
     let h = textureLoad(snow_hits, p, 0);
@@ -469,6 +471,31 @@ fn fs_basic(in: SurfaceVarying) -> @location(0) vec4<f32> {
     if snow_in_hole(surface, in.local.xz) {
         discard;
     }
+    return basic_color(in, pixel);
+}
+
+struct BasicVisible {
+    @location(0) color: vec4<f32>,
+    // Nothing for the compute passes to shade here (the visibility buffer is not cleared: every
+    // fragment that writes the scene's depth before them writes it).
+    @location(1) visibility: vec4<u32>,
+}
+
+// The basic material on the visibility path: its colour, and the visibility buffer told that the
+// pixel is shaded.
+@fragment
+fn fs_basic_visible(in: SurfaceVarying) -> BasicVisible {
+    let pixel = length(fwidth(in.local));
+    if snow_in_hole(surface, in.local.xz) {
+        discard;
+    }
+    var out: BasicVisible;
+    out.color = basic_color(in, pixel);
+    out.visibility = vec4<u32>(0xffffffffu);
+    return out;
+}
+
+fn basic_color(in: SurfaceVarying, pixel: f32) -> vec4<f32> {
     let m = snow_basic(surface, in.local, in.face, sky_tint(), pixel);
     var c = shade(m, in.local, 1.0, pixel);
     switch frame.options.x {

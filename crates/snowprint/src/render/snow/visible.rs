@@ -26,6 +26,8 @@ pub(crate) const SLOTS: usize = 1 << (30 - crate::wgsl::consts::SNOW_SLOT_SHIFT)
 
 /// The pipelines of the snow pass's visibility path.
 pub(super) struct VisiblePath {
+    /// The basic material, its colour and a word that nothing is to be shaded.
+    pub basic: wgpu::RenderPipeline,
     /// The deformable material's trace, both sides of the box.
     pub deformable: wgpu::RenderPipeline,
     /// The same, front faces only (a box seen from outside).
@@ -69,6 +71,22 @@ impl VisiblePath {
             }
             .build(device)
         };
+        let basic = pipeline::Raster {
+            label: "snow basic (visibility)",
+            module: m.plain,
+            vs: "vs_surface",
+            fs: "fs_basic_visible",
+            buffers: &[],
+            groups: &groups,
+            primitive: pipeline::back_culled(),
+            depth: pipeline::depth_state(wgpu::CompareFunction::LessEqual, true),
+            targets: &[
+                pipeline::hdr_target()[0].clone(),
+                pipeline::visibility_targets()[0].clone(),
+            ],
+            constants: &[],
+        }
+        .build(device);
         let deformable = raster(
             "snow deformable (visibility)",
             m.plain,
@@ -98,6 +116,7 @@ impl VisiblePath {
             cache: None,
         });
         Self {
+            basic,
             deformable,
             deformable_outside,
             shade,

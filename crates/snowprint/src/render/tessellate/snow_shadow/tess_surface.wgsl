@@ -197,7 +197,8 @@ fn shade_tess(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let v = textureLoad(visibility, p, 0);
     let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
-    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) != bitcast<f32>(v.y) {
+    let depth = textureLoad(scene_depth, p, 0);
+    if (v.x & id_bits) != snow_visible_id(surface.index) || depth != bitcast<f32>(v.y) || depth >= 1.0 {
         return;
     }
     let h = textureLoad(snow_hits, p, 0);
