@@ -194,12 +194,18 @@ fn scrolling_by_k_columns_writes_exactly_the_entering_strip() {
 
 /// The same walk on a level stored wrapped (offsets (13, 7) after a scroll) and on an ordinary
 /// surface of the same rectangle and layout: the same logical heightmap bit for bit, and the
-/// level's storage is the surface's rotated by the offsets.
+/// level's storage is the surface's rotated by the offsets. Also while snow refills the prints
+/// (the tiles the walk does not reach refill as a stream over the stored words, whose texels and
+/// tiles are found through the offsets).
 #[test]
 fn wrapped_and_unwrapped_storage_give_the_same_logical_heightmap() {
-    for p in [Precision::Bits8, Precision::Bits16, Precision::Bits32] {
+    let cases = [Precision::Bits8, Precision::Bits16, Precision::Bits32]
+        .into_iter()
+        .flat_map(|p| [(p, 0.0), (p, 0.05)]);
+    for (p, rate) in cases {
         let (mut a, mut b) = (world(p), world(p));
-        let desc = terrain("wrapped", &[([64, 48], 0.04)]);
+        let mut desc = terrain("wrapped", &[([64, 48], 0.04)]);
+        desc.replenish_rate = rate;
         let mut t = Terrain::new(&mut a, desc, Vec3::new(-5.0, 0.0, 3.0)).unwrap();
         // A window whose first world texel is (14, 7): stored with offsets (14, 7).
         let focus = Vec3::new((14.0 + 32.0) * 0.04, 0.0, (7.0 + 24.0) * 0.04);
