@@ -64,10 +64,12 @@ pub struct Args {
     /// tessellated (real displaced geometry diced on the GPU, banks, the snow in the shadow map).
     #[arg(long, default_value = "relief")]
     pub tier: Tier,
-    /// How opaque meshes are drawn: forward (shaded per fragment) or visibility (a visibility
-    /// buffer of depth and triangle ids, shaded in a compute pass).
-    #[arg(long, default_value = "forward")]
-    pub opaque: OpaquePath,
+    /// How the scene is shaded: forward (per fragment) or visibility (the opaque meshes' and the
+    /// snow's hits in a visibility buffer, shaded in compute passes, which on GPUs with few
+    /// graphics units costs far less: `docs/PERFORMANCE.md`). Default: visibility on a GPU,
+    /// forward on a software adapter (the goldens' path). The report's `opaque` says which.
+    #[arg(long)]
+    pub opaque: Option<OpaquePath>,
     /// Samples per pixel along each axis, 1 to 4 (default: 2 on a GPU, 1 on a software adapter).
     #[arg(long, allow_negative_numbers = true)]
     pub supersample: Option<u32>,
@@ -267,7 +269,11 @@ impl Settings {
         let mut config = RenderConfig::new(self.width, self.height, args.tier);
         config.supersample = self.supersample;
         config.debug_view = args.debug_view;
-        config.opaque = args.opaque;
+        config.opaque = args.opaque.unwrap_or(if self.software {
+            OpaquePath::Forward
+        } else {
+            OpaquePath::Visibility
+        });
         if self.software {
             config.snowflakes = 3000;
         }
@@ -610,7 +616,7 @@ impl Demo<'_> {
             "supersample": settings.supersample,
             "frames": settings.frames,
             "tier": args.tier,
-            "opaque": args.opaque,
+            "opaque": self.renderer.config().opaque,
             "camera": args.camera,
             "debug_view": args.debug_view,
             "scene": self.scene.name(),
@@ -659,7 +665,7 @@ mod tests {
             size: Some((64, 36)),
             camera: "closeup".into(),
             tier: Tier::Pom,
-            opaque: OpaquePath::Forward,
+            opaque: None,
             supersample: Some(1),
             debug_view: DebugView::Shaded,
             no_snowfall: false,
@@ -750,11 +756,17 @@ mod tests {
         assert_eq!(report["tier"], "pom");
         assert_eq!(report["camera"], "closeup");
         assert!(report["adapter"]["name"].is_string());
-        // The goldens' 32-bit shadow depth on a software adapter, half the bytes on a GPU.
+        // The goldens' forward path and 32-bit shadow depth on a software adapter; on a GPU the
+        // visibility buffer and half the shadow map's bytes.
         let software = report["adapter"]["software"].as_bool().unwrap();
+        let expected = if software {
+            serde_json::json!(["forward", 32])
+        } else {
+            serde_json::json!(["visibility", 16])
+        };
         assert_eq!(
-            report["shadow_depth_bits"],
-            if software { 32 } else { 16 },
+            serde_json::json!([report["opaque"], report["shadow_depth_bits"]]),
+            expected,
             "{software}"
         );
         // Nobody walks on the street (surface 0) of the demo world: the basic material.
