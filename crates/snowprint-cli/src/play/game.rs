@@ -165,6 +165,11 @@ impl App {
         config.debug_view = args.debug_view;
         if software {
             config.snowflakes = 3000;
+        } else {
+            // As `snowprint demo` on a GPU: the scene shaded in compute through the visibility
+            // buffer, and half the shadow map's bytes.
+            config.opaque = snowprint::render::OpaquePath::Visibility;
+            config.shadow_depth_bits = 16;
         }
         let mut world = SnowWorld::new(
             &gfx.ctx,
