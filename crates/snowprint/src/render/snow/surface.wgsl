@@ -4,9 +4,12 @@
 // top, and always with the deformable material) in its local frame; every fragment of the
 // deformable material traces its view ray through the heightfield (snow.wgsl) and writes the depth
 // of the point it hits, so characters standing in prints and bodies lying in trenches are hidden
-// and shown correctly.
+// and shown correctly. On the visibility path (`fs_deformable_visible`, `fs_basic_visible`) the
+// fragments write the hit into the visibility buffer and the hits target instead, and the compute
+// entry `shade_deformable` (the `snow_shade` pass) shades it.
 // Reads: frame uniforms, shadow map, the surface's heightfield texture (heightfield.wgsl), the
-// world's ground fields. Writes: scene colour (HDR) and depth.
+// world's ground fields; `shade_deformable`: the visibility buffer, the hits, the scene's depth.
+// Writes: scene colour (HDR) and depth; the visibility buffer and the hits.
 
 // import frame, snow, ground_texel
 

@@ -15,7 +15,9 @@
 // Imports surface.wgsl (and with it frame.wgsl and snow.wgsl): its bindings 0-4 of group 1 (the
 // bank texture and `bank_height`, the ground fields and `ground_at_uv` included) and its heightfield contract are reused.
 // Reads: frame uniforms, shadow map, the surface's heightfield, light and bank textures, the
-// surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade.
+// surface state, diced vertices and indices. Writes: scene colour and depth, or a shadow cascade;
+// on the visibility path (`fs_tess_visible`) the visibility buffer and the hits, which `shade_tess`
+// shades into the scene colour.
 
 // import surface
 
