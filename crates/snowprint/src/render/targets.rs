@@ -9,10 +9,10 @@
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// The visibility buffer: instance, triangle, the depth written (as bits).
-pub(super) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
-/// The snow's hits on the visibility path: surface-local position and distance along the ray.
-pub(super) const SNOW_HITS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The visibility buffer: an opaque pixel's instance and triangle, or a snow hit's tagged slot and flags and its footprint (`snow/visible.rs`).
+pub(super) const VISIBILITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+/// The snow's hits on the visibility path, as bits: the surface-local point and the self-shadow (or, diced, the slope as two halves).
+pub(super) const SNOW_HITS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 pub(super) const HEIGHTFIELD_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 pub(super) struct Targets {

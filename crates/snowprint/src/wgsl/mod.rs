@@ -135,8 +135,6 @@ pub const OVERRIDES: &[(&str, &str, Override)] = &[
         Override::FilterableIfSupported,
     ),
     ("surface", "heightfield_light", Override::Stages(FRAGMENT)),
-    // The visibility path's snow hits (Rgba32Float), read with textureLoad.
-    ("surface", "snow_hits", Override::NotFiltering),
     // Bank heights, read with textureLoad (bilinear by hand, as in the tessellated tier).
     ("surface", "bank_texture", Override::NotFiltering),
     // The tessellated tier shares the snow pass's bindings with both stages, and with compute

@@ -47,11 +47,10 @@ fn shade(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= size.x || id.y >= size.y {
         return;
     }
-    let ids = textureLoad(visibility, id.xy, 0).xyz;
+    let ids = textureLoad(visibility, id.xy, 0).xy;
     // Nothing to shade here (NO_TRIANGLE), or the snow's hit (shaded by the snow pass); where
     // nothing was drawn (depth 1) the buffer holds an earlier frame's words.
-    let depth = textureLoad(scene_depth, id.xy, 0);
-    if (ids.x & SNOW_VISIBLE) != 0u || depth != bitcast<f32>(ids.z) || depth >= 1.0 {
+    if (ids.x & SNOW_VISIBLE) != 0u || textureLoad(scene_depth, id.xy, 0) >= 1.0 {
         return;
     }
     let inst = instances[ids.x];

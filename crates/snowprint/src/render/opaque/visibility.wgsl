@@ -23,8 +23,7 @@ fn vs_visibility(@builtin(vertex_index) vertex: u32, @builtin(instance_index) in
 }
 
 @fragment
-fn fs_visibility(in: VisibilityVarying) -> @location(0) vec4<u32> {
-    // The depth as the depth target stores it (`Depth32Float`, no bias): the shading, after the
-    // snow, shades the pixel only if the snow left this depth in place.
-    return vec4<u32>(in.ids, bitcast<u32>(in.clip.z), 0u);
+fn fs_visibility(in: VisibilityVarying) -> @location(0) vec2<u32> {
+    // Whatever draws over this pixel later (the snow) writes the buffer too.
+    return in.ids;
 }

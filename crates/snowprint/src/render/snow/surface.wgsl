@@ -330,10 +330,10 @@ fn shade_hit(hit: SnowHit, face: vec3<f32>, pixel: f32) -> vec3<f32> {
 // (on GPUs with few graphics units, the shading costs far more in a fragment than in compute).
 struct SnowVisible {
     // (SNOW_VISIBLE | slot << SNOW_SLOT_SHIFT | taps << 5 | water << 4 | side << 3 | face,
-    // depth bits, pixel footprint bits, self-shadow bits)
-    @location(0) visibility: vec4<u32>,
-    // The hit, surface-local, and its distance along the ray.
-    @location(1) hit: vec4<f32>,
+    // pixel footprint bits)
+    @location(0) visibility: vec2<u32>,
+    // The hit, surface-local, and its self-shadow, as bits.
+    @location(1) hit: vec4<u32>,
     @builtin(frag_depth) depth: f32,
 }
 
@@ -344,13 +344,8 @@ fn fs_deformable_visible(in: SurfaceVarying, @builtin(front_facing) front: bool)
     var out: SnowVisible;
     out.depth = hit_depth(hit);
     let flags = min(hit.taps, 255u) << 5u | (hit.water & 1u) << 4u | (hit.side & 1u) << 3u | face_code(in.face);
-    out.visibility = vec4<u32>(
-        snow_visible_id(surface.index) | flags,
-        bitcast<u32>(out.depth),
-        bitcast<u32>(pixel),
-        bitcast<u32>(hit.shadow),
-    );
-    out.hit = vec4<f32>(hit.position, hit.t);
+    out.visibility = vec2<u32>(snow_visible_id(surface.index) | flags, bitcast<u32>(pixel));
+    out.hit = vec4<u32>(bitcast<vec3<u32>>(hit.position), bitcast<u32>(hit.shadow));
     return out;
 }
 
@@ -372,7 +367,7 @@ fn face_normal(code: u32) -> vec3<f32> {
 }
 
 @group(2) @binding(0) var visibility: texture_2d<u32>;
-@group(2) @binding(1) var snow_hits: texture_2d<f32>;
+@group(2) @binding(1) var snow_hits: texture_2d<u32>;
 @group(2) @binding(2) var scene_color: texture_storage_2d<rgba16float, write>;
 @group(2) @binding(3) var scene_depth: texture_depth_2d;
 // Per surface slot: the rectangle of pixels [x0, x1) x [y0, y1) its box covers on screen.
@@ -380,7 +375,8 @@ fn face_normal(code: u32) -> vec3<f32> {
 
 // The visibility buffer's snow, shaded: one dispatch per relief-mapped surface over the
 // rectangle its box covers, each pixel shaded only where the visibility buffer holds this
-// surface's hit and the scene's depth is still the depth that hit wrote.
+// surface's hit (every fragment that writes the scene's depth before this pass writes the
+// buffer too, so it holds what the scene shows wherever something was drawn).
 @compute @workgroup_size(8, 8, 1)
 fn shade_deformable(@builtin(global_invocation_id) id: vec3<u32>) {
     let rect = shade_rects[surface.index];
@@ -388,23 +384,22 @@ fn shade_deformable(@builtin(global_invocation_id) id: vec3<u32>) {
     if p.x >= rect.z || p.y >= rect.w {
         return;
     }
-    let v = textureLoad(visibility, p, 0);
+    let v = textureLoad(visibility, p, 0).xy;
     let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
-    let depth = textureLoad(scene_depth, p, 0);
     // Where nothing was drawn (depth 1) the buffer holds an earlier frame's words.
-    if (v.x & id_bits) != snow_visible_id(surface.index) || depth != bitcast<f32>(v.y) || depth >= 1.0 {
+    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) >= 1.0 {
         return;
     }
     let h = textureLoad(snow_hits, p, 0);
     var hit: SnowHit;
-    hit.position = h.xyz;
-    hit.t = h.w;
+    hit.position = bitcast<vec3<f32>>(h.xyz);
+    hit.t = 0.0;
     hit.found = 1u;
     hit.taps = (v.x >> 5u) & 255u;
     hit.water = (v.x >> 4u) & 1u;
     hit.side = (v.x >> 3u) & 1u;
-    hit.shadow = bitcast<f32>(v.w);
-    textureStore(scene_color, p, vec4<f32>(shade_hit(hit, face_normal(v.x & 7u), bitcast<f32>(v.z)), 1.0));
+    hit.shadow = bitcast<f32>(h.w);
+    textureStore(scene_color, p, vec4<f32>(shade_hit(hit, face_normal(v.x & 7u), bitcast<f32>(v.y)), 1.0));
 }
 
 struct OnGround {
@@ -481,7 +476,7 @@ struct BasicVisible {
     @location(0) color: vec4<f32>,
     // Nothing for the compute passes to shade here (the visibility buffer is not cleared: every
     // fragment that writes the scene's depth before them writes it).
-    @location(1) visibility: vec4<u32>,
+    @location(1) visibility: vec2<u32>,
 }
 
 // The basic material on the visibility path: its colour, and the visibility buffer told that the
@@ -494,7 +489,7 @@ fn fs_basic_visible(in: SurfaceVarying) -> BasicVisible {
     }
     var out: BasicVisible;
     out.color = basic_color(in, pixel);
-    out.visibility = vec4<u32>(0xffffffffu);
+    out.visibility = vec2<u32>(0xffffffffu);
     return out;
 }
 

@@ -162,11 +162,11 @@ fn tess_shade(local: vec3<f32>, outward: vec4<f32>, pixel: f32) -> vec3<f32> {
 
 // The diced snow on the visibility path (`OpaquePath::Visibility`): the fragment writes what
 // `tess_shade` reads into the visibility buffer (as surface.wgsl's `SnowVisible`: the tag and
-// slot, bit 3 set on skirts; the depth; the footprint; `outward.x`) and the hits target
-// (`local`, `outward.z`), and `shade_tess` shades it in compute.
+// slot, bit 3 set on skirts; the footprint) and the hits target (`local`, and `outward.xz` as two
+// halves: a slope or an axis), and `shade_tess` shades it in compute.
 struct TessVisible {
-    @location(0) visibility: vec4<u32>,
-    @location(1) hit: vec4<f32>,
+    @location(0) visibility: vec2<u32>,
+    @location(1) hit: vec4<u32>,
 }
 
 @fragment
@@ -178,13 +178,8 @@ fn fs_tess_visible(in: TessVarying) -> TessVisible {
     // The depth is the rasterised one (written by the fixed function, as the forward path's).
     var out: TessVisible;
     let skirt = select(0u, 8u, in.outward.w > 0.5);
-    out.visibility = vec4<u32>(
-        snow_visible_id(surface.index) | skirt,
-        bitcast<u32>(in.clip.z),
-        bitcast<u32>(pixel),
-        bitcast<u32>(in.outward.x),
-    );
-    out.hit = vec4<f32>(in.local, in.outward.z);
+    out.visibility = vec2<u32>(snow_visible_id(surface.index) | skirt, bitcast<u32>(pixel));
+    out.hit = vec4<u32>(bitcast<vec3<u32>>(in.local), pack2x16float(in.outward.xz));
     return out;
 }
 
@@ -197,13 +192,13 @@ fn shade_tess(@builtin(global_invocation_id) id: vec3<u32>) {
     if p.x >= rect.z || p.y >= rect.w {
         return;
     }
-    let v = textureLoad(visibility, p, 0);
+    let v = textureLoad(visibility, p, 0).xy;
     let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
-    let depth = textureLoad(scene_depth, p, 0);
-    if (v.x & id_bits) != snow_visible_id(surface.index) || depth != bitcast<f32>(v.y) || depth >= 1.0 {
+    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) >= 1.0 {
         return;
     }
     let h = textureLoad(snow_hits, p, 0);
-    let outward = vec4<f32>(bitcast<f32>(v.w), 0.0, h.w, select(0.0, 1.0, (v.x & 8u) != 0u));
-    textureStore(scene_color, p, vec4<f32>(tess_shade(h.xyz, outward, bitcast<f32>(v.z)), 1.0));
+    let xz = unpack2x16float(h.w);
+    let outward = vec4<f32>(xz.x, 0.0, xz.y, select(0.0, 1.0, (v.x & 8u) != 0u));
+    textureStore(scene_color, p, vec4<f32>(tess_shade(bitcast<vec3<f32>>(h.xyz), outward, bitcast<f32>(v.y)), 1.0));
 }
