@@ -1,6 +1,8 @@
 // shade.wgsl: the visibility buffer's shading, one thread a pixel of the scene, after the snow
-// pass: a pixel is shaded only where the scene's depth is still the depth its triangle wrote (the
-// snow drew over the rest, and the sky fills what nothing covers). The pixel's triangle is
+// pass: a pixel is shaded only where the buffer still holds an opaque triangle (every fragment
+// that writes depth before this pass writes the buffer too: the snow replaced the triangles it
+// drew over; where nothing was drawn, depth 1, the buffer is an earlier frame's and is not read,
+// and the sky fills it). The pixel's triangle is
 // fetched again (`geometry.wgsl`), cut by the pixel's view ray (and its neighbours'
 // rays, for the footprint the forward pass takes from `fwidth`), its normal interpolated by the
 // hit's barycentrics (perspective-correct, as a rasteriser's), and the point shaded by

@@ -1,8 +1,8 @@
 //! The visibility path of the `opaque` pass (`OpaquePath::Visibility`): `visibility.wgsl`
-//! rasterises the meshes into depth and an `Rgba32Uint` target of (instance, triangle, depth),
-//! then, after the snow pass, the `opaque_shade` compute pass (`shade.wgsl`) shades the pixels
-//! where an opaque triangle is still what the scene shows, with the forward path's shading
-//! function.
+//! rasterises the meshes into depth and an `Rg32Uint` target of (instance, triangle), then,
+//! after the snow pass (which writes the buffer where it draws), the `opaque_shade` compute pass
+//! (`shade.wgsl`) shades the pixels where an opaque triangle is still what the buffer holds, with
+//! the forward path's shading function.
 
 use super::super::graph::PASSES;
 use super::super::meshes::{DrawSet, MeshSet};

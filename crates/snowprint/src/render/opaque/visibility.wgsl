@@ -1,5 +1,5 @@
 // visibility.wgsl: the opaque meshes into a visibility buffer: depth, and per pixel the instance
-// and triangle seen and the depth written (an `Rgba32Uint` target), nothing shaded. Vertices are pulled from storage
+// and triangle seen (an `Rg32Uint` target), nothing shaded. Vertices are pulled from storage
 // (`geometry.wgsl`), so the triangle is the vertex's index over three; the clip position is the
 // forward pass's (`vs_mesh`), so both cover the same pixels at the same depths.
 // Reads: frame uniforms, meshes, instances. Writes: visibility, scene depth.
