@@ -33,12 +33,26 @@ pub(super) fn compute(
     entry: &str,
     groups: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
+    compute_with(device, label, (module, entry), groups, &[])
+}
+
+/// [`compute`] with override constants.
+pub(super) fn compute_with(
+    device: &wgpu::Device,
+    label: &str,
+    (module, entry): (&wgpu::ShaderModule, &str),
+    groups: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout: Some(&layout(device, label, groups)),
         module,
         entry_point: Some(entry),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
         cache: None,
     })
 }

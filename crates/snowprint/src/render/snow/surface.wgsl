@@ -373,24 +373,46 @@ fn face_normal(code: u32) -> vec3<f32> {
 // Per surface slot: the rectangle of pixels [x0, x1) x [y0, y1) its box covers on screen.
 @group(2) @binding(4) var<storage, read> shade_rects: array<vec4<u32>>;
 
+// A pixel of this surface's dispatch (invocation `at` of its rectangle) and what the visibility
+// buffer and the hits hold there; `mine` where that is this surface's hit. Where nothing was drawn
+// (depth 1) the buffer holds an earlier frame's words and is not read.
+struct VisibleSnow {
+    mine: bool,
+    pixel: vec2<u32>,
+    words: vec2<u32>,
+    hit: vec4<u32>,
+}
+
+fn visible_snow(at: vec2<u32>) -> VisibleSnow {
+    var s: VisibleSnow;
+    let rect = shade_rects[surface.index];
+    s.pixel = rect.xy + at;
+    if s.pixel.x >= rect.z || s.pixel.y >= rect.w {
+        return s;
+    }
+    s.words = textureLoad(visibility, s.pixel, 0).xy;
+    let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
+    s.mine = (s.words.x & id_bits) == snow_visible_id(surface.index)
+        && textureLoad(scene_depth, s.pixel, 0) < 1.0;
+    if s.mine {
+        s.hit = textureLoad(snow_hits, s.pixel, 0);
+    }
+    return s;
+}
+
 // The visibility buffer's snow, shaded: one dispatch per relief-mapped surface over the
 // rectangle its box covers, each pixel shaded only where the visibility buffer holds this
 // surface's hit (every fragment that writes the scene's depth before this pass writes the
 // buffer too, so it holds what the scene shows wherever something was drawn).
 @compute @workgroup_size(8, 8, 1)
 fn shade_deformable(@builtin(global_invocation_id) id: vec3<u32>) {
-    let rect = shade_rects[surface.index];
-    let p = rect.xy + id.xy;
-    if p.x >= rect.z || p.y >= rect.w {
+    let s = visible_snow(id.xy);
+    if !s.mine {
         return;
     }
-    let v = textureLoad(visibility, p, 0).xy;
-    let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
-    // Where nothing was drawn (depth 1) the buffer holds an earlier frame's words.
-    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) >= 1.0 {
-        return;
-    }
-    let h = textureLoad(snow_hits, p, 0);
+    let p = s.pixel;
+    let v = s.words;
+    let h = s.hit;
     var hit: SnowHit;
     hit.position = bitcast<vec3<f32>>(h.xyz);
     hit.t = 0.0;

@@ -99,22 +99,13 @@ impl VisiblePath {
         );
         let targets_layout =
             crate::wgsl::SURFACE.bind_group_layout(device, "snow shade targets", 2);
-        let layout = pipeline::layout(
+        let shade = pipeline::compute_with(
             device,
             "snow shade",
+            (m.plain, "shade_deformable"),
             &[m.frame_layout, m.surface_layout, &targets_layout],
+            m.constants,
         );
-        let shade = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("snow shade"),
-            layout: Some(&layout),
-            module: m.plain,
-            entry_point: Some("shade_deformable"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: m.constants,
-                ..Default::default()
-            },
-            cache: None,
-        });
         Self {
             basic,
             deformable,

@@ -76,22 +76,13 @@ impl TessSurface {
                 "fs_tess_visible",
                 &pipeline::visibility_targets(),
             );
-            let layout = pipeline::layout(
+            let shade = pipeline::compute_with(
                 device,
                 "snow shade (tessellated)",
+                (&module, "shade_tess"),
                 &[frame_layout, &layout, targets_layout],
+                pipeline::manual_filter(filterable),
             );
-            let shade = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("snow shade (tessellated)"),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some("shade_tess"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: pipeline::manual_filter(filterable),
-                    ..Default::default()
-                },
-                cache: None,
-            });
             (draw, shade)
         });
         let shadow_pipeline_layout =

@@ -187,18 +187,12 @@ fn fs_tess_visible(in: TessVarying) -> TessVisible {
 // `shade_deformable`, over the same rectangles and targets).
 @compute @workgroup_size(8, 8, 1)
 fn shade_tess(@builtin(global_invocation_id) id: vec3<u32>) {
-    let rect = shade_rects[surface.index];
-    let p = rect.xy + id.xy;
-    if p.x >= rect.z || p.y >= rect.w {
+    let s = visible_snow(id.xy);
+    if !s.mine {
         return;
     }
-    let v = textureLoad(visibility, p, 0).xy;
-    let id_bits = ~((1u << SNOW_SLOT_SHIFT) - 1u);
-    if (v.x & id_bits) != snow_visible_id(surface.index) || textureLoad(scene_depth, p, 0) >= 1.0 {
-        return;
-    }
-    let h = textureLoad(snow_hits, p, 0);
-    let xz = unpack2x16float(h.w);
-    let outward = vec4<f32>(xz.x, 0.0, xz.y, select(0.0, 1.0, (v.x & 8u) != 0u));
-    textureStore(scene_color, p, vec4<f32>(tess_shade(bitcast<vec3<f32>>(h.xyz), outward, bitcast<f32>(v.y)), 1.0));
+    let xz = unpack2x16float(s.hit.w);
+    let outward = vec4<f32>(xz.x, 0.0, xz.y, select(0.0, 1.0, (s.words.x & 8u) != 0u));
+    let c = tess_shade(bitcast<vec3<f32>>(s.hit.xyz), outward, bitcast<f32>(s.words.y));
+    textureStore(scene_color, s.pixel, vec4<f32>(c, 1.0));
 }
