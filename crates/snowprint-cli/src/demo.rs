@@ -120,6 +120,12 @@ pub struct Args {
     /// `shadow_depth_bits` says which.
     #[arg(long, value_parser = crate::args::depth_bits)]
     pub shadow_depth_bits: Option<u32>,
+    /// Draw every shadow caster each frame instead of keeping the still scenery's shadow depth
+    /// while the cascade holds still (`RenderConfig::shadow_cache`; the pictures are the same).
+    /// The report's `shadow_cache` says which, and `shadow_cache_frames` how many frames each
+    /// cascade copied its still casters in.
+    #[arg(long)]
+    pub no_shadow_cache: bool,
 }
 
 /// Statistics of one pass over the frames.
@@ -283,6 +289,7 @@ impl Settings {
         config.shadow_depth_bits =
             args.shadow_depth_bits
                 .unwrap_or(if self.software { 32 } else { 16 });
+        config.shadow_cache = !args.no_shadow_cache;
         config
     }
 
@@ -377,6 +384,8 @@ struct Measured {
     instances_count: usize,
     culled_last: usize,
     shadow_last: snowprint::render::ShadowStats,
+    /// Frames whose near and far cascades copied their still casters in from the cache.
+    cache_frames: [usize; 2],
     mp4: bool,
 }
 
@@ -428,6 +437,7 @@ impl Demo<'_> {
             instances_count: 0,
             culled_last: 0,
             shadow_last: Default::default(),
+            cache_frames: [0, 0],
             mp4: false,
         };
         for (k, &t) in clip.times.iter().enumerate() {
@@ -482,6 +492,9 @@ impl Demo<'_> {
             m.last_overflow = out.dice_overflow;
             m.culled_last = out.culled_instances;
             m.shadow_last = out.shadow;
+            for (n, &cached) in m.cache_frames.iter_mut().zip(&out.shadow.from_cache) {
+                *n += usize::from(cached);
+            }
             let image = image::RgbaImage::from_raw(out.width, out.height, out.rgba8)
                 .ok_or("the renderer returned a frame of the wrong size")?;
             if args.compare_tiers && k + 1 == clip.times.len() {
@@ -627,6 +640,8 @@ impl Demo<'_> {
             "shadow_map_size": self.renderer.config().shadow_map_size,
             "shadow_depth_bits": self.renderer.config().shadow_depth_bits,
             "shadow_last_frame": m.shadow_last,
+            "shadow_cache": self.renderer.config().shadow_cache,
+            "shadow_cache_frames": m.cache_frames,
             "search": renderer.config().search_settings(),
             "passes": renderer.passes(),
             "gpu_pass_times_ms": gpu_times,
@@ -677,6 +692,7 @@ mod tests {
             no_spray: false,
             shadow_map_size: None,
             shadow_depth_bits: None,
+            no_shadow_cache: false,
         }
     }
 

@@ -67,7 +67,8 @@ impl Yard {
             part_render,
             albedo,
             ball,
-            statics,
+            // The scenery stays where it is: its shadows are kept while the cascades hold still.
+            statics: statics.into_iter().map(|i| i.with_still(true)).collect(),
         })
     }
 

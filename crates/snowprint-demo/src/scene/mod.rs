@@ -13,6 +13,12 @@ pub mod standin;
 use snowprint::render::{Environment, Instance, PointLight, Renderer};
 use snowprint::{Camera, GroundMaterial, SnowWorld, SurfaceId};
 
+/// The scenery's instances marked as staying where they are ([`Instance::still`]): their shadows
+/// are kept from frame to frame while the moon's cascades hold still.
+pub(crate) fn held_still(statics: Vec<Instance>) -> Vec<Instance> {
+    statics.into_iter().map(|i| i.with_still(true)).collect()
+}
+
 /// A world the demo can simulate and draw. Built once (surfaces into the world, meshes into the
 /// renderer), then asked what happens at each moment.
 pub trait DemoScene {

@@ -178,7 +178,7 @@ impl Scenery {
         }
         Ok(Self {
             surfaces,
-            statics,
+            statics: super::held_still(statics),
             lights,
         })
     }

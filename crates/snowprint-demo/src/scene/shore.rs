@@ -131,7 +131,7 @@ impl Shore {
         ];
         Ok(Self {
             surfaces,
-            statics,
+            statics: super::held_still(statics),
             lights: vec![
                 // A lantern on the bank, warm, and one down the beach.
                 PointLight {

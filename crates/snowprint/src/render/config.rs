@@ -237,6 +237,10 @@ pub struct RenderConfig {
     /// half the bytes to clear and write; on the H100 at 1080p the shadow pass takes 1.9 ms
     /// instead of 3.1, `docs/PERFORMANCE.md`). Fixed when the renderer is made.
     pub shadow_depth_bits: u32,
+    /// Whether each shadow cascade keeps the depth of its still casters ([`Instance::still`](super::Instance::still))
+    /// while they and the cascade hold still, and copies it in each frame instead of clearing the
+    /// cascade and drawing them again (the default; the pictures are the same either way).
+    pub shadow_cache: bool,
     /// Falling flakes drawn when a frame asks for snowfall.
     pub snowflakes: u32,
     /// What the image shows.
@@ -261,6 +265,7 @@ impl RenderConfig {
             supersample: 1,
             shadow_map_size: 2048,
             shadow_depth_bits: 32,
+            shadow_cache: true,
             snowflakes: 6000,
             debug_view: DebugView::Shaded,
             search: None,

@@ -27,6 +27,9 @@ pub enum Resource {
     DicedMesh,
     /// The moon's shadow map.
     ShadowMap,
+    /// Per shadow cascade, its still casters' depth (`RenderConfig::shadow_cache`): written by
+    /// the shadow pass, which reads it and the shadow map again in later frames while they hold.
+    ShadowCache,
     /// The visibility buffer: per pixel of the scene, the opaque instance and triangle seen and
     /// the depth they wrote, or the relief-mapped snow's hit (`OpaquePath::Visibility`).
     Visibility,
@@ -148,7 +151,7 @@ pub const PASSES: [PassInfo; 14] = [
         name: "shadow",
         kind: PassKind::Render,
         reads: &[R::Instances, R::FrameUniforms],
-        writes: &[R::ShadowMap],
+        writes: &[R::ShadowMap, R::ShadowCache],
     },
     PassInfo {
         name: "snow_shadow",

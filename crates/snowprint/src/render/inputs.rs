@@ -131,6 +131,11 @@ pub struct Instance {
     pub snow_cover: f32,
     /// Whether it casts the moon's shadow.
     pub casts_shadow: bool,
+    /// Whether it stays where it is from frame to frame (buildings, props): its shadow may be
+    /// kept in a cascade's cache and copied in instead of drawn again
+    /// ([`RenderConfig::shadow_cache`](super::RenderConfig::shadow_cache)). A still instance that
+    /// does move, or changes its mesh, is still shadowed right: the cache is redrawn.
+    pub still: bool,
     /// Varies the procedural patterns between instances of the same material.
     pub seed: f32,
 }
@@ -147,6 +152,7 @@ impl Instance {
             emission: 0.0,
             snow_cover: 0.0,
             casts_shadow: true,
+            still: false,
             seed: 0.0,
         }
     }
@@ -170,6 +176,12 @@ impl Instance {
     /// The same instance with a shadow or without.
     pub fn with_shadow(mut self, casts_shadow: bool) -> Self {
         self.casts_shadow = casts_shadow;
+        self
+    }
+
+    /// The same instance marked as staying where it is, or as moving ([`Instance::still`]).
+    pub fn with_still(mut self, still: bool) -> Self {
+        self.still = still;
         self
     }
 

@@ -8,6 +8,7 @@ use super::error::{RenderError, RenderResult};
 use super::geometry;
 use super::gpu::{InstanceRaw, MeshVertexRaw};
 use super::inputs::{Instance, RenderMeshId};
+use super::shadow::sphere_rect;
 use crate::gpu::resources::Growable;
 use crate::mesh::Mesh;
 
@@ -21,11 +22,13 @@ pub(super) struct GpuMesh {
     pub source: (Vec<MeshVertexRaw>, Vec<u32>),
 }
 
-/// Which of the frame's draws: the opaque pass's, or a shadow cascade's casters.
+/// Which of the frame's draws: the opaque pass's, or a shadow cascade's still or moving casters
+/// ([`Instance::still`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum DrawSet {
     Opaque,
-    Cascade(usize),
+    Still(usize),
+    Moving(usize),
 }
 
 /// Draws of one mesh: its index and a range of instances.
@@ -37,8 +40,13 @@ pub(super) struct MeshSet {
     instances: Growable,
     /// This frame's draws: every instance, then the shadow casters.
     draws: Vec<Run>,
-    /// Per cascade of the moon's shadow map, the casters that reach it.
-    shadow_draws: [Vec<Run>; 2],
+    /// Per cascade of the moon's shadow map, the still casters that reach it, then the moving.
+    shadow_draws: [[Vec<Run>; 2]; 2],
+    /// Per cascade, what its still casters' depth depends on: their meshes and transforms, the
+    /// meshes' version and the cascade's projection (equal keys: the same depth).
+    pub still_keys: [Option<u64>; 2],
+    /// Per cascade, the texels its moving casters can cover (`shadow::sphere_rect`).
+    pub moving_rects: [Vec<[u32; 4]>; 2],
     /// The mesh of each instance of `draws`, in the instance buffer's order.
     pub instance_meshes: Vec<u32>,
     /// Instances of the frame outside the view, not drawn by the opaque pass.
@@ -63,7 +71,9 @@ impl MeshSet {
                 144 * 64,
             ),
             draws: Vec::new(),
-            shadow_draws: [Vec::new(), Vec::new()],
+            shadow_draws: Default::default(),
+            still_keys: [None; 2],
+            moving_rects: Default::default(),
             cascade_casters: [0, 0],
             instance_meshes: Vec::new(),
             culled: 0,
@@ -97,15 +107,15 @@ impl MeshSet {
     /// Upload the frame's instances: those the view may see (`cull::visible` against
     /// `view_proj`) grouped by mesh, then the shadow casters that reach each of the moon's
     /// cascades (`cascades`, world to each cascade's clip space: the same test against its box),
-    /// each cascade's grouped by mesh. A caster out of view can still shadow what is in it; one
-    /// wholly outside a cascade's box leaves no texel in it.
+    /// each cascade's grouped by mesh, the still ones first. A caster out of view can still shadow
+    /// what is in it; one wholly outside a cascade's box leaves no texel in it.
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         frame: &[Instance],
         view_proj: glam::Mat4,
-        cascades: [glam::Mat4; 2],
+        (cascades, shadow_size): ([glam::Mat4; 2], u32),
     ) {
         let bounds = || {
             frame
@@ -142,8 +152,23 @@ impl MeshSet {
         self.draws = runs(&order, 0);
         self.instance_meshes = order.iter().map(|&i| frame[i].mesh.0).collect();
         for (cascade, ids) in casters.iter().enumerate() {
-            self.shadow_draws[cascade] = runs(ids, instances.len());
-            instances.extend(ids.iter().map(|&i| raw(&frame[i])));
+            let (still, moving): (Vec<usize>, Vec<usize>) =
+                ids.iter().partition(|&&i| frame[i].still);
+            self.still_keys[cascade] = (!still.is_empty())
+                .then(|| still_key(frame, &still, self.version, cascades[cascade]));
+            self.moving_rects[cascade] = moving
+                .iter()
+                .filter_map(|&i| {
+                    let (scale, _, at) = frame[i].transform.to_scale_rotation_translation();
+                    let radius = self.meshes[frame[i].mesh.0 as usize].radius;
+                    let radius = radius * scale.abs().max_element();
+                    sphere_rect(cascades[cascade], at, radius, shadow_size)
+                })
+                .collect();
+            for (k, ids) in [still, moving].iter().enumerate() {
+                self.shadow_draws[cascade][k] = runs(ids, instances.len());
+                instances.extend(ids.iter().map(|&i| raw(&frame[i])));
+            }
         }
         if !instances.is_empty() {
             self.instances
@@ -160,7 +185,8 @@ impl MeshSet {
     fn runs(&self, set: DrawSet) -> &[Run] {
         match set {
             DrawSet::Opaque => &self.draws,
-            DrawSet::Cascade(c) => &self.shadow_draws[c],
+            DrawSet::Still(c) => &self.shadow_draws[c][0],
+            DrawSet::Moving(c) => &self.shadow_draws[c][1],
         }
     }
 
@@ -187,6 +213,21 @@ impl MeshSet {
             p.draw_indexed(0..m.index_count, 0, range.clone());
         }
     }
+}
+
+/// What the depth of a cascade's still casters (`ids` of `frame`) depends on, hashed: each one's
+/// mesh and transform, the registered meshes' `version` and the cascade's `projection`.
+fn still_key(frame: &[Instance], ids: &[usize], version: u64, projection: glam::Mat4) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    version.hash(&mut h);
+    let bits = |m: &glam::Mat4| m.to_cols_array().map(f32::to_bits);
+    bits(&projection).hash(&mut h);
+    for &i in ids {
+        frame[i].mesh.0.hash(&mut h);
+        bits(&frame[i].transform).hash(&mut h);
+    }
+    h.finish()
 }
 
 /// The instance as the mesh pipelines read it.

@@ -7,7 +7,7 @@
 //! |---|---|---|
 //! | `classify` (compute) | heightmap pool, surface table | surface state: material flag, indirect args |
 //! | `heightfield` (compute, indirect) | pool, surface state | per deformed surface: depression, normal, AO texture |
-//! | `shadow` | instances | the moon's shadow map |
+//! | `shadow` | instances, each cascade's cache of still casters | the moon's shadow map (restored from the caches where they hold) |
 //! | `opaque` | instances in view, shadow map | scene colour (HDR), depth; or depth and the visibility buffer ([`OpaquePath::Visibility`]) |
 //! | `snow` (indirect) | surface state, heightfields, shadow map | scene colour, depth (on the visibility path: the deformable and diced snow's hits into the visibility buffer) |
 //! | `snow_shade` (compute) | visibility buffer, hits, heightfields, shadow map, depth | scene colour where the snow's hit is visible (empty on the forward path) |
@@ -25,7 +25,7 @@
 //! by the heightmap, normals by Reoriented Normal Mapping, the transition tinted with the sky. The
 //! choice is made on the GPU by `classify` and costs no readback; [`RenderOutput`] reports it.
 //!
-//! Each pass is a module with its WGSL beside it (`classify/`, `heightfield/`, `shadow`,
+//! Each pass is a module with its WGSL beside it (`classify/`, `heightfield/`, `shadow/`,
 //! `opaque/`, `snow/`, `tessellate/{banks,dice,snow_shadow}/`, `sky/`, `snowfall/`, `spray/`, `tonemap/`),
 //! owning its layouts, pipelines and buffers, with `new`, `prepare` (the frame's uploads and bind
 //! groups) and `encode`. What they share has small modules of its own: `frame/` (the frame
@@ -666,11 +666,16 @@ impl Renderer {
             queue,
             frame.instances,
             view_proj,
-            [shadow.near, shadow.far],
+            ([shadow.near, shadow.far], self.shadow.size),
         );
+        let snow_shadows = (self.snow).shadow_rects([shadow.near, shadow.far], self.shadow.size);
+        let enabled = self.config.shadow_cache;
+        (self.shadow).plan(device, queue, enabled, &mut self.meshes, snow_shadows);
         laps.mark("meshes");
         self.shadow_stats = ShadowStats {
             casters: self.meshes.cascade_casters,
+            from_cache: self.shadow.cached(),
+            restored_texels: self.shadow.restored_texels(),
             texel_m: [shadow.near_texel, shadow.far_texel],
             view_pixel_m: cascades::view_pixel(frame, self.config.height * self.config.supersample),
         };

@@ -59,18 +59,20 @@ pub(super) fn new_timestamps(device: &wgpu::Device, queue: &wgpu::Queue) -> Time
 }
 
 /// The timestamp writes of a pass's render passes: `begin` and `end` say whether this render
-/// pass opens or closes the pass's span (a pass of several render passes spans them all).
+/// pass opens or closes the pass's span (a pass of several render passes spans them all; one in
+/// the middle writes none).
 pub(super) fn render_span(
     ts: Option<&Timestamps>,
     slot: usize,
     begin: bool,
     end: bool,
 ) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-    ts.map(|t| wgpu::RenderPassTimestampWrites {
-        query_set: t.query_set(),
-        beginning_of_pass_write_index: begin.then_some(2 * slot as u32),
-        end_of_pass_write_index: end.then_some(2 * slot as u32 + 1),
-    })
+    ts.filter(|_| begin || end)
+        .map(|t| wgpu::RenderPassTimestampWrites {
+            query_set: t.query_set(),
+            beginning_of_pass_write_index: begin.then_some(2 * slot as u32),
+            end_of_pass_write_index: end.then_some(2 * slot as u32 + 1),
+        })
 }
 
 /// The timestamp writes of a pass that is one render pass.

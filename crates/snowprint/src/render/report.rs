@@ -112,6 +112,12 @@ pub struct RenderOutput {
 pub struct ShadowStats {
     /// Shadow casters drawn into the near and the far cascade (those whose bounds reach its box).
     pub casters: [usize; 2],
+    /// Whether each cascade's still casters came from its cache (copied in or restored, not
+    /// drawn).
+    pub from_cache: [bool; 2],
+    /// Texels of each cascade restored from its cache (where the frame before's moving casters
+    /// and displaced snow drew; overlaps counted twice).
+    pub restored_texels: [u64; 2],
     /// Side of a texel of the near and the far cascade, metres.
     pub texel_m: [f32; 2],
     /// Side of a pixel of the scene (supersampled) at the near cascade's focus, metres: the

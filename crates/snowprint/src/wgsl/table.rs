@@ -52,6 +52,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("mesh_visibility", "render/opaque/visibility.wgsl", true),
     ("mesh_shade", "render/opaque/shade.wgsl", true),
     ("sky", "render/sky/sky.wgsl", true),
+    ("shadow_restore", "render/shadow/restore.wgsl", true),
     ("snowfall", "render/snowfall/snowfall.wgsl", true),
     ("spray", "render/spray/spray.wgsl", true),
     ("tonemap_resolve", "render/tonemap/resolve.wgsl", false),

@@ -87,7 +87,7 @@ impl Mountain {
             };
             !near(&hiker) && !walkers.iter().any(near)
         };
-        let statics = props::build(renderer, clear)?;
+        let statics = crate::scene::held_still(props::build(renderer, clear)?);
         Ok(Self {
             valley,
             surfaces,

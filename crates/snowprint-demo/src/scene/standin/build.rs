@@ -89,7 +89,7 @@ impl StandIn {
         let lights = street_lamps(&set, &mut statics);
         Ok(Self {
             surfaces,
-            statics,
+            statics: crate::scene::held_still(statics),
             lights,
             people: people(),
             body,

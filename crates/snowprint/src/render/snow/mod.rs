@@ -36,6 +36,9 @@ pub(super) struct SnowPass {
     deformable_outside: wgpu::RenderPipeline,
     /// Per surface slot this frame: whether the eye is clearly outside its box.
     outside: Vec<bool>,
+    /// This frame's tessellated surfaces: each one's uniform and how far its snow may rise above
+    /// its box (what `snow_shadow` draws into the moon's cascades).
+    tessellated: Vec<(SurfaceUniform, f32)>,
     /// Per surface: `SurfaceUniform` in a uniform block (also bound by the tessellated draws).
     pub uniforms: Growable,
     /// This frame's group 1 per surface slot; `None` where the tessellated tier dices it.
@@ -133,6 +136,7 @@ impl SnowPass {
             deformable,
             deformable_outside,
             outside: Vec::new(),
+            tessellated: Vec::new(),
             bind_groups: Vec::new(),
             visible,
         }
@@ -156,6 +160,7 @@ impl SnowPass {
     ) {
         let search = cfg.search_settings();
         self.outside.clear();
+        self.tessellated.clear();
         let look = cfg.look;
         let stride = SURFACE_STRIDE as usize;
         let mut bytes = vec![0u8; surfaces.len().max(1) * stride];
@@ -173,6 +178,9 @@ impl SnowPass {
             };
             let u = SurfaceUniform::shaded(surface.view, &shading);
             self.outside.push(eye_outside_box(&u, eye));
+            if surface.tessellated {
+                self.tessellated.push((u, tessellated_rise(&u)));
+            }
             uniforms.push(u);
             bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
                 .copy_from_slice(bytemuck::bytes_of(&u));
@@ -216,6 +224,17 @@ impl SnowPass {
                 .collect();
             v.prepare(device, queue, targets, &uniforms, &shaded, view_proj);
         }
+    }
+
+    /// Per shadow cascade (world to its clip space, `cascades`), the texels of a `size` map that
+    /// this frame's displaced snow can cover.
+    pub(super) fn shadow_rects(&self, cascades: [glam::Mat4; 2], size: u32) -> [Vec<[u32; 4]>; 2] {
+        cascades.map(|m| {
+            self.tessellated
+                .iter()
+                .filter_map(|(u, rise)| visible::screen_rect(u, *rise, m, (size, size)))
+                .collect()
+        })
     }
 
     /// The layout of the visibility path's shading targets (`None` on the forward path).

@@ -64,6 +64,11 @@ fn bank_norm(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let c = i32(gid.x);
     let r = i32(gid.y);
+    // bank_gather reads N only where snow was displaced: elsewhere it is not summed.
+    if textureLoad(light, vec2<i32>(c, r), 0).g <= 0.0 {
+        textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
     var n = 0.0;
     for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
         for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
@@ -78,13 +83,36 @@ fn bank_norm(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(n, 0.0, 0.0, 1.0));
 }
 
+// Whether any texel within the reach of this workgroup's texels had snow displaced.
+var<workgroup> displaced_near: atomic<u32>;
+
 @compute @workgroup_size(8, 8, 1)
-fn bank_gather(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn bank_gather(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    // The workgroup first looks for displaced snow within reach of any of its texels, each lane
+    // a share of the neighbourhood: where there is none, every bank here is 0 (most of a
+    // surface, away from its trails), and the gather's taps are skipped.
+    let origin = vec2<i32>(group.xy * 8u) - vec2<i32>(bank.reach_x, bank.reach_z);
+    let span = vec2<i32>(8 + 2 * bank.reach_x, 8 + 2 * bank.reach_z);
+    for (var k = i32(lane); k < span.x * span.y; k += 64) {
+        let p = origin + vec2<i32>(k % span.x, k / span.x);
+        if inside(p.x, p.y) && textureLoad(light, p, 0).g > 0.0 {
+            atomicOr(&displaced_near, 1u);
+        }
+    }
+    workgroupBarrier();
     if gid.x >= bank.width || gid.y >= bank.height {
         return;
     }
     let c = i32(gid.x);
     let r = i32(gid.y);
+    if atomicLoad(&displaced_near) == 0u {
+        textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
     var sum = 0.0;
     for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
         for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
