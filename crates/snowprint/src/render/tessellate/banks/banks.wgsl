@@ -57,8 +57,51 @@ fn kernel(dc: i32, dr: i32) -> f32 {
     return (1.0 - q) * (1.0 - q);
 }
 
+// The texels within reach of a workgroup's 8 x 8 are read once into workgroup memory, and each
+// texel's sum reads them there, in the same order as from the textures (the same sums, bit for
+// bit); a reach beyond TILE_REACH texels reads the textures directly.
+const TILE_REACH: i32 = 18;
+const TILE_TEXELS: u32 = 1936u; // (8 + 2 * TILE_REACH)^2, 15.5 KB for both tiles
+var<workgroup> tile_a: array<f32, TILE_TEXELS>;
+var<workgroup> tile_b: array<f32, TILE_TEXELS>;
+// Whether any texel within the reach of this workgroup's texels had snow displaced.
+var<workgroup> displaced_near: atomic<u32>;
+
+// A workgroup's neighbourhood: its first texel less the reach, and its side.
+struct Neighbourhood {
+    origin: vec2<i32>,
+    span: vec2<i32>,
+    tiled: bool,
+}
+
+fn neighbourhood(group: vec3<u32>) -> Neighbourhood {
+    let reach = vec2<i32>(bank.reach_x, bank.reach_z);
+    let tiled = bank.reach_x <= TILE_REACH && bank.reach_z <= TILE_REACH;
+    return Neighbourhood(vec2<i32>(group.xy * 8u) - reach, vec2<i32>(8) + 2 * reach, tiled);
+}
+
+// Index in the tiles of texel `p` of the neighbourhood `n`.
+fn tile_index(n: Neighbourhood, p: vec2<i32>) -> u32 {
+    let q = p - n.origin;
+    return u32(q.y * n.span.x + q.x);
+}
+
 @compute @workgroup_size(8, 8, 1)
-fn bank_norm(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn bank_norm(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let hood = neighbourhood(group);
+    if hood.tiled {
+        for (var k = i32(lane); k < hood.span.x * hood.span.y; k += 64) {
+            let p = hood.origin + vec2<i32>(k % hood.span.x, k / hood.span.x);
+            if inside(p.x, p.y) {
+                tile_a[k] = receptivity(textureLoad(shape, p, 0).x);
+            }
+        }
+    }
+    workgroupBarrier();
     if gid.x >= bank.width || gid.y >= bank.height {
         return;
     }
@@ -75,7 +118,14 @@ fn bank_norm(@builtin(global_invocation_id) gid: vec3<u32>) {
             if inside(c + dc, r + dr) {
                 let k = kernel(dc, dr);
                 if k > 0.0 {
-                    n += k * receptivity(textureLoad(shape, vec2<i32>(c + dc, r + dr), 0).x);
+                    let p = vec2<i32>(c + dc, r + dr);
+                    var m: f32;
+                    if hood.tiled {
+                        m = tile_a[tile_index(hood, p)];
+                    } else {
+                        m = receptivity(textureLoad(shape, p, 0).x);
+                    }
+                    n += k * m;
                 }
             }
         }
@@ -83,24 +133,27 @@ fn bank_norm(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(n, 0.0, 0.0, 1.0));
 }
 
-// Whether any texel within the reach of this workgroup's texels had snow displaced.
-var<workgroup> displaced_near: atomic<u32>;
-
 @compute @workgroup_size(8, 8, 1)
 fn bank_gather(
     @builtin(global_invocation_id) gid: vec3<u32>,
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    // The workgroup first looks for displaced snow within reach of any of its texels, each lane
-    // a share of the neighbourhood: where there is none, every bank here is 0 (most of a
+    // The workgroup first reads the displaced snow within reach of its texels (and the room for
+    // banks there), each lane a share: where none was displaced, every bank here is 0 (most of a
     // surface, away from its trails), and the gather's taps are skipped.
-    let origin = vec2<i32>(group.xy * 8u) - vec2<i32>(bank.reach_x, bank.reach_z);
-    let span = vec2<i32>(8 + 2 * bank.reach_x, 8 + 2 * bank.reach_z);
-    for (var k = i32(lane); k < span.x * span.y; k += 64) {
-        let p = origin + vec2<i32>(k % span.x, k / span.x);
-        if inside(p.x, p.y) && textureLoad(light, p, 0).g > 0.0 {
-            atomicOr(&displaced_near, 1u);
+    let hood = neighbourhood(group);
+    for (var k = i32(lane); k < hood.span.x * hood.span.y; k += 64) {
+        let p = hood.origin + vec2<i32>(k % hood.span.x, k / hood.span.x);
+        if inside(p.x, p.y) {
+            let d = textureLoad(light, p, 0).g;
+            if d > 0.0 {
+                atomicOr(&displaced_near, 1u);
+            }
+            if hood.tiled {
+                tile_a[k] = d;
+                tile_b[k] = textureLoad(scratch_in, p, 0).x;
+            }
         }
     }
     workgroupBarrier();
@@ -119,9 +172,18 @@ fn bank_gather(
             if inside(c + dc, r + dr) {
                 let k = kernel(dc, dr);
                 let p = vec2<i32>(c + dc, r + dr);
-                let d = textureLoad(light, p, 0).g;
+                var d: f32;
+                var room: f32;
+                if hood.tiled {
+                    let i = tile_index(hood, p);
+                    d = tile_a[i];
+                    room = tile_b[i];
+                } else {
+                    d = textureLoad(light, p, 0).g;
+                    room = textureLoad(scratch_in, p, 0).x;
+                }
                 if k > 0.0 && d > 0.0 {
-                    sum += d * k / max(textureLoad(scratch_in, p, 0).x, 1e-6);
+                    sum += d * k / max(room, 1e-6);
                 }
             }
         }
