@@ -289,24 +289,41 @@ fn cache_map(
     size: u32,
     format: wgpu::TextureFormat,
 ) -> (wgpu::Texture, wgpu::TextureView) {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("moon shadow cascade cache"),
+    let usage = wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING;
+    let texture = depth_map(
+        device,
+        "moon shadow cascade cache",
+        (size, 1),
+        format,
+        usage,
+    );
+    let view = texture.create_view(&Default::default());
+    (texture, view)
+}
+
+/// A depth texture of `layers` layers of `size` texels a side in `format`, rendered into and
+/// used as `usage` says besides.
+fn depth_map(
+    device: &wgpu::Device,
+    label: &str,
+    (size, layers): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
         size: wgpu::Extent3d {
             width: size,
             height: size,
-            depth_or_array_layers: 1,
+            depth_or_array_layers: layers,
         },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::TEXTURE_BINDING,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
         view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    (texture, view)
+    })
 }
 
 /// The two cascades' depth map of `size` texels a side in `format`: the view that samples both
@@ -316,22 +333,8 @@ fn cascade_maps(
     size: u32,
     format: wgpu::TextureFormat,
 ) -> (wgpu::Texture, wgpu::TextureView, [wgpu::TextureView; 2]) {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("moon shadow cascades"),
-        size: wgpu::Extent3d {
-            width: size,
-            height: size,
-            depth_or_array_layers: 2,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+    let texture = depth_map(device, "moon shadow cascades", (size, 2), format, usage);
     let view = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
