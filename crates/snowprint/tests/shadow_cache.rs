@@ -1,6 +1,7 @@
 //! The shadow cascades' cache of still casters (`RenderConfig::shadow_cache`): frames drawn with
-//! it are the frames drawn without it, byte for byte, while a caster moves, the snow is pressed
-//! and a still caster is moved; and the frames that can use it do (`ShadowStats`).
+//! it are the frames drawn without it, byte for byte, while a caster moves, the snow is pressed,
+//! a still caster is moved, and a frame is recorded into an engine's encoder that is never
+//! submitted; and the frames that can use it do (`ShadowStats`).
 
 mod common;
 
@@ -24,8 +25,9 @@ struct Frame {
 }
 
 /// A 4 m square of snow, a still block beside a sphere that crosses the square pressing the snow,
-/// under a camera that holds still; the block moves at frame [`MOVED_AT`].
-fn run(tier: Tier, cache: bool) -> Vec<Frame> {
+/// under a camera that holds still; the block moves at frame [`MOVED_AT`]. With `discard`, before
+/// that frame another one (the ball elsewhere) is recorded into an encoder that is dropped.
+fn run(tier: Tier, cache: bool, discard: Option<usize>) -> Vec<Frame> {
     let gpu = common::gpu();
     let mut world = SnowWorld::new(
         gpu,
@@ -86,6 +88,41 @@ fn run(tier: Tier, cache: bool) -> Vec<Frame> {
             environment: Environment::moonlit_night(),
             snowfall: false,
         };
+        if discard == Some(k) {
+            let elsewhere = [
+                instances[0],
+                Instance::new(ball, Mat4::from_translation(-at), [0.7, 0.2, 0.1]),
+            ];
+            let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("a frame never shown"),
+                size: wgpu::Extent3d {
+                    width: 96,
+                    height: 64,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8Unorm,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            let view = target.create_view(&Default::default());
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let dropped = RenderFrame {
+                instances: &elsewhere,
+                ..frame
+            };
+            renderer
+                .encode_to_view(
+                    &mut encoder,
+                    &world,
+                    &dropped,
+                    &view,
+                    wgpu::TextureFormat::Rgba8Unorm,
+                )
+                .expect("record");
+        }
         let out = renderer.render(&world, &frame).expect("render");
         frames.push(Frame {
             rgba8: out.rgba8,
@@ -97,8 +134,8 @@ fn run(tier: Tier, cache: bool) -> Vec<Frame> {
 }
 
 fn same_frames_with_and_without_the_cache(tier: Tier) {
-    let with = run(tier, true);
-    let without = run(tier, false);
+    let with = run(tier, true, None);
+    let without = run(tier, false, None);
     for (k, (a, b)) in with.iter().zip(&without).enumerate() {
         let differ = a.rgba8.iter().zip(&b.rgba8).filter(|(x, y)| x != y).count();
         assert_eq!(differ, 0, "{tier:?} frame {k}: {differ} bytes differ");
@@ -122,6 +159,17 @@ fn same_frames_with_and_without_the_cache(tier: Tier) {
     }
     // The ball's shadow moves: the frames are not all the same picture.
     assert_ne!(with[2].rgba8, with[3].rgba8, "{tier:?}");
+    // A frame recorded and never submitted before frame 3: frame 3 starts afresh (draws), the
+    // frames are still those without the cache.
+    let dropped = run(tier, true, Some(3));
+    for (k, (a, b)) in dropped.iter().zip(&without).enumerate() {
+        assert!(
+            a.rgba8 == b.rgba8,
+            "{tier:?} frame {k} after a dropped frame"
+        );
+    }
+    let used: Vec<[bool; 2]> = dropped.iter().map(|f| f.from_cache).collect();
+    assert_eq!(used, [n, n, y, n, n, n, y], "{tier:?}");
 }
 
 #[test]

@@ -410,6 +410,7 @@ impl Renderer {
         let commands = encoder.finish();
         laps.mark("finish");
         self.queue.submit([commands]);
+        self.shadow.confirm();
         laps.mark("submit");
         self.phases.extend(laps.phases);
         let cpu_encode_ms = encode_start.elapsed().as_secs_f64() * 1e3;
@@ -508,6 +509,7 @@ impl Renderer {
     /// report back (without waiting). Returns the report of the latest earlier frame whose GPU
     /// results have come back, if any.
     pub fn submitted(&mut self, pending: RenderPending) -> Option<FrameReport> {
+        self.shadow.confirm();
         if pending.report_copied && self.stats.is_idle() {
             self.stats.start_map();
         }

@@ -36,6 +36,9 @@ pub(super) struct ShadowPass {
     steps: [CascadeStep; 2],
     /// This frame's restored texels of each cascade.
     restored: [u64; 2],
+    /// Whether the last frame planned was submitted ([`ShadowPass::confirm`]): if not, neither
+    /// its cache nor its map hold what the states say, and the next frame starts afresh.
+    confirmed: bool,
     restore: restore::Restore,
     /// Side of the shadow map, texels.
     pub size: u32,
@@ -77,6 +80,7 @@ impl ShadowPass {
             states: Default::default(),
             steps: Default::default(),
             restored: [0, 0],
+            confirmed: true,
             restore: restore::Restore::new(device, format),
             size,
             format,
@@ -104,6 +108,10 @@ impl ShadowPass {
         meshes: &mut MeshSet,
         snow: [Vec<[u32; 4]>; 2],
     ) {
+        if !self.confirmed {
+            self.states = Default::default();
+        }
+        self.confirmed = false;
         let keys = meshes.still_keys;
         let mut drawn = std::mem::take(&mut meshes.moving_rects);
         for (d, s) in drawn.iter_mut().zip(snow) {
@@ -131,6 +139,11 @@ impl ShadowPass {
                 .map(|v| (restored[c].as_slice(), v))
         });
         self.restore.prepare(device, queue, size, jobs);
+    }
+
+    /// The frame last planned was submitted: the next may build on what it leaves.
+    pub(super) fn confirm(&mut self) {
+        self.confirmed = true;
     }
 
     /// Whether each cascade's still casters come from its cache this frame (copied in or
