@@ -113,7 +113,8 @@ fn run(tier: Tier, cache: bool, discard: Option<usize>) -> Vec<Frame> {
                 instances: &elsewhere,
                 ..frame
             };
-            renderer
+            // Recorded, then dropped with its encoder: never submitted, never `submitted`.
+            let _never_submitted = renderer
                 .encode_to_view(
                     &mut encoder,
                     &world,
