@@ -1,7 +1,7 @@
 //! The moon's two shadow cascades: the near one around what the camera looks at, the far one
 //! around the snow surfaces and every shadow caster. Pure maths on the frame's inputs.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::inputs::RenderFrame;
 use super::meshes::GpuMesh;
@@ -12,6 +12,20 @@ const NEAR_CASCADE: f32 = 12.0;
 
 /// Where the near cascade is centred: this far along the view, as a fraction of its side.
 const NEAR_FOCUS: f32 = 0.4;
+
+/// How far the near cascade's focus may move (metres, along either axis of the moon's view)
+/// before the cascade follows it: while it holds still, its shadows of still casters come from
+/// its cache (`shadow/cache.rs`) instead of being drawn again, for a moving camera too.
+const NEAR_HOLD: f32 = 1.0;
+
+/// Where the near cascade stood: its centre in the moon's view (metres), that view, and the
+/// map's side it was snapped to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct NearHold {
+    view: Mat4,
+    size: u32,
+    centre: Vec2,
+}
 
 /// Side of a scene pixel (`rows` pixels high) at the near cascade's focus, metres: the shadow
 /// texel the view would need there for one texel a pixel.
@@ -37,15 +51,18 @@ pub(super) struct ShadowCascades {
     pub far: Mat4,
     pub near_texel: f32,
     pub far_texel: f32,
+    /// Where the near cascade stands, for the next frame.
+    pub hold: NearHold,
 }
 
-/// The moon's two shadow cascades: the near one around what the camera looks at, the far one
-/// around the snow surfaces and every shadow caster.
+/// The moon's two shadow cascades: the near one around what the camera looks at (where it stood
+/// the frame before, `held`, while the focus stays within [`NEAR_HOLD`] of it under the same
+/// moon's view), the far one around the snow surfaces and every shadow caster.
 pub(super) fn shadow_cascades<'a>(
     surfaces: impl IntoIterator<Item = &'a SurfaceDesc>,
     frame: &RenderFrame<'_>,
     meshes: &[GpuMesh],
-    shadow_size: u32,
+    (shadow_size, held): (u32, Option<NearHold>),
 ) -> ShadowCascades {
     let mut lo = Vec3::splat(f32::MAX);
     let mut hi = Vec3::splat(f32::MIN);
@@ -111,7 +128,21 @@ pub(super) fn shadow_cascades<'a>(
     let focus = view.transform_point3(cam.eye + forward * (NEAR_CASCADE * NEAR_FOCUS));
     let near_texel = NEAR_CASCADE / shadow_size as f32;
     let snap = |v: f32| (v / near_texel).round() * near_texel;
-    let (cx, cy) = (snap(focus.x), snap(focus.y));
+    let target = Vec2::new(snap(focus.x), snap(focus.y));
+    let hold = match held {
+        Some(h) if h.view == view && h.size == shadow_size => h,
+        _ => NearHold {
+            view,
+            size: shadow_size,
+            centre: target,
+        },
+    };
+    let centre = if (hold.centre - target).abs().max_element() <= NEAR_HOLD {
+        hold.centre
+    } else {
+        target
+    };
+    let (cx, cy) = (centre.x, centre.y);
     let half = NEAR_CASCADE * 0.5;
     let near_proj = glam::camera::rh::proj::directx::orthographic(
         cx - half,
@@ -126,6 +157,7 @@ pub(super) fn shadow_cascades<'a>(
         far: proj * view,
         near_texel,
         far_texel,
+        hold: NearHold { centre, ..hold },
     }
 }
 
@@ -149,5 +181,42 @@ mod tests {
         assert_eq!(shadow_map_size_for_view(10.0, 2160), 8192);
         // No field or no rows is no panic.
         assert_eq!(shadow_map_size_for_view(0.0, 0), 512);
+    }
+
+    /// The near cascade stays where it stood while the camera's focus moves less than
+    /// NEAR_HOLD along the moon's view, and follows it beyond; a first frame (or another moon)
+    /// places it as it always did.
+    #[test]
+    fn the_near_cascade_holds_still_while_the_focus_stays_near() {
+        let frame = |x: f32| RenderFrame {
+            camera: crate::Camera {
+                eye: Vec3::new(x, 3.0, 6.0),
+                target: Vec3::new(x, 0.0, 0.0),
+                fov_y_degrees: 50.0,
+            },
+            time: 0.0,
+            surfaces: &[],
+            instances: &[],
+            lights: &[],
+            environment: crate::render::Environment::moonlit_night(),
+            snowfall: false,
+        };
+        let place = |x: f32, held| shadow_cascades([], &frame(x), &[], (1024, held));
+        let first = place(0.0, None);
+        // 0.5 m: held (the far cascade, around nothing, does not move).
+        let near = place(0.5, Some(first.hold));
+        assert_eq!(near.near, first.near);
+        assert_eq!(near.far, first.far);
+        assert_ne!(place(0.5, None).near, first.near);
+        // 3 m: the cascade follows, where a first frame would put it.
+        let far = place(3.0, Some(first.hold));
+        assert_eq!(far.near, place(3.0, None).near);
+        assert_ne!(far.near, first.near);
+        // Another map side: placed afresh.
+        let resized = shadow_cascades([], &frame(0.5), &[], (2048, Some(first.hold)));
+        assert_eq!(
+            resized.near,
+            shadow_cascades([], &frame(0.5), &[], (2048, None)).near
+        );
     }
 }

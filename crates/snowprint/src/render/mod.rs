@@ -601,7 +601,9 @@ impl Renderer {
             tessellated_tier,
         )?;
         let descs = surfaces.iter().map(|s| s.view.desc);
-        let shadow = cascades::shadow_cascades(descs, frame, &self.meshes.meshes, self.shadow.size);
+        let placed = (self.shadow.size, self.shadow.near_hold);
+        let shadow = cascades::shadow_cascades(descs, frame, &self.meshes.meshes, placed);
+        self.shadow.near_hold = Some(shadow.hold);
         let uniform = frame::frame_uniform(&self.config, frame, &shadow);
         self.frame.prepare(&self.queue, &uniform);
         laps.mark("surfaces");

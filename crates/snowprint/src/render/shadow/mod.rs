@@ -36,6 +36,9 @@ pub(super) struct ShadowPass {
     steps: [CascadeStep; 2],
     /// This frame's restored texels of each cascade.
     restored: [u64; 2],
+    /// Where the near cascade stood last frame (`cascades::shadow_cascades` keeps it there while
+    /// the view's focus stays near).
+    pub near_hold: Option<super::cascades::NearHold>,
     /// Whether the last frame planned was submitted ([`ShadowPass::confirm`]): if not, neither
     /// its cache nor its map hold what the states say, and the next frame starts afresh.
     confirmed: bool,
@@ -81,6 +84,7 @@ impl ShadowPass {
             steps: Default::default(),
             restored: [0, 0],
             confirmed: true,
+            near_hold: None,
             restore: restore::Restore::new(device, format),
             size,
             format,
