@@ -159,9 +159,8 @@ impl MeshSet {
             self.moving_rects[cascade] = moving
                 .iter()
                 .filter_map(|&i| {
-                    let (scale, _, at) = frame[i].transform.to_scale_rotation_translation();
                     let radius = self.meshes[frame[i].mesh.0 as usize].radius;
-                    let radius = radius * scale.abs().max_element();
+                    let (at, radius) = cull::bounding_sphere(frame[i].transform, radius);
                     sphere_rect(cascades[cascade], at, radius, shadow_size)
                 })
                 .collect();

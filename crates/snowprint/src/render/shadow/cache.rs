@@ -81,7 +81,8 @@ pub(super) fn cascade_step(
 
 impl CacheState {
     /// After the frame's `step` with `key`: what the map and the cache hold, and the rectangles
-    /// `drawn` over the still depth this frame (the moving casters and the displaced snow).
+    /// `drawn` over the still depth this frame (the moving casters and the displaced snow),
+    /// [`merged`] only where the next frame may restore them.
     pub(super) fn advance(&mut self, step: CascadeStep, key: Option<u64>, drawn: Vec<[u32; 4]>) {
         self.last = key;
         if step == CascadeStep::Keep {
@@ -89,7 +90,7 @@ impl CacheState {
         }
         self.live = (step != CascadeStep::Draw).then_some(key).flatten();
         self.dirty = if self.live.is_some() {
-            drawn
+            merged(drawn)
         } else {
             Vec::new()
         };

@@ -133,7 +133,7 @@ impl ShadowPass {
             if step == CascadeStep::Restore {
                 restored[c] = std::mem::take(&mut state.dirty);
             }
-            state.advance(step, keys[c], cache::merged(drawn));
+            state.advance(step, keys[c], drawn);
             self.steps[c] = step;
             self.restored[c] = restored[c].iter().map(|&r| cache::area(r)).sum();
         }
