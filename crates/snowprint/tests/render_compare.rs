@@ -113,18 +113,23 @@ fn heightfield_case(slope: Option<Vec2>) {
         wrap: 0,
         _pad: [0; 3],
         light: [light.x, light.y, light.z, 0.0],
+        // Nothing beside it: every side's texels clamp to the edge.
+        sides: Default::default(),
     };
     let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("params"),
         contents: bytemuck::bytes_of(&params),
         usage: wgpu::BufferUsages::UNIFORM,
     });
+    // The textures hold a border around the heightmap's texels.
+    let b = snowprint::wgsl::consts::HEIGHTFIELD_BORDER as u32;
+    let (tw, th) = (w + 2 * b, h + 2 * b);
     let texture = || {
         dev.create_texture(&wgpu::TextureDescriptor {
             label: None,
             size: wgpu::Extent3d {
-                width: w,
-                height: h,
+                width: tw,
+                height: th,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -191,11 +196,11 @@ fn heightfield_case(slope: Option<Vec2>) {
             },
         ],
     });
-    let row = (w * 8).div_ceil(256) * 256;
+    let row = (tw * 8).div_ceil(256) * 256;
     let readback = |t: &wgpu::Texture, enc: &mut wgpu::CommandEncoder| {
         let b = dev.create_buffer(&wgpu::BufferDescriptor {
             label: None,
-            size: (row * h) as u64,
+            size: (row * th) as u64,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -206,12 +211,12 @@ fn heightfield_case(slope: Option<Vec2>) {
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
+                    rows_per_image: Some(th),
                 },
             },
             wgpu::Extent3d {
-                width: w,
-                height: h,
+                width: tw,
+                height: th,
                 depth_or_array_layers: 1,
             },
         );
@@ -222,12 +227,14 @@ fn heightfield_case(slope: Option<Vec2>) {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        pass.dispatch_workgroups(tw.div_ceil(8), th.div_ceil(8), 1);
     }
     let (shape_rb, lit_rb) = (readback(&shape, &mut enc), readback(&lit, &mut enc));
     gpu.queue.submit([enc.finish()]);
     let (shape_bytes, lit_bytes) = (read_buffer(&shape_rb), read_buffer(&lit_rb));
-    let texel_at = |bytes: &[u8], c: u32, r: u32| -> [f32; 4] {
+    // Texel (c, r) of the heightmap, which may lie in the border.
+    let texel_at = |bytes: &[u8], c: i32, r: i32| -> [f32; 4] {
+        let (c, r) = ((c + b as i32) as u32, (r + b as i32) as u32);
         let o = (r * row + c * 8) as usize;
         let v: &[u16] = bytemuck::cast_slice(&bytes[o..o + 8]);
         [
@@ -257,7 +264,7 @@ fn heightfield_case(slope: Option<Vec2>) {
             if slope.is_some() && !inner(c, r) {
                 continue;
             }
-            let gpu_texel = texel_at(&shape_bytes, c as u32, r as u32);
+            let gpu_texel = texel_at(&shape_bytes, c, r);
             let n = cpu::sobel_normal(d, c, r, depth, texel);
             let ao = cpu::horizon_ao(|dx, dz| {
                 let (oc, orow) = ((dx / texel.x).round() as i32, (dz / texel.y).round() as i32);
@@ -282,7 +289,7 @@ fn heightfield_case(slope: Option<Vec2>) {
                 )
             };
             let vis = march(turned);
-            let gpu_light = texel_at(&lit_bytes, c as u32, r as u32);
+            let gpu_light = texel_at(&lit_bytes, c, r);
             let gpu_vis = gpu_light[0];
             if (march(light) - gpu_vis).abs() > 0.05 {
                 unturned_differs += 1;
@@ -301,6 +308,24 @@ fn heightfield_case(slope: Option<Vec2>) {
             ];
             for k in 0..5 {
                 worst[k] = worst[k].max(errors[k]);
+            }
+        }
+    }
+    // With no surface beside it, each texel of the border repeats the edge texel nearest it, bit
+    // for bit, so that filtering across the edge is clamping at it.
+    let (bi, wi, hi) = (b as i32, w as i32, h as i32);
+    for r in -bi..hi + bi {
+        for c in -bi..wi + bi {
+            if c >= 0 && r >= 0 && c < wi && r < hi {
+                continue;
+            }
+            let (ec, er) = (c.clamp(0, wi - 1), r.clamp(0, hi - 1));
+            for bytes in [&shape_bytes, &lit_bytes] {
+                assert_eq!(
+                    texel_at(bytes, c, r),
+                    texel_at(bytes, ec, er),
+                    "border texel ({c}, {r}) against edge texel ({ec}, {er})"
+                );
             }
         }
     }

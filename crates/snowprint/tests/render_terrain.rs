@@ -581,8 +581,13 @@ fn tessellated_vertices_stand_on_the_ground_plus_the_snow() {
         let b = x.to_bits();
         ((((b >> 23) & 0xff) as u16 - 127 + 15) << 10) | ((b >> 13) & 0x3ff) as u16
     };
-    let texels: Vec<u16> = (0..h)
-        .flat_map(|r| (0..w).map(move |c| (c, r)))
+    // The renderer's textures hold a border around the heightmap's texels: the edge repeated,
+    // with no surface beside this one.
+    let b = snowprint::wgsl::consts::HEIGHTFIELD_BORDER;
+    let (tw, th) = (w + 2 * b as u32, h + 2 * b as u32);
+    let edge = |t: u32, n: u32| (t as i32 - b).clamp(0, n as i32 - 1) as u32;
+    let texels: Vec<u16> = (0..th)
+        .flat_map(|r| (0..tw).map(move |c| (edge(c, w), edge(r, h))))
         .flat_map(|(c, r)| [half_bits(dep(c, r)), 0, 0, 0])
         .collect();
     let texture = |data: &[u16]| {
@@ -591,8 +596,8 @@ fn tessellated_vertices_stand_on_the_ground_plus_the_snow() {
             &wgpu::TextureDescriptor {
                 label: None,
                 size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
+                    width: tw,
+                    height: th,
                     depth_or_array_layers: 1,
                 },
                 mip_level_count: 1,

@@ -12,6 +12,8 @@ pub const STATE_BASIC_DRAW: u64 = 0;
 pub const STATE_DEFORMABLE_DRAW: u64 = 4;
 /// Offset of the heightfield pass's indirect dispatch arguments.
 pub const STATE_HEIGHTFIELD_DISPATCH: u64 = 8;
+/// Offset of the bank passes' indirect dispatch arguments.
+pub const STATE_BANKS_DISPATCH: u64 = 13;
 /// Offset of the "deformed" flag.
 pub const STATE_TOUCHED: u64 = crate::wgsl::consts::STATE_TOUCHED as u64;
 /// Offset of the deepest depression (an f32 fraction of the snow depth, as bits).
@@ -286,8 +288,8 @@ pub struct ClassifyRecord {
     pub terrain: u32,
     /// Toroidal storage offsets ([`crate::pool::wrapped`]).
     pub wrap: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// The texels the bank passes run over: along x in the low 16 bits, along z in the high.
+    pub banks: u32,
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
@@ -317,6 +319,32 @@ pub struct HeightfieldParams {
     pub _pad: [u32; 3],
     /// Unit direction towards the moon in the surface's local frame; w unused.
     pub light: [f32; 4],
+    /// The surfaces beside its sides (local -x, +x, -z, +z), whose texels the pass reads beyond
+    /// its edges (`heightfield::sides`).
+    pub sides: [HeightfieldSide; 4],
+}
+
+/// The surface beside one side of a surface, for the heightfield pass. Must match
+/// `HeightfieldSide` in `heightfield.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct HeightfieldSide {
+    /// Element offset of its heightmap in the pool.
+    pub heights: u32,
+    /// Texels along x.
+    pub width: u32,
+    /// Texels along z.
+    pub height: u32,
+    /// Bits a channel of its heightmap.
+    pub bits: u32,
+    /// Its toroidal storage offsets.
+    pub wrap: u32,
+    /// Its texel along the side is the surface's plus this.
+    pub offset: i32,
+    /// 1 when a surface lies beside this side, else 0 (the side's texels clamp to the edge).
+    pub present: u32,
+    /// Padding.
+    pub _pad: u32,
 }
 
 /// A mesh vertex. Must match `MeshVertex` in `mesh.wgsl`.

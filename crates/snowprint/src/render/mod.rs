@@ -614,7 +614,7 @@ impl Renderer {
         laps.mark("classify");
         let moon = frame.environment.moon_direction;
         self.heightfield
-            .prepare(device, queue, pool, ground, &surfaces, moon);
+            .prepare(device, queue, (pool, ground), &surfaces, moon);
         laps.mark("heightfield");
         self.snow.prepare(
             device,
@@ -650,7 +650,7 @@ impl Renderer {
             device,
             queue,
             tessellated_tier,
-            &surfaces,
+            (pool, &surfaces),
             &self.heightfield,
         );
         laps.mark("banks");
@@ -775,16 +775,19 @@ fn frame_surfaces<'a>(
     default_geometry: &'a SurfaceGeometry,
     tessellated_tier: bool,
 ) -> RenderResult<Vec<FrameSurface<'a>>> {
+    let mut besides = heightfield::besides(&view.surfaces, frame.surfaces.iter().map(|s| s.0));
     frame
         .surfaces
         .iter()
-        .map(|&(id, ground)| {
+        .zip(besides.drain(..))
+        .map(|(&(id, ground), sides)| {
             let geometry = geometry.get(&id).unwrap_or(default_geometry);
             Ok(FrameSurface {
                 view: view.surface(id)?,
                 ground,
                 geometry,
                 tessellated: tessellated_tier && geometry.tessellate,
+                sides,
             })
         })
         .collect()

@@ -35,6 +35,10 @@ const MODE_GROUND: u32 = 4u;
 const PRIM_CAPSULE: u32 = 0u;
 // Primitive kind of a capture primitive: an oriented box.
 const PRIM_BOX: u32 = 1u;
+// Texels the renderer's heightfield and bank textures hold beyond each side of a heightmap: the
+// surface's cubic B-spline reads two texels past its edge, so two surfaces side by side draw the
+// same heights on the line where they meet (render/heightfield/heightfield.wgsl).
+const HEIGHTFIELD_BORDER: i32 = 2;
 // Words per surface in the renderer's surface state table (written by classify.wgsl).
 const STATE_WORDS: u32 = 16u;
 // Word of a surface's state holding the "deformed" flag.

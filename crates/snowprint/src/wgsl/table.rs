@@ -59,6 +59,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("tonemap", "render/tonemap/tonemap.wgsl", true),
     ("tonemap_compute", "render/tonemap/tonemap_compute.wgsl", true),
     ("classify", "render/classify/classify.wgsl", true),
+    ("heightfield_texels", "render/heightfield/texels.wgsl", false),
     ("heightfield", "render/heightfield/heightfield.wgsl", true),
     ("banks", "render/tessellate/banks/banks.wgsl", true),
     ("dice", "render/tessellate/dice/dice.wgsl", true),

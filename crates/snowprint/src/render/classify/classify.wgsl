@@ -3,7 +3,8 @@
 // gets the basic material; any other the deformable one, and so does every surface on ground that is
 // not flat (the basic material draws a flat top). The pass writes, per surface, the
 // indirect draw arguments of both snow pipelines (one of them with zero instances), the indirect
-// dispatch of its heightfield pass (zero workgroups when basic), and the flag the report reads.
+// dispatches of its heightfield and bank passes (zero workgroups when basic), and the flag the
+// report reads.
 // Reads: the heightmap pool, the surface list. Writes: the surface state table.
 
 // import texel, constants
@@ -17,7 +18,7 @@ struct ClassifyRecord {
     bits: u32,        // bits a channel (pool/texel.wgsl)
     terrain: u32,     // 1 on ground that is not flat
     wrap: u32,        // toroidal storage offsets (pool/texel.wgsl)
-    _pad: u32,
+    banks: u32,       // texels the bank passes run over: x | z << 16
 }
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
@@ -56,11 +57,16 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
         state[base + 5u] = deformable;
         state[base + 6u] = 0u;
         state[base + 7u] = 0u;
-        // Heightfield dispatch (8 x 8 workgroups).
-        state[base + 8u] = select(0u, (rec.width + 7u) / 8u, deformable == 1u);
-        state[base + 9u] = (rec.height + 7u) / 8u;
+        // Heightfield dispatch (8 x 8 workgroups over the heightmap and its border).
+        let border = u32(2 * HEIGHTFIELD_BORDER);
+        state[base + 8u] = select(0u, (rec.width + border + 7u) / 8u, deformable == 1u);
+        state[base + 9u] = (rec.height + border + 7u) / 8u;
         state[base + 10u] = 1u;
         state[base + STATE_TOUCHED] = touched;
         state[base + 12u] = bitcast<u32>(f32(d) / f32(channel_max(rec.bits)));
+        // The bank passes' dispatch (8 x 8 workgroups over their domain).
+        state[base + 13u] = select(0u, ((rec.banks & 0xffffu) + 7u) / 8u, deformable == 1u);
+        state[base + 14u] = ((rec.banks >> 16u) + 7u) / 8u;
+        state[base + 15u] = 1u;
     }
 }

@@ -1,7 +1,7 @@
 //! The `classify` pass (compute, `classify.wgsl`): one workgroup per surface reads its heightmap
 //! and writes its state words: whether anything touched it (the basic or the deformable
-//! material), the deepest point, and the indirect arguments of the heightfield dispatch and of
-//! the two snow draws.
+//! material), the deepest point, and the indirect arguments of the heightfield and bank
+//! dispatches and of the two snow draws.
 
 use super::frame::FrameSurface;
 use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
@@ -66,7 +66,10 @@ impl ClassifyPass {
                 bits: s.view.precision.bits(),
                 terrain: u32::from(s.view.ground != crate::capture::NO_GROUND),
                 wrap: s.view.wrap,
-                _pad: 0,
+                banks: {
+                    let [x0, z0, x1, z1] = s.bank_domain();
+                    (x1 - x0) as u32 | ((z1 - z0) as u32) << 16
+                },
             })
             .collect();
         if n > 0 {

@@ -7,6 +7,7 @@ use glam::{Vec2, Vec3};
 use super::cascades::ShadowCascades;
 use super::config::{RenderConfig, Tier};
 use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
+use super::heightfield::{Beside, SIDES};
 use super::inputs::{PointLight, RenderFrame};
 use super::tessellate::SurfaceGeometry;
 use crate::extract::SurfaceView;
@@ -27,6 +28,8 @@ pub(super) struct FrameSurface<'a> {
     pub geometry: &'a SurfaceGeometry,
     /// Whether it is diced this frame (the tessellated tier, and its geometry asks for it).
     pub tessellated: bool,
+    /// The surfaces of the world beside its sides, local -x, +x, -z, +z (`heightfield::sides`).
+    pub sides: [Option<Beside<'a>>; SIDES],
 }
 
 impl FrameSurface<'_> {
@@ -43,6 +46,31 @@ impl FrameSurface<'_> {
     /// then draw the banks above the snow top too.
     pub(super) fn rims(&self) -> bool {
         self.view.desc.material.rim_fraction().is_some()
+    }
+
+    /// The texels the bank passes run over, `[x0, z0, x1, z1)` of its heightmap's (its first
+    /// at 0): the bank texture's border beyond each side and, beyond a side with a surface beside
+    /// it, as far again as banks reach (the banks there gather snow pushed beyond the line, and
+    /// need the norm of where it lands).
+    pub(super) fn bank_domain(&self) -> [i32; 4] {
+        let border = crate::wgsl::consts::HEIGHTFIELD_BORDER;
+        let texel = self.texel();
+        let width = self.banks().width;
+        let reach = [width / texel.x, width / texel.y].map(|r| r.floor() as i32 + border);
+        let out = |side: usize, reach: i32| {
+            if self.sides[side].is_some() {
+                reach
+            } else {
+                border
+            }
+        };
+        let layout = self.view.layout;
+        [
+            -out(0, reach[0]),
+            -out(2, reach[1]),
+            layout.width as i32 + out(1, reach[0]),
+            layout.height as i32 + out(3, reach[1]),
+        ]
     }
 
     /// Its banks: the geometry's, with the share of the pushed volume set by the material's

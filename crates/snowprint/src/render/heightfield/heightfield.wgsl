@@ -7,29 +7,18 @@
 // per texel instead of per pixel) in .r and the displaced snow (the pool's high 16 bits, raw) in
 // .g, which the tessellated tier's banks read. Dispatched indirectly: zero workgroups for a surface on the
 // basic material.
-// Reads: the heightmap pool. Writes: the surface's heightfield and light textures.
+// The textures hold HEIGHTFIELD_BORDER texels more on each side than the heightmap: there, and in every tap that
+// reaches past the surface's edge, the heights are those of the surface linked beside that side
+// (render/heightfield/sides.rs) where there is one, so that two surfaces side by side shade as one;
+// elsewhere the taps clamp to the edge and the border repeats it.
+// Reads: the heightmap pool (this surface's and its neighbours'). Writes: the surface's
+// heightfield and light textures.
 // CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
 // displaced_fraction}.
 
-// import texel, constants, ground_texel
+// import heightfield_texels, constants, ground_texel
 
-// Must match `HeightfieldParams` in src/render/gpu.rs.
-struct HeightfieldParams {
-    heights: u32,       // word offset of the heightmap in the pool
-    width: u32,
-    height: u32,
-    bits: u32,          // bits a channel (pool/texel.wgsl)
-    snow_depth: f32,
-    texel_x: f32,
-    texel_z: f32,
-    ground: u32,        // first texel of the ground field (ground_texel), or NO_GROUND
-    wrap: u32,          // toroidal storage offsets (pool/texel.wgsl)
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-    light: vec4<f32>,   // xyz: unit direction towards the moon in the surface's local frame
-}
-
+// `pool` and `params` are what heightfield_texels.wgsl reads.
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
 @group(0) @binding(1) var<uniform> params: HeightfieldParams;
 @group(0) @binding(2) var out_texture: texture_storage_2d<rgba16float, write>;
@@ -39,20 +28,6 @@ struct HeightfieldParams {
 
 // Must match AO_RADII in cpu.rs (PENUMBRA_*, LIGHT_TAPS and AO_DIRECTIONS: constants.wgsl).
 const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
-
-fn depression(c: i32, r: i32) -> f32 {
-    let x = u32(clamp(c, 0, i32(params.width) - 1));
-    let y = u32(clamp(r, 0, i32(params.height) - 1));
-    return pool_fractions(params.bits, params.heights, params.width, params.height, params.wrap, x, y).x;
-}
-
-// The displaced snow at a texel (the talk's projected-displacement channel: what the captures
-// pushed deeper, accumulated), as a fraction of the snow depth. Same shape as `depression`.
-fn displaced(c: i32, r: i32) -> f32 {
-    let x = u32(clamp(c, 0, i32(params.width) - 1));
-    let y = u32(clamp(r, 0, i32(params.height) - 1));
-    return pool_fractions(params.bits, params.heights, params.width, params.height, params.wrap, x, y).y;
-}
 
 // Snow height (metres above the ground) at the texel nearest to a metric offset.
 fn height_at(c: i32, r: i32, dx: f32, dz: f32) -> f32 {
@@ -130,21 +105,6 @@ fn light_visibility(c: i32, r: i32) -> f32 {
     return visible;
 }
 
-// The depression smoothed by a 3x3 binomial filter: the capture rasterizes deformers with binary
-// coverage on the texel grid, so the rim of a pit pressed to the ground is a staircase of texels;
-// this (and the renderer's cubic B-spline on top) keeps that staircase out of the picture.
-// Must match `smoothed_depression` in cpu.rs.
-fn smoothed_depression(c: i32, r: i32) -> f32 {
-    var sum = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let w = f32((2 - abs(dx)) * (2 - abs(dy)));
-            sum += w * depression(c + dx, r + dy);
-        }
-    }
-    return sum / 16.0;
-}
-
 // Must match `sobel_normal` in cpu.rs.
 fn sobel_normal(c: i32, r: i32) -> vec3<f32> {
     let d = params.snow_depth;
@@ -180,15 +140,29 @@ fn horizon_ao(c: i32, r: i32) -> f32 {
     return 1.0 - sum / f32(AO_DIRECTIONS);
 }
 
+// The texel a texel `t` of the border stands for along one axis: itself where a surface is linked
+// on that side, else the edge texel, so that the border repeats the edge.
+fn border_texel(t: i32, size: i32, low: u32, high: u32) -> i32 {
+    if (t < 0 && low == 0u) || (t >= size && high == 0u) {
+        return clamp(t, 0, size - 1);
+    }
+    return t;
+}
+
+// One texel of the textures, which hold the surface and a border around it: texture texel (x, y)
+// is the surface's (x - HEIGHTFIELD_BORDER, y - HEIGHTFIELD_BORDER).
 @compute @workgroup_size(8, 8, 1)
 fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if gid.x >= params.width || gid.y >= params.height {
+    let b = HEIGHTFIELD_BORDER;
+    if i32(gid.x) >= i32(params.width) + 2 * b || i32(gid.y) >= i32(params.height) + 2 * b {
         return;
     }
-    let c = i32(gid.x);
-    let r = i32(gid.y);
+    let s = params.sides;
+    let c = border_texel(i32(gid.x) - b, i32(params.width), s[0].present, s[1].present);
+    let r = border_texel(i32(gid.y) - b, i32(params.height), s[2].present, s[3].present);
     let n = sobel_normal(c, r);
     let ao = horizon_ao(c, r);
-    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(smoothed_depression(c, r), n.x, n.z, ao));
-    textureStore(out_light, vec2<i32>(c, r), vec4<f32>(light_visibility(c, r), displaced(c, r), 0.0, 1.0));
+    let at = vec2<i32>(gid.xy);
+    textureStore(out_texture, at, vec4<f32>(smoothed_depression(c, r), n.x, n.z, ao));
+    textureStore(out_light, at, vec4<f32>(light_visibility(c, r), displaced(c, r), 0.0, 1.0));
 }

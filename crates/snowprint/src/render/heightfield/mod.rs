@@ -9,7 +9,9 @@ use glam::Vec3;
 
 use super::error::{RenderError, RenderResult};
 use super::frame::FrameSurface;
-use super::gpu::{HeightfieldParams, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use super::gpu::{
+    HeightfieldParams, HeightfieldSide, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE,
+};
 use super::pipeline;
 use super::readback::{Timestamps, compute_pass, f16_to_f32, map_staging};
 use super::targets::HEIGHTFIELD_FORMAT;
@@ -17,29 +19,54 @@ use super::tessellate::SurfaceFields;
 use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::surface::SurfaceId;
 
+mod sides;
+pub(super) use sides::{Beside, SIDES, besides};
+
+/// What the pass reads of the surface beside a side (all zero where there is none).
+fn side_params(side: Option<Beside<'_>>) -> HeightfieldSide {
+    let Some(side) = side else {
+        return HeightfieldSide::default();
+    };
+    let n = side.view;
+    HeightfieldSide {
+        heights: n.heights,
+        width: n.layout.width,
+        height: n.layout.height,
+        bits: n.precision.bits(),
+        wrap: n.wrap,
+        offset: side.offset,
+        present: 1,
+        _pad: 0,
+    }
+}
+
 /// A deformed surface's shading textures, written by the heightfield pass.
 pub(super) struct HeightfieldTexture {
+    /// The heightmap's texels.
     pub size: (u32, u32),
-    /// Depression, normal x and z, ambient occlusion.
+    /// Depression, normal x and z, ambient occlusion; with a border of one texel around the
+    /// heightmap's (`heightfield.wgsl`).
     pub shape: wgpu::TextureView,
-    /// Moon visibility, displaced snow.
+    /// Moon visibility, displaced snow; with the same border.
     pub light: wgpu::TextureView,
-    /// Room for banks around each texel (the bank passes' scratch).
+    /// Room for banks around each texel of the bank passes' domain (their scratch).
     pub bank_scratch: wgpu::TextureView,
-    /// Bank heights, metres.
+    /// Bank heights, metres; with the same border as the shape.
     pub bank: wgpu::TextureView,
+    /// The scratch's texels.
+    scratch_size: (u32, u32),
     /// The textures of shape, light and bank, for readbacks.
     pub textures: [wgpu::Texture; 3],
 }
 
 impl HeightfieldTexture {
-    fn new(device: &wgpu::Device, size: (u32, u32)) -> Self {
-        let texture = |label| {
+    fn new(device: &wgpu::Device, size: (u32, u32), scratch_size: (u32, u32)) -> Self {
+        let texture = |label, (width, height): (u32, u32)| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
+                    width,
+                    height,
                     depth_or_array_layers: 1,
                 },
                 mip_level_count: 1,
@@ -53,20 +80,25 @@ impl HeightfieldTexture {
             })
         };
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let shape = texture("snow heightfield");
-        let light = texture("snow heightfield light");
-        let bank = texture("snow banks");
-        let scratch = texture("snow bank scratch");
+        let bordered = (size.0 + 2 * BORDER, size.1 + 2 * BORDER);
+        let shape = texture("snow heightfield", bordered);
+        let light = texture("snow heightfield light", bordered);
+        let bank = texture("snow banks", bordered);
+        let scratch = texture("snow bank scratch", scratch_size);
         Self {
             size,
             shape: view(&shape),
             light: view(&light),
             bank: view(&bank),
             bank_scratch: view(&scratch),
+            scratch_size,
             textures: [shape, light, bank],
         }
     }
 }
+
+/// Texels the shape, light and bank textures hold beyond each side of the heightmap.
+pub(super) const BORDER: u32 = crate::wgsl::consts::HEIGHTFIELD_BORDER as u32;
 
 pub(super) struct HeightfieldPass {
     layout: wgpu::BindGroupLayout,
@@ -98,19 +130,28 @@ impl HeightfieldPass {
         }
     }
 
+    /// The heightfield parameters of the frame's surface `s` (after [`HeightfieldPass::prepare`]),
+    /// which the bank passes read too.
+    pub(super) fn params(&self, s: usize) -> wgpu::BindingResource<'_> {
+        uniform_block(
+            &self.params.buffer,
+            s,
+            std::mem::size_of::<HeightfieldParams>(),
+        )
+    }
+
     /// A surface's textures (after [`HeightfieldPass::prepare`] of a frame that drew it).
     pub(super) fn texture(&self, id: SurfaceId) -> Option<&HeightfieldTexture> {
         self.textures.get(&id)
     }
 
-    /// Upload each surface's parameters (with the moon in its frame), make its textures at its
-    /// heightmap's size, and bind them.
+    /// Upload each surface's parameters (with the moon in its frame and the surfaces beside it),
+    /// make its textures at its heightmap's size, and bind them.
     pub(super) fn prepare(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        pool: &wgpu::Buffer,
-        ground: &wgpu::Buffer,
+        (pool, ground): (&wgpu::Buffer, &wgpu::Buffer),
         surfaces: &[FrameSurface<'_>],
         moon_direction: Vec3,
     ) {
@@ -137,6 +178,7 @@ impl HeightfieldPass {
                         .normalize();
                     [l.x, l.y, l.z, 0.0]
                 },
+                sides: surface.sides.map(side_params),
             };
             bytes[s * stride..s * stride + std::mem::size_of::<HeightfieldParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&p));
@@ -145,9 +187,15 @@ impl HeightfieldPass {
         queue.write_buffer(&self.params.buffer, 0, &bytes);
         for s in surfaces {
             let size = (s.view.layout.width, s.view.layout.height);
-            if self.textures.get(&s.view.id).is_none_or(|t| t.size != size) {
+            let [x0, z0, x1, z1] = s.bank_domain();
+            let scratch = ((x1 - x0) as u32, (z1 - z0) as u32);
+            if self
+                .textures
+                .get(&s.view.id)
+                .is_none_or(|t| t.size != size || t.scratch_size != scratch)
+            {
                 self.textures
-                    .insert(s.view.id, HeightfieldTexture::new(device, size));
+                    .insert(s.view.id, HeightfieldTexture::new(device, size, scratch));
             }
         }
         self.bind_groups = surfaces
@@ -195,7 +243,7 @@ impl HeightfieldPass {
     }
 
     /// A surface's smoothed depression, displaced channel and bank heights as the latest frame's
-    /// passes wrote them.
+    /// passes wrote them (over the heightmap's texels, without the border).
     pub(super) fn read_fields(
         &self,
         device: &wgpu::Device,
@@ -209,10 +257,10 @@ impl HeightfieldPass {
         let (w, h) = tex.size;
         let row = (w * 8).div_ceil(256) * 256;
         let mut channels = Vec::new();
-        for (texture, channel) in [
-            (&tex.textures[0], 0),
-            (&tex.textures[1], 1),
-            (&tex.textures[2], 0),
+        for (texture, channel, border) in [
+            (&tex.textures[0], 0, BORDER),
+            (&tex.textures[1], 1, BORDER),
+            (&tex.textures[2], 0, BORDER),
         ] {
             let staging = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("field readback"),
@@ -222,7 +270,14 @@ impl HeightfieldPass {
             });
             let mut encoder = device.create_command_encoder(&Default::default());
             encoder.copy_texture_to_buffer(
-                texture.as_image_copy(),
+                wgpu::TexelCopyTextureInfo {
+                    origin: wgpu::Origin3d {
+                        x: border,
+                        y: border,
+                        z: 0,
+                    },
+                    ..texture.as_image_copy()
+                },
                 wgpu::TexelCopyBufferInfo {
                     buffer: &staging,
                     layout: wgpu::TexelCopyBufferLayout {

@@ -100,9 +100,9 @@ fn surface_box(i: u32, rim_room: f32) -> SurfaceVarying {
     return out;
 }
 
+// The bank texture has the heightfield's border (banks.wgsl).
 fn bank_texel(c: vec2<i32>) -> f32 {
-    let size = vec2<i32>(surface.grid);
-    return textureLoad(bank_texture, clamp(c, vec2<i32>(0), size - 1), 0).x;
+    return textureLoad(bank_texture, border_texel(c), 0).x;
 }
 
 // Bank height (metres) at uv, bilinear by hand (also usable in the vertex stage).
@@ -127,9 +127,22 @@ fn bank_gradient(uv: vec2<f32>) -> vec2<f32> {
     );
 }
 
+// The heightfield, light and bank textures hold a border of HEIGHTFIELD_BORDER texels around the
+// heightmap's (heightfield.wgsl): the texels of the surface beside that side where one is linked,
+// else the edge repeated. Texel `c` of the heightmap is the textures' `c + HEIGHTFIELD_BORDER`;
+// `border_uv` maps the heightmap's uv to the textures'.
+fn border_texel(c: vec2<i32>) -> vec2<i32> {
+    let b = HEIGHTFIELD_BORDER;
+    return clamp(c, vec2<i32>(-b), vec2<i32>(surface.grid) + b - 1) + b;
+}
+
+fn border_uv(uv: vec2<f32>) -> vec2<f32> {
+    let b = f32(HEIGHTFIELD_BORDER);
+    return (uv * surface.grid + b) / (surface.grid + 2.0 * b);
+}
+
 fn load_texel(c: vec2<i32>) -> vec4<f32> {
-    let size = vec2<i32>(surface.grid);
-    return textureLoad(heightfield, clamp(c, vec2<i32>(0), size - 1), 0);
+    return textureLoad(heightfield, border_texel(c), 0);
 }
 
 // Bilinear filtering by hand (the fallback when the format cannot be filtered).
@@ -147,7 +160,7 @@ fn sample_bilinear(uv: vec2<f32>) -> vec4<f32> {
     if MANUAL_FILTER {
         return manual_bilinear(uv);
     }
-    return textureSampleLevel(heightfield, linear_sampler, uv, 0.0);
+    return textureSampleLevel(heightfield, linear_sampler, border_uv(uv), 0.0);
 }
 
 fn ground_column(c: vec2<i32>) -> vec2<f32> {
@@ -224,9 +237,10 @@ fn snow_heightfield(s: SnowSurface, uv: vec2<f32>) -> vec4<f32> {
 fn snow_light_visibility(s: SnowSurface, uv: vec2<f32>) -> f32 {
     if MANUAL_FILTER {
         let size = vec2<i32>(s.grid);
-        return textureLoad(heightfield_light, clamp(vec2<i32>(uv * s.grid), vec2<i32>(0), size - 1), 0).x;
+        let c = clamp(vec2<i32>(floor(uv * s.grid)), vec2<i32>(0), size - 1);
+        return textureLoad(heightfield_light, c + HEIGHTFIELD_BORDER, 0).x;
     }
-    return textureSampleLevel(heightfield_light, linear_sampler, uv, 0.0).x;
+    return textureSampleLevel(heightfield_light, linear_sampler, border_uv(uv), 0.0).x;
 }
 
 fn sky_tint() -> vec3<f32> {

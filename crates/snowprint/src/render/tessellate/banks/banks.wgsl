@@ -8,13 +8,22 @@
 //                beside a trail, not back into it, unless nothing else is within reach).
 //   bank_gather: bank(x) = fraction * depth * m(x) * sum over y of displaced(y) K(x - y) / N(y).
 // Summing bank(x) over x gives fraction * depth * sum of displaced(y) exactly: every source gives
-// away exactly what it pushed, normalized over where it lands (texels outside the surface are not
+// away exactly what it pushed, normalized over where it lands (texels that hold no snow are not
 // receivers), so the volume of the banks is the fraction of the pushed volume, up to rounding.
+// The snow is the surface's and that of the surfaces linked beside its sides (`held`,
+// heightfield_texels.wgsl): snow pushed across the line where two surfaces meet lands on the
+// other, as on one surface over both. The passes run over the surface and a band beyond each
+// side (`BankParams::domain`: the reach and the border where a surface is linked, the border
+// elsewhere), N over all of it, the banks over the surface and the border of HEIGHTFIELD_BORDER
+// texels (where no surface is linked, the edge repeated) that the bank texture holds around the
+// heightmap's, as the heightfield textures do.
 // Reads: the surface's heightfield textures (heightfield.wgsl: smoothed depression in .x, the
-// displaced channel in the light texture's .g). Writes: the bank scratch (N) and the bank texture
-// (metres of snow added, .x). CPU reference: render::tessellate::cpu::bank_field.
+// displaced channel in the light texture's .g; texel p at p + HEIGHTFIELD_BORDER), past their
+// border the pool (this surface's neighbours). Writes: the bank scratch (N over the domain, texel
+// p at p - domain.xy) and the bank texture (metres of snow added, .x, p at p + HEIGHTFIELD_BORDER).
+// CPU reference: render::tessellate::cpu::bank_field.
 
-// import constants
+// import constants, heightfield_texels
 
 // Must match `BankParams` in src/render/tessellate/mod.rs.
 struct BankParams {
@@ -30,6 +39,7 @@ struct BankParams {
     _pad0: f32,
     _pad1: f32,
     _pad2: f32,
+    domain: vec4<i32>,   // texels the passes run over: [x0, x1) x [z0, z1), the surface's first at 0
 }
 
 @group(0) @binding(0) var<uniform> bank: BankParams;
@@ -37,9 +47,46 @@ struct BankParams {
 @group(0) @binding(2) var light: texture_2d<f32>;
 @group(0) @binding(3) var scratch_in: texture_2d<f32>;
 @group(0) @binding(4) var out_texture: texture_storage_2d<rgba16float, write>;
+// What heightfield_texels.wgsl reads: the pool and this surface's heightfield parameters.
+@group(0) @binding(5) var<storage, read> pool: array<u32>;
+@group(0) @binding(6) var<uniform> params: HeightfieldParams;
 
+// Whether texel p holds snow (`held`) and is within the domain, where N is: a source of banks.
 fn inside(c: i32, r: i32) -> bool {
-    return c >= 0 && r >= 0 && c < i32(bank.width) && r < i32(bank.height);
+    let d = bank.domain;
+    return c >= d.x && r >= d.y && c < d.z && r < d.w && held(c, r);
+}
+
+// Whether texel (c, r) is in the textures (the surface and its border).
+fn textured(c: i32, r: i32) -> bool {
+    let b = HEIGHTFIELD_BORDER;
+    return c >= -b && r >= -b && c < i32(bank.width) + b && r < i32(bank.height) + b;
+}
+
+// A value as a 16-bit float texel holds it.
+fn as_half(x: f32) -> f32 {
+    return unpack2x16float(pack2x16float(vec2<f32>(x, 0.0))).x;
+}
+
+// The smoothed depression at a held texel: the texture's, or past its border the pool's, as the
+// surface beside holds it in its own texture.
+fn smoothed_at(p: vec2<i32>) -> f32 {
+    if textured(p.x, p.y) {
+        return textureLoad(shape, p + HEIGHTFIELD_BORDER, 0).x;
+    }
+    return as_half(smoothed_depression(p.x, p.y));
+}
+
+// The displaced snow at a held texel, likewise.
+fn displaced_at(p: vec2<i32>) -> f32 {
+    if textured(p.x, p.y) {
+        return textureLoad(light, p + HEIGHTFIELD_BORDER, 0).g;
+    }
+    return as_half(displaced(p.x, p.y));
+}
+
+fn room_at(p: vec2<i32>) -> f32 {
+    return textureLoad(scratch_in, p - bank.domain.xy, 0).x;
 }
 
 // Must match `receptivity` in cpu.rs.
@@ -77,7 +124,8 @@ struct Neighbourhood {
 fn neighbourhood(group: vec3<u32>) -> Neighbourhood {
     let reach = vec2<i32>(bank.reach_x, bank.reach_z);
     let tiled = bank.reach_x <= TILE_REACH && bank.reach_z <= TILE_REACH;
-    return Neighbourhood(vec2<i32>(group.xy * 8u) - reach, vec2<i32>(8) + 2 * reach, tiled);
+    let first = vec2<i32>(group.xy * 8u) + bank.domain.xy;
+    return Neighbourhood(first - reach, vec2<i32>(8) + 2 * reach, tiled);
 }
 
 // Index in the tiles of texel `p` of the neighbourhood `n`.
@@ -96,41 +144,50 @@ fn bank_norm(
     if hood.tiled {
         for (var k = i32(lane); k < hood.span.x * hood.span.y; k += 64) {
             let p = hood.origin + vec2<i32>(k % hood.span.x, k / hood.span.x);
-            if inside(p.x, p.y) {
-                tile_a[k] = receptivity(textureLoad(shape, p, 0).x);
+            if held(p.x, p.y) {
+                tile_a[k] = receptivity(smoothed_at(p));
             }
         }
     }
     workgroupBarrier();
-    if gid.x >= bank.width || gid.y >= bank.height {
+    let y = vec2<i32>(gid.xy) + bank.domain.xy;
+    if y.x >= bank.domain.z || y.y >= bank.domain.w {
         return;
     }
-    let c = i32(gid.x);
-    let r = i32(gid.y);
     // bank_gather reads N only where snow was displaced: elsewhere it is not summed.
-    if textureLoad(light, vec2<i32>(c, r), 0).g <= 0.0 {
-        textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+    if !inside(y.x, y.y) || displaced_at(y) <= 0.0 {
+        textureStore(out_texture, vec2<i32>(gid.xy), vec4<f32>(0.0, 0.0, 0.0, 1.0));
         return;
     }
+    // Where the snow lands needs no norm of its own: any held texel, in the domain or past it.
     var n = 0.0;
     for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
         for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
-            if inside(c + dc, r + dr) {
+            let p = y + vec2<i32>(dc, dr);
+            if held(p.x, p.y) {
                 let k = kernel(dc, dr);
                 if k > 0.0 {
-                    let p = vec2<i32>(c + dc, r + dr);
                     var m: f32;
                     if hood.tiled {
                         m = tile_a[tile_index(hood, p)];
                     } else {
-                        m = receptivity(textureLoad(shape, p, 0).x);
+                        m = receptivity(smoothed_at(p));
                     }
                     n += k * m;
                 }
             }
         }
     }
-    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(n, 0.0, 0.0, 1.0));
+    textureStore(out_texture, vec2<i32>(gid.xy), vec4<f32>(n, 0.0, 0.0, 1.0));
+}
+
+// The texel whose bank a texel of the bank texture holds: itself on the surface and where a
+// surface is linked beside it, else the edge texel next to it (the border repeats the edge).
+fn bank_texel_of(p: vec2<i32>) -> vec2<i32> {
+    if held(p.x, p.y) {
+        return p;
+    }
+    return clamp(p, vec2<i32>(0), vec2<i32>(i32(bank.width), i32(bank.height)) - 1);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -146,41 +203,45 @@ fn bank_gather(
     for (var k = i32(lane); k < hood.span.x * hood.span.y; k += 64) {
         let p = hood.origin + vec2<i32>(k % hood.span.x, k / hood.span.x);
         if inside(p.x, p.y) {
-            let d = textureLoad(light, p, 0).g;
+            let d = displaced_at(p);
             if d > 0.0 {
                 atomicOr(&displaced_near, 1u);
             }
             if hood.tiled {
                 tile_a[k] = d;
-                tile_b[k] = textureLoad(scratch_in, p, 0).x;
+                tile_b[k] = room_at(p);
             }
         }
     }
     workgroupBarrier();
-    if gid.x >= bank.width || gid.y >= bank.height {
+    let at = vec2<i32>(gid.xy) + bank.domain.xy;
+    if !textured(at.x, at.y) {
         return;
     }
-    let c = i32(gid.x);
-    let r = i32(gid.y);
-    if atomicLoad(&displaced_near) == 0u {
-        textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(0.0, 0.0, 0.0, 1.0));
+    // A border texel that repeats the edge sums around the edge texel, which the tiles may not
+    // reach: from the textures, the same sums.
+    let x = bank_texel_of(at);
+    let moved = any(x != at);
+    if atomicLoad(&displaced_near) == 0u && !moved {
+        textureStore(out_texture, at + HEIGHTFIELD_BORDER, vec4<f32>(0.0, 0.0, 0.0, 1.0));
         return;
     }
+    let tiled = hood.tiled && !moved;
     var sum = 0.0;
     for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
         for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
-            if inside(c + dc, r + dr) {
+            let p = x + vec2<i32>(dc, dr);
+            if inside(p.x, p.y) {
                 let k = kernel(dc, dr);
-                let p = vec2<i32>(c + dc, r + dr);
                 var d: f32;
                 var room: f32;
-                if hood.tiled {
+                if tiled {
                     let i = tile_index(hood, p);
                     d = tile_a[i];
                     room = tile_b[i];
                 } else {
-                    d = textureLoad(light, p, 0).g;
-                    room = textureLoad(scratch_in, p, 0).x;
+                    d = displaced_at(p);
+                    room = room_at(p);
                 }
                 if k > 0.0 && d > 0.0 {
                     sum += d * k / max(room, 1e-6);
@@ -188,7 +249,7 @@ fn bank_gather(
             }
         }
     }
-    let m = receptivity(textureLoad(shape, vec2<i32>(c, r), 0).x);
-    let h = bank.fraction * bank.snow_depth * m * sum;
-    textureStore(out_texture, vec2<i32>(c, r), vec4<f32>(h, 0.0, 0.0, 1.0));
+    let m = receptivity(smoothed_at(x));
+    let h_bank = bank.fraction * bank.snow_depth * m * sum;
+    textureStore(out_texture, at + HEIGHTFIELD_BORDER, vec4<f32>(h_bank, 0.0, 0.0, 1.0));
 }

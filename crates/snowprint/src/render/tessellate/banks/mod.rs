@@ -1,12 +1,13 @@
 //! The `banks` pass (compute, indirect, `banks.wgsl`): a share of the snow each diced surface's
-//! captures pushed down rises in banks beside the trails. Two dispatches per surface over the
-//! deformed texels only (the heightfield's indirect arguments): `bank_norm` spreads each texel's
-//! share into the scratch texture, `bank_gather` collects it into the bank heights.
+//! captures pushed down rises in banks beside the trails, on it and on the surfaces beside it. Two
+//! dispatches per deformed surface (indirect, `classify` writes them) over its texels and a band
+//! around it (`FrameSurface::bank_domain`): `bank_norm` spreads each texel's share into the
+//! scratch texture, `bank_gather` collects it into the bank heights.
 
 use super::BankParams;
 use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
-use crate::render::gpu::{STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use crate::render::gpu::{STATE_BANKS_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_pass};
@@ -50,7 +51,7 @@ impl BanksPass {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         active: bool,
-        surfaces: &[FrameSurface<'_>],
+        (pool, surfaces): (&wgpu::Buffer, &[FrameSurface<'_>]),
         heightfields: &HeightfieldPass,
     ) {
         self.bind_groups.clear();
@@ -71,13 +72,16 @@ impl BanksPass {
                 continue;
             }
             let (desc, layout) = (surface.view.desc, surface.view.layout);
-            let bank = BankParams::new(
-                layout.width,
-                layout.height,
-                surface.texel(),
-                desc.snow_depth,
-                surface.banks(),
-            );
+            let bank = BankParams {
+                domain: surface.bank_domain(),
+                ..BankParams::new(
+                    layout.width,
+                    layout.height,
+                    surface.texel(),
+                    desc.snow_depth,
+                    surface.banks(),
+                )
+            };
             bytes[s * stride..s * stride + std::mem::size_of::<BankParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&bank));
         }
@@ -94,6 +98,7 @@ impl BanksPass {
                 let tex = heightfields.texture(surface.view.id)?;
                 let params =
                     uniform_block(&self.params.buffer, s, std::mem::size_of::<BankParams>());
+                let texels = [pool.as_entire_binding(), heightfields.params(s)];
                 let norm = bind_group(
                     device,
                     "bank norm",
@@ -104,6 +109,8 @@ impl BanksPass {
                         tv(&tex.light),
                         tv(&tex.bank),
                         tv(&tex.bank_scratch),
+                        texels[0].clone(),
+                        texels[1].clone(),
                     ],
                 );
                 let gather = bind_group(
@@ -116,6 +123,8 @@ impl BanksPass {
                         tv(&tex.light),
                         tv(&tex.bank_scratch),
                         tv(&tex.bank),
+                        texels[0].clone(),
+                        texels[1].clone(),
                     ],
                 );
                 Some([norm, gather])
@@ -123,7 +132,7 @@ impl BanksPass {
             .collect();
     }
 
-    /// Both bank passes run over the deformed surfaces only (the heightfield's dispatch).
+    /// Both bank passes run over the deformed surfaces only (their dispatch from `classify`).
     pub(crate) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -139,7 +148,7 @@ impl BanksPass {
                     p.set_bind_group(0, &groups[step], &[]);
                     p.dispatch_workgroups_indirect(
                         state,
-                        (s as u64 * STATE_WORDS + STATE_HEIGHTFIELD_DISPATCH) * 4,
+                        (s as u64 * STATE_WORDS + STATE_BANKS_DISPATCH) * 4,
                     );
                 }
             }

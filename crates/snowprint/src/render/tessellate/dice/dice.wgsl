@@ -98,7 +98,10 @@ fn ground_bend(p0: vec3<f32>, p1: vec3<f32>) -> f32 {
 fn field_height(xz: vec2<f32>) -> f32 {
     let size = vec2<i32>(dice.grid.xy);
     let uv = (xz + dice.half_size.xy) / (2.0 * dice.half_size.xy);
-    let t = clamp(vec2<i32>(floor(uv * vec2<f32>(size))), vec2<i32>(0), size - 1);
+    // Both textures hold a border (heightfield.wgsl, banks.wgsl): on the far edges (uv = 1) the
+    // nearest texel is the first past the line, which a surface beside reads as its edge's, so
+    // that both dice the line alike.
+    let t = clamp(vec2<i32>(floor(uv * vec2<f32>(size))), vec2<i32>(0), size) + HEIGHTFIELD_BORDER;
     let dep = textureLoad(shape, t, 0).x;
     return dice.extent.x * (1.0 - dep) + textureLoad(banks, t, 0).x;
 }
