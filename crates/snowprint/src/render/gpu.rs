@@ -290,6 +290,10 @@ pub struct ClassifyRecord {
     pub wrap: u32,
     /// The texels the bank passes run over: along x in the low 16 bits, along z in the high.
     pub banks: u32,
+    /// The texels the heightfield pass runs over, likewise.
+    pub heightfield: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.

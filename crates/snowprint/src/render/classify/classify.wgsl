@@ -19,6 +19,10 @@ struct ClassifyRecord {
     terrain: u32,     // 1 on ground that is not flat
     wrap: u32,        // toroidal storage offsets (pool/texel.wgsl)
     banks: u32,       // texels the bank passes run over: x | z << 16
+    heightfield: u32, // texels the heightfield pass runs over, likewise
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
@@ -57,10 +61,9 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
         state[base + 5u] = deformable;
         state[base + 6u] = 0u;
         state[base + 7u] = 0u;
-        // Heightfield dispatch (8 x 8 workgroups over the heightmap and its border).
-        let border = u32(2 * HEIGHTFIELD_BORDER);
-        state[base + 8u] = select(0u, (rec.width + border + 7u) / 8u, deformable == 1u);
-        state[base + 9u] = (rec.height + border + 7u) / 8u;
+        // Heightfield dispatch (8 x 8 workgroups over its domain).
+        state[base + 8u] = select(0u, ((rec.heightfield & 0xffffu) + 7u) / 8u, deformable == 1u);
+        state[base + 9u] = ((rec.heightfield >> 16u) + 7u) / 8u;
         state[base + 10u] = 1u;
         state[base + STATE_TOUCHED] = touched;
         state[base + 12u] = bitcast<u32>(f32(d) / f32(channel_max(rec.bits)));

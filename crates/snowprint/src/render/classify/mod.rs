@@ -9,6 +9,11 @@ use super::pipeline;
 use super::readback::{Timestamps, compute_pass};
 use crate::gpu::resources::{Growable, bind_group};
 
+/// A domain's size, x in the low 16 bits and z in the high.
+fn packed_size([x0, z0, x1, z1]: [i32; 4]) -> u32 {
+    (x1 - x0) as u32 | ((z1 - z0) as u32) << 16
+}
+
 pub(super) struct ClassifyPass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
@@ -66,10 +71,9 @@ impl ClassifyPass {
                 bits: s.view.precision.bits(),
                 terrain: u32::from(s.view.ground != crate::capture::NO_GROUND),
                 wrap: s.view.wrap,
-                banks: {
-                    let [x0, z0, x1, z1] = s.bank_domain();
-                    (x1 - x0) as u32 | ((z1 - z0) as u32) << 16
-                },
+                banks: packed_size(s.bank_domain()),
+                heightfield: packed_size(s.heightfield_domain()),
+                _pad: [0; 3],
             })
             .collect();
         if n > 0 {

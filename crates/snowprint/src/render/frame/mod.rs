@@ -8,6 +8,9 @@ use super::cascades::ShadowCascades;
 use super::config::{RenderConfig, Tier};
 use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
 use super::heightfield::{Beside, SIDES};
+
+/// Texels the heightfield and bank textures hold beyond each side of a heightmap.
+const BORDER: i32 = crate::wgsl::consts::HEIGHTFIELD_BORDER;
 use super::inputs::{PointLight, RenderFrame};
 use super::tessellate::SurfaceGeometry;
 use crate::extract::SurfaceView;
@@ -49,28 +52,48 @@ impl FrameSurface<'_> {
     }
 
     /// The texels the bank passes run over, `[x0, z0, x1, z1)` of its heightmap's (its first
-    /// at 0): the bank texture's border beyond each side and, beyond a side with a surface beside
-    /// it, as far again as banks reach (the banks there gather snow pushed beyond the line, and
-    /// need the norm of where it lands).
+    /// at 0): its own and, beyond a side with a surface beside it, the bank texture's border and
+    /// as far again as banks reach (the banks there gather snow pushed beyond the line, and need
+    /// the norm of where it lands).
     pub(super) fn bank_domain(&self) -> [i32; 4] {
-        let border = crate::wgsl::consts::HEIGHTFIELD_BORDER;
         let texel = self.texel();
         let width = self.banks().width;
-        let reach = [width / texel.x, width / texel.y].map(|r| r.floor() as i32 + border);
-        let out = |side: usize, reach: i32| {
-            if self.sides[side].is_some() {
-                reach
-            } else {
-                border
-            }
-        };
+        let reach = [width / texel.x, width / texel.y].map(|r| r.floor() as i32 + BORDER);
+        let [x0, z0, x1, z1] = self.beyond([reach[0], reach[0], reach[1], reach[1]]);
         let layout = self.view.layout;
         [
-            -out(0, reach[0]),
-            -out(2, reach[1]),
-            layout.width as i32 + out(1, reach[0]),
-            layout.height as i32 + out(3, reach[1]),
+            -x0,
+            -z0,
+            layout.width as i32 + x1,
+            layout.height as i32 + z1,
         ]
+    }
+
+    /// The texels the heightfield pass runs over: its own and the textures' border beyond each
+    /// side with a surface beside it (the border beyond the others repeats the edge, which the
+    /// edge's invocations store), as `[x0, z0, x1, z1)`.
+    pub(super) fn heightfield_domain(&self) -> [i32; 4] {
+        let [x0, z0, x1, z1] = self.beyond([BORDER; 4]);
+        let layout = self.view.layout;
+        [
+            -x0,
+            -z0,
+            layout.width as i32 + x1,
+            layout.height as i32 + z1,
+        ]
+    }
+
+    /// `by` (texels past -x, +x, -z, +z) where a surface lies beside that side, else 0, as
+    /// `[-x, -z, +x, +z]`.
+    fn beyond(&self, by: [i32; 4]) -> [i32; 4] {
+        let out = |side: usize| {
+            if self.sides[side].is_some() {
+                by[side]
+            } else {
+                0
+            }
+        };
+        [out(0), out(2), out(1), out(3)]
     }
 
     /// Its banks: the geometry's, with the share of the pushed volume set by the material's

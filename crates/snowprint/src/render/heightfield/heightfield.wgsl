@@ -140,29 +140,41 @@ fn horizon_ao(c: i32, r: i32) -> f32 {
     return 1.0 - sum / f32(AO_DIRECTIONS);
 }
 
-// The texel a texel `t` of the border stands for along one axis: itself where a surface is linked
-// on that side, else the edge texel, so that the border repeats the edge.
-fn border_texel(t: i32, size: i32, low: u32, high: u32) -> i32 {
-    if (t < 0 && low == 0u) || (t >= size && high == 0u) {
-        return clamp(t, 0, size - 1);
-    }
-    return t;
+// The texels of the textures that hold texel `t` along one axis: itself and, at an edge with no
+// surface linked beyond it, the border there (which repeats the edge), as offsets from `t`.
+fn held_span(t: i32, size: i32, low: bool, high: bool) -> vec2<i32> {
+    let b = HEIGHTFIELD_BORDER;
+    return vec2<i32>(select(0, -b, t == 0 && low), select(0, b, t == size - 1 && high));
 }
 
 // One texel of the textures, which hold the surface and a border around it: texture texel (x, y)
-// is the surface's (x - HEIGHTFIELD_BORDER, y - HEIGHTFIELD_BORDER).
+// is the surface's (x - HEIGHTFIELD_BORDER, y - HEIGHTFIELD_BORDER). A border texel past a side
+// with no surface linked repeats the edge: the edge texel's invocation writes it.
+// The pass runs over the surface and the border past its linked sides (`FrameSurface::
+// heightfield_domain`): a surface with nothing beside it keeps its grid of workgroups.
 @compute @workgroup_size(8, 8, 1)
 fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
     let b = HEIGHTFIELD_BORDER;
-    if i32(gid.x) >= i32(params.width) + 2 * b || i32(gid.y) >= i32(params.height) + 2 * b {
+    let w = i32(params.width);
+    let h = i32(params.height);
+    let c = i32(gid.x) - select(b, 0, open_side(0u));
+    let r = i32(gid.y) - select(b, 0, open_side(2u));
+    let outside = c < -b || r < -b || c >= w + b || r >= h + b;
+    let repeated = (c < 0 && open_side(0u)) || (c >= w && open_side(1u))
+        || (r < 0 && open_side(2u)) || (r >= h && open_side(3u));
+    if outside || repeated {
         return;
     }
-    let s = params.sides;
-    let c = border_texel(i32(gid.x) - b, i32(params.width), s[0].present, s[1].present);
-    let r = border_texel(i32(gid.y) - b, i32(params.height), s[2].present, s[3].present);
     let n = sobel_normal(c, r);
-    let ao = horizon_ao(c, r);
-    let at = vec2<i32>(gid.xy);
-    textureStore(out_texture, at, vec4<f32>(smoothed_depression(c, r), n.x, n.z, ao));
-    textureStore(out_light, at, vec4<f32>(light_visibility(c, r), displaced(c, r), 0.0, 1.0));
+    let shape = vec4<f32>(smoothed_depression(c, r), n.x, n.z, horizon_ao(c, r));
+    let light = vec4<f32>(light_visibility(c, r), displaced(c, r), 0.0, 1.0);
+    let xs = held_span(c, w, open_side(0u), open_side(1u));
+    let ys = held_span(r, h, open_side(2u), open_side(3u));
+    for (var y = ys.x; y <= ys.y; y++) {
+        for (var x = xs.x; x <= xs.y; x++) {
+            let at = vec2<i32>(c + x + b, r + y + b);
+            textureStore(out_texture, at, shape);
+            textureStore(out_light, at, light);
+        }
+    }
 }

@@ -100,22 +100,47 @@ impl HeightfieldTexture {
 /// Texels the shape, light and bank textures hold beyond each side of the heightmap.
 pub(super) const BORDER: u32 = crate::wgsl::consts::HEIGHTFIELD_BORDER as u32;
 
+/// A pass's pipelines for surfaces with nothing beside them and for those with a surface linked
+/// beside a side (`LINKED` in `heightfield/texels.wgsl`).
+pub(super) fn linked_pipelines(
+    device: &wgpu::Device,
+    label: &str,
+    (module, entry): (&wgpu::ShaderModule, &str),
+    layout: &wgpu::BindGroupLayout,
+) -> [wgpu::ComputePipeline; 2] {
+    [0.0, 1.0].map(|linked| {
+        pipeline::compute_with(
+            device,
+            label,
+            (module, entry),
+            &[layout],
+            &[("LINKED", linked)],
+        )
+    })
+}
+
+/// Whether a surface lies beside any of a frame's surface's sides.
+pub(super) fn linked(surface: &FrameSurface<'_>) -> bool {
+    surface.sides.iter().any(Option::is_some)
+}
+
 pub(super) struct HeightfieldPass {
     layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
+    /// For surfaces with nothing beside them, and with a surface beside a side.
+    pipelines: [wgpu::ComputePipeline; 2],
     /// Per surface: `HeightfieldParams` in a uniform block.
     params: Growable,
     /// Every surface's textures (kept while its size holds).
     textures: HashMap<SurfaceId, HeightfieldTexture>,
-    /// This frame's bind groups, in surface order.
-    bind_groups: Vec<wgpu::BindGroup>,
+    /// This frame's bind groups, in surface order, and whether each surface is linked.
+    bind_groups: Vec<(wgpu::BindGroup, bool)>,
 }
 
 impl HeightfieldPass {
     pub(super) fn new(device: &wgpu::Device) -> Self {
         let layout = crate::wgsl::HEIGHTFIELD.bind_group_layout(device, "heightfield", 0);
         let module = pipeline::shader(device, "heightfield.wgsl", crate::wgsl::HEIGHTFIELD.wgsl());
-        let pipeline = pipeline::compute(device, "heightfield", &module, "heightfield", &[&layout]);
+        let pipelines = linked_pipelines(device, "heightfield", (&module, "heightfield"), &layout);
         Self {
             params: Growable::new(
                 device,
@@ -124,7 +149,7 @@ impl HeightfieldPass {
                 UNIFORM_STRIDE * 8,
             ),
             layout,
-            pipeline,
+            pipelines,
             textures: HashMap::new(),
             bind_groups: Vec::new(),
         }
@@ -203,7 +228,7 @@ impl HeightfieldPass {
             .enumerate()
             .map(|(s, surface)| {
                 let tex = &self.textures[&surface.view.id];
-                bind_group(
+                let group = bind_group(
                     device,
                     "heightfield",
                     &self.layout,
@@ -218,7 +243,8 @@ impl HeightfieldPass {
                         wgpu::BindingResource::TextureView(&tex.light),
                         ground.as_entire_binding(),
                     ],
-                )
+                );
+                (group, linked(surface))
             })
             .collect();
     }
@@ -232,8 +258,12 @@ impl HeightfieldPass {
         state: &wgpu::Buffer,
     ) {
         let mut p = compute_pass(encoder, ts, slot);
-        p.set_pipeline(&self.pipeline);
-        for (s, bg) in self.bind_groups.iter().enumerate() {
+        let mut bound = None;
+        for (s, (bg, linked)) in self.bind_groups.iter().enumerate() {
+            if bound != Some(*linked) {
+                p.set_pipeline(&self.pipelines[usize::from(*linked)]);
+                bound = Some(*linked);
+            }
             p.set_bind_group(0, bg, &[]);
             p.dispatch_workgroups_indirect(
                 state,

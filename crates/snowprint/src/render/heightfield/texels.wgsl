@@ -6,6 +6,10 @@
 
 // import texel
 
+// Whether the pipeline serves surfaces with a surface linked beside a side: the others' pipelines
+// leave the reads across the line out (their code and registers cost time where nothing is linked).
+override LINKED: bool = false;
+
 // The surface beside one side. Must match `HeightfieldSide` in src/render/gpu.rs.
 struct HeightfieldSide {
     heights: u32,
@@ -67,6 +71,11 @@ fn side_fractions(k: u32, along: i32, across: i32) -> vec3<f32> {
 fn fractions(c: i32, r: i32) -> vec2<f32> {
     let w = i32(params.width);
     let h = i32(params.height);
+    if !LINKED {
+        let x = u32(clamp(c, 0, w - 1));
+        let y = u32(clamp(r, 0, h - 1));
+        return pool_fractions(params.bits, params.heights, params.width, params.height, params.wrap, x, y);
+    }
     if c < 0 || c >= w {
         let k = select(1u, 0u, c < 0);
         let f = side_fractions(k, r, select(c - w, -1 - c, c < 0));
@@ -112,11 +121,19 @@ fn smoothed_depression(c: i32, r: i32) -> f32 {
 }
 
 
+// Whether nothing is linked beside side `k` (the border past it repeats the edge).
+fn open_side(k: u32) -> bool {
+    return !LINKED || params.sides[k].present == 0u;
+}
+
 // Whether texel (c, r) holds snow of this surface or of a surface linked beside it (past a side,
 // within that surface; not the corners beyond two sides).
 fn held(c: i32, r: i32) -> bool {
     let w = i32(params.width);
     let h = i32(params.height);
+    if !LINKED {
+        return c >= 0 && r >= 0 && c < w && r < h;
+    }
     let across_x = c < 0 || c >= w;
     let across_z = r < 0 || r >= h;
     if across_x && across_z {

@@ -381,18 +381,16 @@ pub struct BankParams {
     /// Padding.
     pub _pad: [f32; 3],
     /// The texels the passes run over, `[x0, z0, x1, z1)` of the heightmap's (its first at 0):
-    /// the surface, the textures' border around it and, beyond a side with a surface beside it,
-    /// the band that the banks reach across the line.
+    /// the surface and, beyond a side with a surface beside it, the band that the banks reach
+    /// across the line and the textures' border.
     pub domain: [i32; 4],
 }
 
 impl BankParams {
-    /// The parameters of a surface of `width x height` texels, with the textures' border around
-    /// it.
+    /// The parameters of a surface of `width x height` texels with nothing beside it.
     pub fn new(width: u32, height: u32, texel: Vec2, snow_depth: f32, banks: BankSettings) -> Self {
-        let b = crate::wgsl::consts::HEIGHTFIELD_BORDER;
         Self {
-            domain: [-b, -b, width as i32 + b, height as i32 + b],
+            domain: [0, 0, width as i32, height as i32],
             width,
             height,
             reach_x: (banks.width / texel.x).floor() as i32,

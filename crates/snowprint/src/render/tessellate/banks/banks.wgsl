@@ -12,11 +12,11 @@
 // receivers), so the volume of the banks is the fraction of the pushed volume, up to rounding.
 // The snow is the surface's and that of the surfaces linked beside its sides (`held`,
 // heightfield_texels.wgsl): snow pushed across the line where two surfaces meet lands on the
-// other, as on one surface over both. The passes run over the surface and a band beyond each
-// side (`BankParams::domain`: the reach and the border where a surface is linked, the border
-// elsewhere), N over all of it, the banks over the surface and the border of HEIGHTFIELD_BORDER
-// texels (where no surface is linked, the edge repeated) that the bank texture holds around the
-// heightmap's, as the heightfield textures do.
+// other, as on one surface over both. The passes run over the surface and, past a linked side, a
+// band as wide as the reach and the border (`BankParams::domain`): N over all of it, the banks
+// over the surface and the border of HEIGHTFIELD_BORDER texels that the bank texture holds around
+// the heightmap's, as the heightfield textures do (past a side with nothing linked, the edge
+// repeated: the edge texel's invocation stores it).
 // Reads: the surface's heightfield textures (heightfield.wgsl: smoothed depression in .x, the
 // displaced channel in the light texture's .g; texel p at p + HEIGHTFIELD_BORDER), past their
 // border the pool (this surface's neighbours). Writes: the bank scratch (N over the domain, texel
@@ -53,6 +53,9 @@ struct BankParams {
 
 // Whether texel p holds snow (`held`) and is within the domain, where N is: a source of banks.
 fn inside(c: i32, r: i32) -> bool {
+    if !LINKED {
+        return c >= 0 && r >= 0 && c < i32(bank.width) && r < i32(bank.height);
+    }
     let d = bank.domain;
     return c >= d.x && r >= d.y && c < d.z && r < d.w && held(c, r);
 }
@@ -71,7 +74,7 @@ fn as_half(x: f32) -> f32 {
 // The smoothed depression at a held texel: the texture's, or past its border the pool's, as the
 // surface beside holds it in its own texture.
 fn smoothed_at(p: vec2<i32>) -> f32 {
-    if textured(p.x, p.y) {
+    if !LINKED || textured(p.x, p.y) {
         return textureLoad(shape, p + HEIGHTFIELD_BORDER, 0).x;
     }
     return as_half(smoothed_depression(p.x, p.y));
@@ -79,7 +82,7 @@ fn smoothed_at(p: vec2<i32>) -> f32 {
 
 // The displaced snow at a held texel, likewise.
 fn displaced_at(p: vec2<i32>) -> f32 {
-    if textured(p.x, p.y) {
+    if !LINKED || textured(p.x, p.y) {
         return textureLoad(light, p + HEIGHTFIELD_BORDER, 0).g;
     }
     return as_half(displaced(p.x, p.y));
@@ -181,13 +184,34 @@ fn bank_norm(
     textureStore(out_texture, vec2<i32>(gid.xy), vec4<f32>(n, 0.0, 0.0, 1.0));
 }
 
-// The texel whose bank a texel of the bank texture holds: itself on the surface and where a
-// surface is linked beside it, else the edge texel next to it (the border repeats the edge).
-fn bank_texel_of(p: vec2<i32>) -> vec2<i32> {
-    if held(p.x, p.y) {
-        return p;
+// The texels of the bank texture that hold texel `p`'s bank, as offsets from it along each axis:
+// itself and, at an edge with no surface linked beyond it, the border there (the edge repeated).
+fn held_spans(p: vec2<i32>) -> vec4<i32> {
+    let b = HEIGHTFIELD_BORDER;
+    let w = i32(bank.width) - 1;
+    let h = i32(bank.height) - 1;
+    return vec4<i32>(
+        select(0, -b, p.x == 0 && open_side(0u)),
+        select(0, b, p.x == w && open_side(1u)),
+        select(0, -b, p.y == 0 && open_side(2u)),
+        select(0, b, p.y == h && open_side(3u)),
+    );
+}
+
+// Store texel p's bank (and, at an edge with nothing linked beyond it, the border's).
+fn store_bank(p: vec2<i32>, value: f32) {
+    let v = vec4<f32>(value, 0.0, 0.0, 1.0);
+    let last = vec2<i32>(i32(bank.width), i32(bank.height)) - 1;
+    if all(p > vec2<i32>(0)) && all(p < last) {
+        textureStore(out_texture, p + HEIGHTFIELD_BORDER, v);
+        return;
     }
-    return clamp(p, vec2<i32>(0), vec2<i32>(i32(bank.width), i32(bank.height)) - 1);
+    let spans = held_spans(p);
+    for (var y = spans.z; y <= spans.w; y++) {
+        for (var x = spans.x; x <= spans.y; x++) {
+            textureStore(out_texture, p + vec2<i32>(x, y) + HEIGHTFIELD_BORDER, v);
+        }
+    }
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -214,19 +238,17 @@ fn bank_gather(
         }
     }
     workgroupBarrier();
-    let at = vec2<i32>(gid.xy) + bank.domain.xy;
-    if !textured(at.x, at.y) {
+    // The banks are over the surface and the border past its linked sides; the border past the
+    // others repeats the edge, which stores it.
+    let x = vec2<i32>(gid.xy) + bank.domain.xy;
+    if !textured(x.x, x.y) || x.x >= bank.domain.z || x.y >= bank.domain.w {
         return;
     }
-    // A border texel that repeats the edge sums around the edge texel, which the tiles may not
-    // reach: from the textures, the same sums.
-    let x = bank_texel_of(at);
-    let moved = any(x != at);
-    if atomicLoad(&displaced_near) == 0u && !moved {
-        textureStore(out_texture, at + HEIGHTFIELD_BORDER, vec4<f32>(0.0, 0.0, 0.0, 1.0));
+    if atomicLoad(&displaced_near) == 0u {
+        store_bank(x, 0.0);
         return;
     }
-    let tiled = hood.tiled && !moved;
+    let tiled = hood.tiled;
     var sum = 0.0;
     for (var dr = -bank.reach_z; dr <= bank.reach_z; dr++) {
         for (var dc = -bank.reach_x; dc <= bank.reach_x; dc++) {
@@ -250,6 +272,5 @@ fn bank_gather(
         }
     }
     let m = receptivity(smoothed_at(x));
-    let h_bank = bank.fraction * bank.snow_depth * m * sum;
-    textureStore(out_texture, at + HEIGHTFIELD_BORDER, vec4<f32>(h_bank, 0.0, 0.0, 1.0));
+    store_bank(x, bank.fraction * bank.snow_depth * m * sum);
 }

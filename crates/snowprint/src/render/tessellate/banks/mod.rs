@@ -8,26 +8,28 @@ use super::BankParams;
 use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_BANKS_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
-use crate::render::heightfield::HeightfieldPass;
+use crate::render::heightfield::{HeightfieldPass, linked, linked_pipelines};
 use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_pass};
 
 pub(in crate::render) struct BanksPass {
     layout: wgpu::BindGroupLayout,
-    norm: wgpu::ComputePipeline,
-    gather: wgpu::ComputePipeline,
+    /// `bank_norm` and `bank_gather`, each for surfaces with nothing beside them and with a
+    /// surface beside a side.
+    pipelines: [[wgpu::ComputePipeline; 2]; 2],
     /// Per surface: `BankParams` in a uniform block.
     params: Growable,
-    /// This frame's bind groups (norm, gather) per surface; `None` where it is not diced.
-    bind_groups: Vec<Option<[wgpu::BindGroup; 2]>>,
+    /// This frame's bind groups (norm, gather) per surface and whether it is linked; `None` where
+    /// it draws no banks.
+    bind_groups: Vec<Option<([wgpu::BindGroup; 2], bool)>>,
 }
 
 impl BanksPass {
     pub(crate) fn new(device: &wgpu::Device) -> Self {
         let layout = crate::wgsl::BANKS.bind_group_layout(device, "banks", 0);
         let module = pipeline::shader(device, "banks.wgsl", crate::wgsl::BANKS.wgsl());
-        let norm = pipeline::compute(device, "bank norm", &module, "bank_norm", &[&layout]);
-        let gather = pipeline::compute(device, "bank gather", &module, "bank_gather", &[&layout]);
+        let pipelines = [("bank norm", "bank_norm"), ("bank gather", "bank_gather")]
+            .map(|(label, entry)| linked_pipelines(device, label, (&module, entry), &layout));
         Self {
             params: Growable::new(
                 device,
@@ -36,8 +38,7 @@ impl BanksPass {
                 256 * 8,
             ),
             layout,
-            norm,
-            gather,
+            pipelines,
             bind_groups: Vec::new(),
         }
     }
@@ -127,7 +128,7 @@ impl BanksPass {
                         texels[1].clone(),
                     ],
                 );
-                Some([norm, gather])
+                Some(([norm, gather], linked(surface)))
             })
             .collect();
     }
@@ -141,10 +142,14 @@ impl BanksPass {
         state: &wgpu::Buffer,
     ) {
         let mut p = compute_pass(encoder, ts, slot);
-        for (step, pipeline) in [&self.norm, &self.gather].into_iter().enumerate() {
-            p.set_pipeline(pipeline);
+        for (step, pipelines) in self.pipelines.iter().enumerate() {
+            let mut bound = None;
             for (s, groups) in self.bind_groups.iter().enumerate() {
-                if let Some(groups) = groups {
+                if let Some((groups, linked)) = groups {
+                    if bound != Some(*linked) {
+                        p.set_pipeline(&pipelines[usize::from(*linked)]);
+                        bound = Some(*linked);
+                    }
                     p.set_bind_group(0, &groups[step], &[]);
                     p.dispatch_workgroups_indirect(
                         state,
