@@ -7,10 +7,10 @@
 // per texel instead of per pixel) in .r and the displaced snow (the pool's high 16 bits, raw) in
 // .g, which the tessellated tier's banks read. Dispatched indirectly: zero workgroups for a surface on the
 // basic material.
-// The textures hold HEIGHTFIELD_BORDER texels more on each side than the heightmap: there, and in every tap that
-// reaches past the surface's edge, the heights are those of the surface linked beside that side
-// (render/heightfield/sides.rs) where there is one, so that two surfaces side by side shade as one;
-// elsewhere the taps clamp to the edge and the border repeats it.
+// The textures hold HEIGHTFIELD_BORDER texels more on each side than the heightmap: there, and in
+// every tap that reaches past the surface's edge, the heights are those of the surface linked
+// beside that side (render/heightfield/sides.rs) where there is one, so that two surfaces side by
+// side shade as one; elsewhere the taps clamp to the edge and the border repeats it.
 // Reads: the heightmap pool (this surface's and its neighbours'). Writes: the surface's
 // heightfield and light textures.
 // CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
