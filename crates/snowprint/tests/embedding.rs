@@ -2,6 +2,8 @@
 //! fall short), records the snow into its own command encoder between its own passes, and reads
 //! GPU times that never make the frame wait.
 
+mod common;
+
 use glam::Vec3;
 use snowprint::low_level::gpu::download;
 use snowprint::render::{
@@ -164,20 +166,13 @@ fn a_frame_recorded_between_two_of_the_callers_passes() {
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let target = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("engine target"),
-        size: wgpu::Extent3d {
-            width: 16,
-            height: 16,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
+    let target = common::target(
+        device,
+        "engine target",
+        (16, 16),
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
     let view = target.create_view(&Default::default());
 
     let mut encoder = device.create_command_encoder(&Default::default());
@@ -361,20 +356,13 @@ fn the_renderer_records_into_the_callers_encoder() {
     config.snowflakes = 100;
     let mut renderer = Renderer::new(&gpu, config).unwrap();
     let surfaces = [(id, GroundMaterial::Concrete)];
-    let target = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("engine swapchain stand-in"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: OUTPUT_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let target = common::target(
+        device,
+        "engine swapchain stand-in",
+        (w, h),
+        OUTPUT_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
     let view = target.create_view(&Default::default());
     let row = 256u32;
     let pixels = device.create_buffer(&wgpu::BufferDescriptor {

@@ -206,20 +206,13 @@ fn renders_into_a_callers_texture() {
     let cube = r.add_mesh(&Mesh::cuboid(Vec3::splat(0.5))).unwrap();
     let inst = [Instance::new(cube, Mat4::IDENTITY, [0.6, 0.2, 0.1])];
     // A window's surface is often Bgra8Unorm (not sRGB): the tonemap pass then encodes sRGB itself.
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("window stand-in"),
-        size: wgpu::Extent3d {
-            width: 64,
-            height: 36,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Bgra8Unorm,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let texture = common::target(
+        &gpu.device,
+        "window stand-in",
+        (64, 36),
+        wgpu::TextureFormat::Bgra8Unorm,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
     let view = texture.create_view(&Default::default());
     for _ in 0..3 {
         r.render_to_view(
@@ -298,20 +291,13 @@ fn renders_into_a_callers_texture() {
     assert!(r.latest_report().is_some());
 
     // A target of the wrong size is refused.
-    let wrong = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: None,
-        size: wgpu::Extent3d {
-            width: 32,
-            height: 36,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Bgra8Unorm,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
+    let wrong = common::target(
+        &gpu.device,
+        "",
+        (32, 36),
+        wgpu::TextureFormat::Bgra8Unorm,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
     let e = r
         .render_to_view(
             &world,

@@ -93,20 +93,13 @@ fn run(tier: Tier, cache: bool, discard: Option<usize>) -> Vec<Frame> {
                 instances[0],
                 Instance::new(ball, Mat4::from_translation(-at), [0.7, 0.2, 0.1]),
             ];
-            let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("a frame never shown"),
-                size: wgpu::Extent3d {
-                    width: 96,
-                    height: 64,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8Unorm,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            });
+            let target = common::target(
+                &gpu.device,
+                "a frame never shown",
+                (96, 64),
+                wgpu::TextureFormat::Rgba8Unorm,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            );
             let view = target.create_view(&Default::default());
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let dropped = RenderFrame {
