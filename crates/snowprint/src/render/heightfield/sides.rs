@@ -67,19 +67,22 @@ pub(crate) struct Side {
 }
 
 /// Each surface's neighbours on its four sides, among `all` (the world's live surfaces). `of`
-/// indexes the surfaces to link into `all` (an index past its end has none).
+/// indexes the surfaces to link into `all` (an index past its end has none). The candidates come
+/// from the lines the sides run along ([`Lines`]), so a frame of many surfaces tests only those
+/// whose sides could meet, not every pair.
 pub(crate) fn sides(all: &[SurfaceView<'_>], of: &[usize]) -> Vec<[Option<Side>; SIDES]> {
+    let lines = Lines::new(all);
     of.iter()
         .map(|&a| {
             let mut best: [Option<(Side, i32)>; SIDES] = [None; SIDES];
             let Some(this) = all.get(a) else {
                 return [None; SIDES];
             };
-            for (b, other) in all.iter().enumerate() {
+            for b in lines.facing(this) {
                 if b == a {
                     continue;
                 }
-                if let Some((side, link, shared)) = beside(this, other, b)
+                if let Some((side, link, shared)) = beside(this, &all[b], b)
                     && best[side].is_none_or(|(_, s)| shared > s)
                 {
                     best[side] = Some((link, shared));
@@ -88,6 +91,62 @@ pub(crate) fn sides(all: &[SurfaceView<'_>], of: &[usize]) -> Vec<[Option<Side>;
             best.map(|b| b.map(|(link, _)| link))
         })
         .collect()
+}
+
+/// Where a surface's sides run: for each, its yaw (thousandths of a degree), which side it is,
+/// and the line in the yaw's frame (quarters of a texel), sorted, with the surface's index. Two
+/// sides that meet face each other along one line, up to the slack of [`beside`], which the
+/// lookups cover by the neighbouring keys.
+struct Lines(Vec<((i64, usize, i64), usize)>);
+
+impl Lines {
+    fn new(all: &[SurfaceView<'_>]) -> Self {
+        let mut keys = Vec::with_capacity(all.len() * SIDES);
+        for (i, s) in all.iter().enumerate() {
+            let (yaw, lines) = side_lines(s);
+            for (k, line) in lines.into_iter().enumerate() {
+                keys.push(((yaw, k, line), i));
+            }
+        }
+        keys.sort_unstable();
+        Self(keys)
+    }
+
+    /// The surfaces with a side facing one of `s`'s along its line, each once.
+    fn facing(&self, s: &SurfaceView<'_>) -> Vec<usize> {
+        let mut found = Vec::new();
+        let (yaw, lines) = side_lines(s);
+        for (k, line) in lines.into_iter().enumerate() {
+            for dy in -1..=1 {
+                let yaw = (yaw + dy).rem_euclid(YAW_STEPS);
+                let (lo, hi) = ((yaw, k ^ 1, line - 1), (yaw, k ^ 1, line + 1));
+                let first = self.0.partition_point(|(key, _)| *key < lo);
+                let last = self.0.partition_point(|(key, _)| *key <= hi);
+                found.extend(self.0[first..last].iter().map(|&(_, i)| i));
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        found
+    }
+}
+
+/// Thousandths of a degree in a turn.
+const YAW_STEPS: i64 = 360_000;
+
+/// A surface's yaw key and the lines of its sides -x, +x, -z, +z (see [`Lines`]).
+fn side_lines(s: &SurfaceView<'_>) -> (i64, [i64; SIDES]) {
+    let yaw = (s.desc.yaw_degrees.rem_euclid(360.0) as f64 * 1000.0).round() as i64 % YAW_STEPS;
+    let c = s.desc.rotation().inverse() * s.desc.center;
+    let (half, quarter) = (0.5 * s.desc.size, 0.25 * texel(s));
+    let line = |at: f32, step: f32| (at / step).round() as i64;
+    let lines = [
+        line(c.x - half.x, quarter.x),
+        line(c.x + half.x, quarter.x),
+        line(c.z - half.y, quarter.y),
+        line(c.z + half.y, quarter.y),
+    ];
+    (yaw, lines)
 }
 
 /// Texel sides (x, z) of a surface, metres.
