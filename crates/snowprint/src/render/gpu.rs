@@ -174,6 +174,7 @@ impl SurfaceUniform {
             ground: 0,
             index: surface.id.index(),
             macro_waves: 1.0,
+            seams: 0,
         };
         Self::shaded(surface, &shading)
     }
@@ -210,7 +211,7 @@ impl SurfaceUniform {
             pattern: [
                 desc.center.x,
                 desc.center.z,
-                look.switch_bits() as f32,
+                (look.switch_bits() | shading.seams << SEAM_SWITCH_SHIFT) as f32,
                 shading.macro_waves,
             ],
             heights: surface.heights,
@@ -255,6 +256,10 @@ impl SurfaceUniform {
     }
 }
 
+/// Bit of the material's switches (`pattern.z`) where the seam sides begin (`SNOW_SEAM_SIDES` in
+/// `snow.wgsl`).
+const SEAM_SWITCH_SHIFT: u32 = 2;
+
 /// The material settings of one surface's [`SurfaceUniform`].
 pub(crate) struct Shading {
     /// The relief or POM search.
@@ -267,6 +272,9 @@ pub(crate) struct Shading {
     pub index: u32,
     /// Strength of the macro waves.
     pub macro_waves: f32,
+    /// Sides (bits 0-3: local -x, +x, -z, +z) where its snow meets another surface's
+    /// (`tessellate::seams::seam_sides`).
+    pub seams: u32,
 }
 
 /// One surface for the classify pass. Must match `ClassifyRecord` in `classify.wgsl`.
@@ -283,9 +291,10 @@ pub struct ClassifyRecord {
     pub box_vertices: u32,
     /// Bits a channel of the pool's heightmaps.
     pub bits: u32,
-    /// 1 when the surface lies on ground that is not flat (always the deformable material: the
-    /// basic one draws a flat top), else 0.
-    pub terrain: u32,
+    /// 1 when the surface takes the deformable material even untouched: on ground that is not
+    /// flat (the basic one draws a flat top), or with a hole (the basic one cannot meet the step
+    /// at its edge, `surface.wgsl`'s `hole_step`), else 0.
+    pub always_deformable: u32,
     /// Toroidal storage offsets ([`crate::pool::wrapped`]).
     pub wrap: u32,
     /// The texels the bank passes run over: along x in the low 16 bits, along z in the high.

@@ -92,12 +92,11 @@ mod tonemap;
 use std::collections::HashMap;
 use std::time::Instant;
 
-use crate::extract::FrameView;
 use crate::gpu::GpuContext;
 use crate::mesh::Mesh;
 use crate::surface::SurfaceId;
 use crate::world::SnowWorld;
-use frame::{FrameLayouts, FrameResources, FrameSurface};
+use frame::{FrameLayouts, FrameResources};
 use graph::pass;
 use readback::Timestamps;
 use stats::{StatsReadback, StatsSources};
@@ -593,7 +592,7 @@ impl Renderer {
         let mut laps = report::Laps::start();
         let view = world.frame_view();
         let tessellated_tier = self.config.tier == Tier::Tessellated;
-        let surfaces = frame_surfaces(
+        let surfaces = frame::frame_surfaces(
             &view,
             frame,
             &self.geometry,
@@ -764,31 +763,4 @@ impl Renderer {
             _ => unreachable!("pass {slot} of PASSES has no encoder"),
         }
     }
-}
-
-/// The frame's surfaces in its order, each looked up in the world's extract (a surface the world
-/// does not hold is the world's error), with its tessellated-tier settings.
-fn frame_surfaces<'a>(
-    view: &'a FrameView<'a>,
-    frame: &RenderFrame<'_>,
-    geometry: &'a HashMap<SurfaceId, SurfaceGeometry>,
-    default_geometry: &'a SurfaceGeometry,
-    tessellated_tier: bool,
-) -> RenderResult<Vec<FrameSurface<'a>>> {
-    let mut besides = heightfield::besides(&view.surfaces, frame.surfaces.iter().map(|s| s.0));
-    frame
-        .surfaces
-        .iter()
-        .zip(besides.drain(..))
-        .map(|(&(id, ground), sides)| {
-            let geometry = geometry.get(&id).unwrap_or(default_geometry);
-            Ok(FrameSurface {
-                view: view.surface(id)?,
-                ground,
-                geometry,
-                tessellated: tessellated_tier && geometry.tessellate,
-                sides,
-            })
-        })
-        .collect()
 }

@@ -47,6 +47,14 @@ const STATE_TOUCHED: u32 = 11u;
 const ARGS_BASE: u32 = 8u;
 // Words per surface of the dicing's draw arguments.
 const ARGS_STRIDE: u32 = 8u;
+// Bit of a base triangle's first edge's seam mark (`ids.w`, four bits an edge): where the diced
+// snow meets another surface's (render/tessellate/seams.rs), the edge's skirt is shaded as the top.
+const SEAM_SHIFT: u32 = 8u;
+// Seam mark of an edge on the rectangle's side k (local -x, +x, -z, +z): SEAM_SIDE + k, a seam
+// when the dicing parameters' side mask has bit k.
+const SEAM_SIDE: u32 = 1u;
+// Seam mark of an edge of the hole a finer terrain window level draws: always a seam.
+const SEAM_HOLE: u32 = 5u;
 // Dicing counter of vertices appended.
 const COUNTER_VERTICES: u32 = 0u;
 // Dicing counter of indices appended.

@@ -1,7 +1,8 @@
 // classify.wgsl: which snow material each surface needs this frame, decided on the GPU. A surface
 // whose heightmap is all zero (nothing ever pressed it, or the snow has filled every print back)
 // gets the basic material; any other the deformable one, and so does every surface on ground that is
-// not flat (the basic material draws a flat top). The pass writes, per surface, the
+// not flat (the basic material draws a flat top) or with a hole (a coarser terrain window level:
+// the basic material cannot meet the step at the hole's edge). The pass writes, per surface, the
 // indirect draw arguments of both snow pipelines (one of them with zero instances), the indirect
 // dispatches of its heightfield and bank passes (zero workgroups when basic), and the flag the
 // report reads.
@@ -16,7 +17,7 @@ struct ClassifyRecord {
     height: u32,
     box_vertices: u32,
     bits: u32,        // bits a channel (pool/texel.wgsl)
-    terrain: u32,     // 1 on ground that is not flat
+    always_deformable: u32, // 1 on ground that is not flat, or with a hole (ClassifyRecord)
     wrap: u32,        // toroidal storage offsets (pool/texel.wgsl)
     banks: u32,       // texels the bank passes run over: x | z << 16
     heightfield: u32, // texels the heightfield pass runs over, likewise
@@ -49,7 +50,7 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
     if li == 0u {
         let d = atomicLoad(&deepest);
         let touched = select(0u, 1u, d > 0u);
-        let deformable = max(touched, rec.terrain);
+        let deformable = max(touched, rec.always_deformable);
         let base = wg.x * STATE_WORDS;
         // Basic material draw: vertex count, instance count, first vertex, first instance.
         state[base + 0u] = rec.box_vertices;

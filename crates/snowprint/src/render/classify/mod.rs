@@ -69,7 +69,9 @@ impl ClassifyPass {
                 height: s.view.layout.height,
                 box_vertices: BOX_VERTICES,
                 bits: s.view.precision.bits(),
-                terrain: u32::from(s.view.ground != crate::capture::NO_GROUND),
+                always_deformable: u32::from(
+                    s.view.ground != crate::capture::NO_GROUND || s.view.hole.is_some(),
+                ),
                 wrap: s.view.wrap,
                 banks: packed_size(s.bank_domain()),
                 heightfield: packed_size(s.heightfield_domain()),

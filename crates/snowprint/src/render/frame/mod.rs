@@ -6,16 +6,19 @@ use glam::{Vec2, Vec3};
 
 use super::cascades::ShadowCascades;
 use super::config::{RenderConfig, Tier};
+use super::error::RenderResult;
 use super::gpu::{FrameUniform, MAX_POINT_LIGHTS, PointLightRaw};
-use super::heightfield::{Beside, SIDES};
+use super::heightfield::{self, Beside, SIDES};
 
 /// Texels the heightfield and bank textures hold beyond each side of a heightmap.
 const BORDER: i32 = crate::wgsl::consts::HEIGHTFIELD_BORDER;
 use super::inputs::{PointLight, RenderFrame};
 use super::tessellate::SurfaceGeometry;
-use crate::extract::SurfaceView;
+use crate::extract::{FrameView, SurfaceView};
 use crate::gpu::resources::bind_group;
+use crate::surface::SurfaceId;
 use crate::view::GroundMaterial;
+use std::collections::HashMap;
 
 /// Near and far planes of the camera, metres.
 pub(super) const NEAR: f32 = 0.05;
@@ -33,6 +36,8 @@ pub(super) struct FrameSurface<'a> {
     pub tessellated: bool,
     /// The surfaces of the world beside its sides, local -x, +x, -z, +z (`heightfield::sides`).
     pub sides: [Option<Beside<'a>>; SIDES],
+    /// Whether it lies in a coarser terrain window level's hole (`tessellate::seams::enclosed`).
+    pub enclosed: bool,
 }
 
 impl FrameSurface<'_> {
@@ -299,4 +304,38 @@ pub(super) fn frame_uniform(
         ],
         lights: raw,
     }
+}
+
+/// The frame's surfaces in its order, each looked up in the world's extract (a surface the world
+/// does not hold is the world's error), with its tessellated-tier settings.
+pub(super) fn frame_surfaces<'a>(
+    view: &'a FrameView<'a>,
+    frame: &RenderFrame<'_>,
+    geometry: &'a HashMap<SurfaceId, SurfaceGeometry>,
+    default_geometry: &'a SurfaceGeometry,
+    tessellated_tier: bool,
+) -> RenderResult<Vec<FrameSurface<'a>>> {
+    let mut besides = heightfield::besides(&view.surfaces, frame.surfaces.iter().map(|s| s.0));
+    let drawn: Vec<_> = frame
+        .surfaces
+        .iter()
+        .map(|&(id, _)| view.surface(id))
+        .collect::<Result<_, _>>()?;
+    frame
+        .surfaces
+        .iter()
+        .zip(&drawn)
+        .zip(besides.drain(..))
+        .map(|((&(id, ground), &view), sides)| {
+            let geometry = geometry.get(&id).unwrap_or(default_geometry);
+            Ok(FrameSurface {
+                view,
+                ground,
+                geometry,
+                tessellated: tessellated_tier && geometry.tessellate,
+                sides,
+                enclosed: super::tessellate::seams::enclosed(view, &drawn),
+            })
+        })
+        .collect()
 }

@@ -22,6 +22,7 @@ use super::pipeline;
 use super::readback::{Timestamps, render_span};
 use super::targets::{KEEP, Targets};
 use super::tessellate::dice::DicePass;
+use super::tessellate::seams::seam_sides;
 use super::tessellate::snow_shadow::TessSurface;
 use crate::gpu::resources::{Growable, bind_group};
 use crate::view::GroundMaterial;
@@ -175,6 +176,7 @@ impl SnowPass {
                 },
                 index: s as u32,
                 macro_waves: surface.geometry.macro_waves,
+                seams: seam_sides(surface.enclosed, surface.sides.map(|s| s.is_some())),
             };
             let u = SurfaceUniform::shaded(surface.view, &shading);
             self.outside.push(eye_outside_box(&u, eye));

@@ -645,6 +645,15 @@ fn snow_sss_tint(albedo: vec3<f32>, transition: f32, sky: vec3<f32>) -> vec3<f32
 // test can show the images see the term. Must match `SnowLook::switch_bits` in mod.rs.
 const SNOW_NO_SKY_TINT: u32 = 1u;
 const SNOW_NO_RNM: u32 = 2u;
+// Above the switches, one bit a side (local -x, +x, -z, +z): where the surface's snow meets
+// another surface's (a finer terrain window level inside a coarser one, a surface linked beside
+// it), so a cut met there is no cut: the renderer shades it as the top.
+const SNOW_SEAM_SIDES: u32 = 4u;
+
+// Whether side k (local -x, +x, -z, +z) of the surface meets another surface's snow.
+fn snow_seam_side(s: SnowSurface, k: u32) -> bool {
+    return (u32(s.pattern.z) & (SNOW_SEAM_SIDES << k)) != 0u;
+}
 
 fn snow_switched_off(s: SnowSurface, bit: u32) -> bool {
     return (u32(s.pattern.z) & bit) != 0u;

@@ -303,10 +303,65 @@ fn trace_pixel(in: SurfaceVarying, front: bool) -> SnowHit {
     let o = select(in.local, eye, inside);
     let d = normalize(in.local - eye);
     let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
-    let hit = snow_trace(surface, o, d, frame.options.z, moon);
-    if hit.found == 0u || snow_in_hole(surface, hit.position.xz) {
+    var hit = snow_trace(surface, o, d, frame.options.z, moon);
+    if hit.found == 0u {
         discard;
     }
+    if snow_in_hole(surface, hit.position.xz) {
+        hit = hole_step(o, d);
+        if hit.found == 0u {
+            discard;
+        }
+    }
+    if hit.side == 1u && !inside && snow_seam_side(surface, face_side(in.face)) {
+        // Entered through a side where another surface's snow goes on: the step between the two
+        // tops, shaded as the top.
+        hit.side = 0u;
+        hit.shadow = snow_light_visibility(surface, snow_uv(surface, hit.position.xz));
+    }
+    return hit;
+}
+
+// Side k (local -x, +x, -z, +z) of a box face's normal (a side face's).
+fn face_side(face: vec3<f32>) -> u32 {
+    if abs(face.x) > 0.5 {
+        return select(0u, 1u, face.x > 0.0);
+    }
+    return select(2u, 3u, face.z > 0.0);
+}
+
+// A ray from `o` along `d` whose first snow lies in the surface's hole, where a finer terrain
+// window level draws: where it leaves the hole under this level's snow (the finer level lower at
+// its edge, as in a print that this coarser level holds shallower), it meets the step between
+// the two levels' tops, which is drawn as this level's top there (the tessellated tier's seam
+// skirts, tessellate/seams.rs). Found nowhere else: the finer level draws what the ray meets.
+fn hole_step(o: vec3<f32>, d: vec3<f32>) -> SnowHit {
+    var hit: SnowHit;
+    hit.found = 0u;
+    let far = 3.0e38;
+    let lo = surface.hole.xy;
+    let hi = surface.hole.zw;
+    var t = far;
+    if d.x != 0.0 {
+        t = min(t, (select(lo.x, hi.x, d.x > 0.0) - o.x) / d.x);
+    }
+    if d.z != 0.0 {
+        t = min(t, (select(lo.y, hi.y, d.z > 0.0) - o.z) / d.z);
+    }
+    let p = o + d * t;
+    if t <= 0.0 || t >= far || any(abs(p.xz) > surface.half_size) || !snow_inside(surface, o, d, t) {
+        return hit;
+    }
+    if p.y < snow_ground_base(surface, snow_uv(surface, p.xz)) {
+        return hit;
+    }
+    hit.position = p;
+    hit.t = t;
+    hit.found = 1u;
+    hit.side = 0u;
+    hit.water = 0u;
+    hit.taps = 1u;
+    hit.shadow = snow_light_visibility(surface, snow_uv(surface, p.xz));
     return hit;
 }
 

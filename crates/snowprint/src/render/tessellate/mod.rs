@@ -30,6 +30,7 @@ pub(in crate::render) mod banks;
 pub(crate) mod cpu;
 pub(in crate::render) mod dice;
 pub(crate) mod gpu;
+pub(in crate::render) mod seams;
 pub(in crate::render) mod snow_shadow;
 
 use bytemuck::{Pod, Zeroable};

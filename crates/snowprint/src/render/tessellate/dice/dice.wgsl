@@ -14,7 +14,9 @@
 //      expression from the same canonical endpoints, so positions match bit for bit: no cracks,
 //      no T-junctions;
 //   4. skirts on the edges of the base mesh that no other triangle shares: a wall from the snow's
-//      displaced top down to the base, so open edges never show a gap.
+//      displaced top down to the base, so open edges never show a gap. Where the edge meets
+//      another surface's snow (a seam: render/tessellate/seams.rs) the skirt closes the step
+//      between the two tops and is marked to be shaded as the top.
 // Vertices (two vec4 each: local position with the base height and a kind; the skirt's outward
 // normal) and indices are appended with atomic counters; `seal` then writes the surface's
 // indexed indirect draw. Displacement happens in the vertex stage (tess_surface.wgsl).
@@ -42,7 +44,7 @@ struct BaseTriangle {
     a: vec4<f32>,            // xyz local position (y: base height), w unused
     b: vec4<f32>,
     c: vec4<f32>,
-    ids: vec4<u32>,          // xyz: vertex ids of a, b, c; w: bit e set when edge e is a border
+    ids: vec4<u32>,          // xyz: vertex ids of a, b, c; w: bit e set when edge e is a border, its seam mark at bit SEAM_SHIFT + 4e
 }
 
 // Samples of the heightfield along an edge for its relief.
@@ -230,8 +232,13 @@ fn base_slope(t: BaseTriangle) -> vec2<f32> {
 }
 
 fn put_vertex(at: u32, p: vec3<f32>, kind: f32, n: vec2<f32>) {
+    put_vertex_marked(at, p, kind, n, 0.0);
+}
+
+// A vertex whose second vec4 has `w` (1 on a seam's skirt: shaded as the top, `n` the base's slope).
+fn put_vertex_marked(at: u32, p: vec3<f32>, kind: f32, n: vec2<f32>, w: f32) {
     vertices[2u * at] = vec4<f32>(p, kind);
-    vertices[2u * at + 1u] = vec4<f32>(n.x, 0.0, n.y, 0.0);
+    vertices[2u * at + 1u] = vec4<f32>(n.x, 0.0, n.y, w);
 }
 
 fn put_triangle(at: u32, a: u32, b: u32, c: u32) {
@@ -256,6 +263,16 @@ fn strip_triangles(e: u32) -> u32 {
 
 fn is_border(t: BaseTriangle, e: u32) -> bool {
     return (t.ids.w & (1u << e)) != 0u;
+}
+
+// Whether border edge e meets another surface's snow this frame (render/tessellate/seams.rs):
+// the hole of a finer level, or a side the dicing parameters' mask (`capacity.w`) names.
+fn is_seam(t: BaseTriangle, e: u32) -> bool {
+    let mark = (t.ids.w >> (SEAM_SHIFT + 4u * e)) & 15u;
+    if mark == SEAM_HOLE {
+        return true;
+    }
+    return mark >= SEAM_SIDE && mark < SEAM_SIDE + 4u && ((dice.capacity.w >> (mark - SEAM_SIDE)) & 1u) != 0u;
 }
 
 // Whether the box of the triangle (from its base up to the highest snow, widened by the ground
@@ -432,10 +449,14 @@ fn dice_surface(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id)
             if dot(outward, opposite.xz - s.xz) > 0.0 {
                 outward = -outward;
             }
+            // A seam's skirt closes the step between two surfaces' tops and is shaded as the top.
+            let seam = is_seam(t, e);
+            let n = select(outward, base_slope(t), seam);
+            let w = select(0.0, 1.0, seam);
             for (var k = li; k <= l; k += 64u) {
                 let p = outer_point(t, e, k);
-                put_vertex(vertex_base + next_v + 2u * k, p, KIND_SKIRT_TOP, outward);
-                put_vertex(vertex_base + next_v + 2u * k + 1u, p, KIND_SKIRT_BOTTOM, outward);
+                put_vertex_marked(vertex_base + next_v + 2u * k, p, KIND_SKIRT_TOP, n, w);
+                put_vertex_marked(vertex_base + next_v + 2u * k + 1u, p, KIND_SKIRT_BOTTOM, n, w);
             }
             for (var k = li; k < l; k += 64u) {
                 let top0 = next_v + 2u * k;

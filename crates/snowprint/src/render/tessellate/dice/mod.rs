@@ -10,6 +10,7 @@ use glam::Mat4;
 
 use super::VERTEX_BYTES;
 use super::gpu::counters_bytes;
+use super::seams;
 use super::{ARGS_BASE, ARGS_STRIDE, DiceParams, DicedKind, DicedMesh, DicedVertex, SurfaceMesh};
 use crate::gpu::resources::{Growable, bind_group, uniform_block};
 use crate::render::config::RenderConfig;
@@ -26,8 +27,16 @@ use crate::surface::SurfaceId;
 struct BaseMeshGpu {
     buffer: wgpu::Buffer,
     triangles: u32,
-    /// The surface's size and the geometry's version it was built for.
-    key: ([u32; 2], u64),
+    key: BaseMeshKey,
+}
+
+/// What a base mesh on the GPU was built for: the surface's half sides and hole (bits), and the
+/// geometry's version.
+#[derive(Clone, Copy, PartialEq)]
+struct BaseMeshKey {
+    half: [u32; 2],
+    version: u64,
+    hole: Option<[u32; 4]>,
 }
 
 pub(in crate::render) struct DicePass {
@@ -127,9 +136,14 @@ impl DicePass {
             let (desc, layout, g) = (surface.view.desc, surface.view.layout, surface.geometry);
             let texel = surface.texel();
             let half = desc.size * 0.5;
-            let key = ([half.x.to_bits(), half.y.to_bits()], geometry_version);
+            let hole = surface.view.hole;
+            let key = BaseMeshKey {
+                half: [half.x.to_bits(), half.y.to_bits()],
+                version: geometry_version,
+                hole: hole.map(|h| h.map(f32::to_bits)),
+            };
             let id = surface.view.id;
-            self.upload_base_mesh(device, id, g.mesh.as_ref(), half, key)?;
+            self.upload_base_mesh(device, id, g.mesh.as_ref(), half, hole, key)?;
             let base = &self.base_meshes[&id];
             let local_to_world = desc.local_to_world();
             let eye = local_to_world.inverse().transform_point3(frame.camera.eye);
@@ -151,7 +165,12 @@ impl DicePass {
                     surface.view.ground_range.1,
                 ],
                 grid: [layout.width, layout.height, s as u32, base.triangles],
-                capacity: [vertex_capacity, index_capacity, surface.view.ground, 0],
+                capacity: [
+                    vertex_capacity,
+                    index_capacity,
+                    surface.view.ground,
+                    seams::seam_sides(surface.enclosed, surface.sides.map(|s| s.is_some())),
+                ],
                 half_size: [half.x, half.y, 0.0, 0.0],
                 local_to_shadow: (Mat4::from_cols_array_2d(&uniform.shadow_near) * local_to_world)
                     .to_cols_array_2d(),
@@ -190,27 +209,27 @@ impl DicePass {
         Ok(())
     }
 
-    /// Upload a surface's base mesh (its own, or its rectangle) unless the one on the GPU was
-    /// built for the same size and geometry version `key`.
+    /// Upload a surface's base mesh (its own, or its rectangle with its `hole` cut out) unless
+    /// the one on the GPU was built for the same `key`.
     fn upload_base_mesh(
         &mut self,
         device: &wgpu::Device,
         id: SurfaceId,
         mesh: Option<&SurfaceMesh>,
         half: glam::Vec2,
-        key: ([u32; 2], u64),
+        hole: Option<[f32; 4]>,
+        key: BaseMeshKey,
     ) -> RenderResult<()> {
         if self.base_meshes.get(&id).is_some_and(|b| b.key == key) {
             return Ok(());
         }
-        let mesh = match mesh {
+        let triangles = match mesh {
             Some(m) => {
                 m.validate(half)?;
-                m.clone()
+                m.base_triangles()
             }
-            None => SurfaceMesh::rectangle(half),
+            None => seams::rectangle_triangles(half, hole),
         };
-        let triangles = mesh.base_triangles();
         use wgpu::util::DeviceExt;
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("snow base mesh"),

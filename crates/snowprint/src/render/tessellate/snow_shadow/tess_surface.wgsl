@@ -28,7 +28,7 @@ const MACRO_MEAN: f32 = 0.025;
 
 struct TessVertex {
     @location(0) position: vec4<f32>,   // xyz local (y: the base), w: 0 top, 1 skirt top, 2 skirt base
-    @location(1) outward: vec4<f32>,    // skirts: outward normal; top: the base's slope (xz)
+    @location(1) outward: vec4<f32>,    // skirts: outward normal; top and seams' skirts: the base's slope (xz); w: 1 on seams' skirts
 }
 
 struct TessVarying {
@@ -83,13 +83,22 @@ fn tess_local(v: TessVertex) -> vec3<f32> {
     return p;
 }
 
+// Whether local xz lies in the surface's hole, less a millimetre: the renderer's rectangle is
+// diced with the hole cut out (render/tessellate/seams.rs), and the skirts on its sides, which
+// lie on the hole's lines, are kept; a mesh the user gave is cut here.
+fn tess_in_hole(xz: vec2<f32>) -> bool {
+    return all(xz > surface.hole.xy + 1e-3) && all(xz < surface.hole.zw - 1e-3);
+}
+
 @vertex
 fn vs_tess(v: TessVertex) -> TessVarying {
     let p = tess_local(v);
     var out: TessVarying;
     out.clip = frame.view_proj * (surface.local_to_world * vec4<f32>(p, 1.0));
     out.local = p;
-    out.outward = vec4<f32>(v.outward.xyz, select(0.0, 1.0, v.position.w > 0.5));
+    // A seam's skirt (outward.w 1) is shaded as the top: it closes the step between two
+    // surfaces' tops (dice.wgsl), and its `outward` holds the base's slope.
+    out.outward = vec4<f32>(v.outward.xyz, select(0.0, 1.0, v.position.w > 0.5 && v.outward.w < 0.5));
     return out;
 }
 
@@ -108,7 +117,7 @@ fn vs_tess_shadow(v: TessVertex) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs_tess(in: TessVarying) -> @location(0) vec4<f32> {
     let pixel = length(fwidth(in.local));
-    if snow_in_hole(surface, in.local.xz) {
+    if tess_in_hole(in.local.xz) {
         discard;
     }
     return vec4<f32>(tess_shade(in.local, in.outward, pixel), 1.0);
@@ -172,7 +181,7 @@ struct TessVisible {
 @fragment
 fn fs_tess_visible(in: TessVarying) -> TessVisible {
     let pixel = length(fwidth(in.local));
-    if snow_in_hole(surface, in.local.xz) {
+    if tess_in_hole(in.local.xz) {
         discard;
     }
     // The depth is the rasterised one (written by the fixed function, as the forward path's).
