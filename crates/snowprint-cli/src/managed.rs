@@ -165,10 +165,21 @@ pub fn simulate(
             .sum::<u64>()
             .max(1 << 20);
     }
+    if scene.budget.is_none() {
+        // The terrains' levels in a pool of the scene's own size: room for them as well.
+        config.pool_bytes += crate::terrain::pool_bytes(scene, config.format);
+    }
+    if scene.budget.and_then(|b| b.updates_per_frame).is_none() {
+        // No budget stated: the default's updates for the surfaces, and one a level besides
+        // (every level is updated every frame).
+        let levels: usize = scene.terrains.iter().map(|t| t.desc.levels.len()).sum();
+        config.updates_per_frame = config.updates_per_frame.saturating_add(levels);
+    }
     let budget = config.updates_per_frame;
     let (mut snow, ids) = start(&ctx, scene, config, persist.load.as_deref())?;
     // Frames continue from the save's clock.
     let first = snow.planner().next_frame();
+    let windows = crate::terrain::ManagedWindows::new(&mut snow, scene, first as f32 * dt)?;
     // An animated mesh is posed each frame before the tick (on the CPU, so that a surface the
     // budget leaves waiting is pressed later with each frame's own pose); a save keeps a mesh's
     // last posing, and its skeleton is given back here.
@@ -210,8 +221,9 @@ pub fn simulate(
                 _ => None,
             })
             .collect();
-        match snow
-            .animate_meshes(&animations)
+        match windows
+            .follow(&mut snow, scene, t)
+            .and_then(|()| snow.animate_meshes(&animations))
             .and_then(|()| snow.tick(dt, camera.as_ref(), &deformers))
         {
             Ok(stats) => {
@@ -269,7 +281,10 @@ pub fn simulate(
         dt,
     };
     let dump_dir = dump.dir().to_owned();
-    let mut written = read_maps(&snow, &ids)
+    let mut dump = dump;
+    let mut written = windows
+        .dump(&mut snow, scene, &mut dump)
+        .and_then(|()| read_maps(&snow, &ids))
         .and_then(|maps| crate::simulate::write_dump(scene, &maps, &done, dump));
     if let Some((set, stream)) = report {
         let partial = if frames_done < frames {

@@ -1,7 +1,9 @@
 //! A scene's `[[terrain]]` windows in `snowprint simulate`: made centred on their focus at the
 //! first frame, moved before each step, and each level dumped as `<terrain>.<level>.png` and
-//! `.json` beside the surfaces.
+//! `.json` beside the surfaces; in a plain world ([`Windows`]) or run by the surface manager
+//! ([`ManagedWindows`]: its pool and budget).
 
+use snowprint::manager::{ManagedTerrainId, SnowManager};
 use snowprint::scene::{Scene, SceneTerrain};
 use snowprint::{SnowWorld, Terrain};
 
@@ -76,32 +78,85 @@ impl Windows {
             terrain.flush(world).map_err(|e| e.to_string())?;
         }
         for (terrain, st) in self.terrains.iter().zip(&scene.terrains) {
-            for ((i, id), name) in terrain
-                .surfaces()
-                .into_iter()
-                .enumerate()
-                .zip(level_names(st))
-            {
-                let map = world.read_heightmap(id).map_err(|e| e.to_string())?;
-                map.save_png(&set.path(&format!("{name}.png")))
-                    .map_err(|e| e.to_string())?;
-                let level = st.desc.levels[i];
-                let desc = world.surface(id).map_err(|e| e.to_string())?;
-                let meta = serde_json::json!({
-                    "terrain": st.desc.name,
-                    "level": i,
-                    "resolution": level.texels,
-                    "texel_size": level.texel_size,
-                    "center": desc.center.to_array(),
-                    "origin_texel": terrain.origin(i),
-                    "snow_depth": st.desc.snow_depth,
-                    "scroll": terrain.stats(),
-                    "png": "16-bit greyscale depression: 0 = untouched, 65535 = pressed to the ground; column 0 = smallest x, row 0 = smallest z, the window where it stood after the last frame",
-                });
-                let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
-                set.write(&format!("{name}.json"), text + "\n")?;
-            }
+            write_levels(world, terrain, st, set)?;
         }
         Ok(())
     }
+}
+
+/// The scene's terrains run by a surface manager, in its pool and under its budget.
+pub struct ManagedWindows {
+    ids: Vec<ManagedTerrainId>,
+}
+
+impl ManagedWindows {
+    /// Add every terrain of `scene` to `snow`, centred on its focus at time `t`.
+    pub fn new(snow: &mut SnowManager, scene: &Scene, t: f32) -> Result<Self, String> {
+        let mut ids = Vec::new();
+        for st in &scene.terrains {
+            let id = snow
+                .add_terrain(st.desc.clone(), st.focus(scene, t))
+                .map_err(|e| format!("{}:{}: {e}", scene.path.display(), st.line))?;
+            ids.push(id);
+        }
+        Ok(Self { ids })
+    }
+
+    /// Centre every window on its focus at time `t`.
+    pub fn follow(&self, snow: &mut SnowManager, scene: &Scene, t: f32) -> snowprint::Result<()> {
+        for (&id, st) in self.ids.iter().zip(&scene.terrains) {
+            snow.follow_terrain(id, st.focus(scene, t))?;
+        }
+        Ok(())
+    }
+
+    /// Write every level's heightmap and description into the dump.
+    pub fn dump(
+        &self,
+        snow: &mut SnowManager,
+        scene: &Scene,
+        set: &mut OutputSet,
+    ) -> Result<(), String> {
+        for (&id, st) in self.ids.iter().zip(&scene.terrains) {
+            snow.flush_terrain(id).map_err(|e| e.to_string())?;
+            let terrain = snow.terrain(id).map_err(|e| e.to_string())?;
+            write_levels(snow.world(), terrain, st, set)?;
+        }
+        Ok(())
+    }
+}
+
+/// Write a terrain's levels' heightmaps and descriptions into the dump.
+fn write_levels(
+    world: &SnowWorld,
+    terrain: &Terrain,
+    st: &SceneTerrain,
+    set: &mut OutputSet,
+) -> Result<(), String> {
+    for ((i, id), name) in terrain
+        .surfaces()
+        .into_iter()
+        .enumerate()
+        .zip(level_names(st))
+    {
+        let map = world.read_heightmap(id).map_err(|e| e.to_string())?;
+        map.save_png(&set.path(&format!("{name}.png")))
+            .map_err(|e| e.to_string())?;
+        let level = st.desc.levels[i];
+        let desc = world.surface(id).map_err(|e| e.to_string())?;
+        let meta = serde_json::json!({
+            "terrain": st.desc.name,
+            "level": i,
+            "resolution": level.texels,
+            "texel_size": level.texel_size,
+            "center": desc.center.to_array(),
+            "origin_texel": terrain.origin(i),
+            "snow_depth": st.desc.snow_depth,
+            "scroll": terrain.stats(),
+            "png": "16-bit greyscale depression: 0 = untouched, 65535 = pressed to the ground; column 0 = smallest x, row 0 = smallest z, the window where it stood after the last frame",
+        });
+        let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
+        set.write(&format!("{name}.json"), text + "\n")?;
+    }
+    Ok(())
 }

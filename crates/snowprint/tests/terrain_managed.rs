@@ -328,3 +328,268 @@ fn a_touch_volume_follows_the_ground() {
     let want = SINK / DEPTH;
     assert!(d > want - 0.1 && d < want + 0.02, "{d}, {want} by hand");
 }
+
+/// Terrain windows run by the manager: their levels in its pool and under its budget.
+mod windows {
+    use super::*;
+    use snowprint::{LevelDesc, Material, SnowError, SnowWorld, TerrainDesc, WorldConfig};
+
+    fn valley() -> TerrainDesc {
+        TerrainDesc {
+            name: "valley".into(),
+            ground_height: 0.0,
+            ground: None,
+            snow_depth: DEPTH,
+            replenish_rate: 0.0005,
+            material: Material::snow(),
+            levels: vec![
+                LevelDesc {
+                    texels: [48, 48],
+                    texel_size: 0.05,
+                },
+                LevelDesc {
+                    texels: [32, 32],
+                    texel_size: 0.2,
+                },
+            ],
+        }
+    }
+
+    /// Four roofs far from the valley, each 2 m square (50 texels a side by the talk's rule).
+    fn roofs() -> Vec<SurfaceDesc> {
+        (0..4)
+            .map(|i| {
+                SurfaceDesc::new(
+                    &format!("roof{i}"),
+                    [40.0 + 4.0 * i as f32, 0.0, 0.0],
+                    [2.0, 2.0],
+                    DEPTH,
+                )
+            })
+            .collect()
+    }
+
+    /// A pool of the valley's two levels and two roofs: the roofs' walker pages them in and out.
+    fn config() -> ManagerConfig {
+        let f = snowprint::PoolFormat::default();
+        ManagerConfig {
+            updates_per_frame: 3,
+            pool_bytes: f.slot_bytes(48, 48)
+                + f.slot_bytes(32, 32)
+                + 2 * f.slot_bytes(50, 50)
+                + 1024,
+            active_distance: 500.0,
+            ..ManagerConfig::default()
+        }
+    }
+
+    /// The hiker's sphere in the valley at frame `f`, walking along x past the near level's edge.
+    fn hiker(f: u32) -> Deformer {
+        let at = |f: u32| {
+            Pose::at([
+                -1.0 + 0.04 * f as f32,
+                DEPTH - SINK + RADIUS,
+                0.3 * (f as f32 * 0.1).sin(),
+            ])
+        };
+        Deformer::moving(
+            Shape::Sphere { radius: RADIUS },
+            at(f.saturating_sub(1)),
+            at(f),
+        )
+    }
+
+    /// A second walker crossing roof `(f / 10) % 4`, so the roofs take turns in the pool.
+    fn roofer(f: u32) -> Deformer {
+        let k = ((f / 10) % 4) as f32;
+        let x = 40.0 + 4.0 * k - 0.8 + 0.16 * (f % 10) as f32;
+        Deformer::new(
+            Shape::Sphere { radius: RADIUS },
+            Pose::at([x, DEPTH - SINK + RADIUS, 0.0]),
+        )
+    }
+
+    /// A levels' depression channels in logical order.
+    fn levels_of(w: &SnowWorld, t: &snowprint::Terrain) -> Vec<Vec<u32>> {
+        t.surfaces()
+            .iter()
+            .map(|&id| w.read_channels(id).expect("read").0)
+            .collect()
+    }
+
+    /// The hiker's trail in a terrain run by a manager whose budget and pool are busy with the
+    /// roofs (paged in and out as a second walker crosses them) is the trail of the same walk in
+    /// a plain world's terrain, texel for texel in both levels, the window moving with the hiker;
+    /// every tick updates every level and at most `updates_per_frame` surfaces in all, the levels'
+    /// slots are never given up, and the manager's pool accounting stays the world's.
+    #[test]
+    fn a_managed_terrain_holds_the_trail_a_plain_world_does() {
+        let mut m = SnowManager::new(common::gpu(), config()).expect("manager");
+        for r in roofs() {
+            m.add_surface(r, ZoneId(0)).expect("roof");
+        }
+        let t = m.add_terrain(valley(), Vec3::ZERO).expect("terrain");
+        let levels = m.terrain(t).unwrap().surfaces();
+        let mut plain = SnowWorld::new(
+            common::gpu(),
+            WorldConfig {
+                format: config().format,
+                capture: config().capture,
+                ..WorldConfig::default()
+            },
+        )
+        .expect("world");
+        let mut pt = snowprint::Terrain::new(&mut plain, valley(), Vec3::ZERO).expect("terrain");
+        let names: Vec<String> = levels
+            .iter()
+            .map(|&l| m.world().surface(l).unwrap().name.clone())
+            .collect();
+        let mut evicted = 0;
+        for f in 0..120u32 {
+            let focus = hiker(f).pose.position;
+            m.follow_terrain(t, focus).expect("follow");
+            pt.follow(&mut plain, focus).expect("follow");
+            let stats = m
+                .tick(
+                    DT,
+                    None,
+                    &[
+                        ManagedDeformer::player(hiker(f)),
+                        ManagedDeformer::new(roofer(f)),
+                    ],
+                )
+                .expect("tick");
+            plain.step(DT, &[hiker(f), roofer(f)]).expect("step");
+            assert!(stats.updated.len() <= 3, "frame {f}: {:?}", stats.updated);
+            for n in &names {
+                assert!(
+                    stats.updated.contains(n),
+                    "frame {f}: {n} not updated: {:?}",
+                    stats.updated
+                );
+            }
+            assert_eq!(stats.pool_bytes_used, m.planner().pool_used(), "frame {f}");
+            evicted += stats.evicted.len();
+        }
+        assert!(
+            evicted >= 4,
+            "the roofs were paged out only {evicted} times"
+        );
+        assert_eq!(
+            m.terrain(t).unwrap().surfaces(),
+            levels,
+            "the levels kept their surfaces"
+        );
+        m.flush_terrain(t).unwrap();
+        pt.flush(&mut plain).unwrap();
+        assert_eq!(
+            m.terrain(t).unwrap().origin(0),
+            pt.origin(0),
+            "the windows moved alike"
+        );
+        let (ours, theirs) = (
+            levels_of(m.world(), m.terrain(t).unwrap()),
+            levels_of(&plain, &pt),
+        );
+        let pressed = ours[0].iter().filter(|&&v| v > 0).count();
+        assert!(
+            pressed > 100,
+            "the hiker pressed only {pressed} texels of the near level"
+        );
+        for (i, (a, b)) in ours.iter().zip(&theirs).enumerate() {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert_eq!(
+                differ, 0,
+                "level {i}: {differ} texels differ from the plain world's"
+            );
+        }
+    }
+
+    /// What the manager refuses of terrains, in one sentence each, with nothing changed.
+    #[test]
+    fn a_managed_terrain_is_refused_in_one_sentence() {
+        // Two levels leave no update to a budget of 2.
+        let mut m = SnowManager::new(
+            common::gpu(),
+            ManagerConfig {
+                updates_per_frame: 2,
+                ..config()
+            },
+        )
+        .expect("manager");
+        let e = m.add_terrain(valley(), Vec3::ZERO).unwrap_err();
+        assert!(matches!(e, SnowError::InvalidTerrain { .. }), "{e}");
+        assert!(e.to_string().contains("updates_per_frame"), "{e}");
+        assert_eq!(m.world().surfaces().count(), 0);
+        // A pool too small for the levels whatever it holds: refused before anything is added.
+        let mut m = SnowManager::new(
+            common::gpu(),
+            ManagerConfig {
+                pool_bytes: 4096,
+                ..config()
+            },
+        )
+        .expect("manager");
+        let e = m.add_terrain(valley(), Vec3::ZERO).unwrap_err();
+        assert!(matches!(e, SnowError::InvalidTerrain { .. }), "{e}");
+        assert!(e.to_string().contains("pool"), "{e}");
+        // A pool that two resident roofs leave too little room: the world's refusal, no slot kept.
+        let f = snowprint::PoolFormat::default();
+        let mut m = SnowManager::new(
+            common::gpu(),
+            ManagerConfig {
+                pool_bytes: config().pool_bytes - f.slot_bytes(32, 32),
+                ..config()
+            },
+        )
+        .expect("manager");
+        for r in roofs() {
+            m.add_surface(r, ZoneId(0)).expect("roof");
+        }
+        for frame in [0, 10] {
+            m.tick(DT, None, &[ManagedDeformer::new(roofer(frame))])
+                .expect("tick");
+        }
+        let (surfaces, used) = (m.world().surfaces().count(), m.planner().pool_used());
+        assert_eq!(surfaces, 2, "two roofs resident");
+        let e = m.add_terrain(valley(), Vec3::ZERO).unwrap_err();
+        assert!(matches!(e, SnowError::PoolExhausted { .. }), "{e}");
+        assert_eq!(
+            (m.world().surfaces().count(), m.planner().pool_used()),
+            (surfaces, used)
+        );
+        // A save does not hold windows yet: refused, and allowed again once the terrain is gone.
+        let mut m = SnowManager::new(common::gpu(), config()).expect("manager");
+        let t = m.add_terrain(valley(), Vec3::ZERO).expect("terrain");
+        let used = m.planner().pool_used();
+        assert!(used > 0);
+        let e = m.to_save_bytes().unwrap_err();
+        assert!(matches!(e, SnowError::SaveWithTerrain { .. }), "{e}");
+        assert!(e.to_string().contains("remove_terrain"), "{e}");
+        m.remove_terrain(t).expect("remove");
+        assert_eq!(
+            m.planner().pool_used(),
+            0,
+            "the levels gave their slots back"
+        );
+        assert!(matches!(
+            m.follow_terrain(t, Vec3::ZERO),
+            Err(SnowError::StaleHandle { .. })
+        ));
+        m.to_save_bytes().expect("a save without terrains");
+        // No scroll while a tick is pending.
+        let t = m.add_terrain(valley(), Vec3::ZERO).expect("terrain");
+        assert_eq!(m.planner().pool_used(), used);
+        let device = m.world().device().clone();
+        let mut enc = device.create_command_encoder(&Default::default());
+        let pending = m.encode_tick(&mut enc, DT, None, &[]).expect("tick");
+        assert!(matches!(
+            m.follow_terrain(t, Vec3::new(3.0, 0.0, 0.0)),
+            Err(SnowError::FramePending)
+        ));
+        m.world().queue().submit([enc.finish()]);
+        m.submitted(pending).expect("submitted");
+        m.follow_terrain(t, Vec3::new(3.0, 0.0, 0.0))
+            .expect("follow");
+    }
+}

@@ -94,6 +94,16 @@ impl SnowManager {
             &plan.updates,
             self.planner.config().catch_up,
         );
+        // The terrains' levels, every tick, in the first layer (they never queue).
+        let levels: Vec<_> = self.level_ids().collect();
+        let level_deformers: Vec<_> = deformers.iter().map(|d| d.deformer).collect();
+        let mut runs = runs;
+        if !levels.is_empty() {
+            if runs.is_empty() {
+                runs.push(Vec::new());
+            }
+            runs[0].extend(super::terrain::level_updates(&levels, dt, &level_deformers));
+        }
         let layers: Vec<&[SurfaceUpdate<'_>]> = runs.iter().map(Vec::as_slice).collect();
         let frame = if layers.is_empty() {
             None
@@ -102,6 +112,9 @@ impl SnowManager {
         };
         let mut stats = plan.stats.clone();
         drop(runs);
+        for &l in &levels {
+            stats.updated.push(self.world.surface(l)?.name.clone());
+        }
         self.free_retired_meshes()?;
         let memory = self.world.memory();
         if memory.pool_used != self.planner.pool_used() {

@@ -48,6 +48,7 @@ mod ground;
 mod probe;
 mod skinned;
 mod stats;
+mod terrain;
 
 use glam::Vec3;
 
@@ -60,6 +61,7 @@ pub use frame::PendingTick;
 pub use probe::{ManagedProbeStatus, ManagedProbeTicket, ManagedSample};
 pub use save::{SaveFile, SavedGround, SavedSurface, Section};
 pub use stats::TickStats;
+pub use terrain::ManagedTerrainId;
 
 use crate::deformer::Deformer;
 use crate::error::{Result, SnowError};
@@ -163,6 +165,8 @@ pub struct SnowManager {
     arriving: Vec<frame::PageRead>,
     /// Gameplay probes asked of the manager.
     probes: probe::ManagerProbes,
+    /// Terrain windows, by [`ManagedTerrainId`] (`None`: removed).
+    terrains: Vec<Option<terrain::ManagedTerrain>>,
 }
 
 /// Source of [`SnowManager`] ids.
@@ -230,6 +234,7 @@ impl SnowManager {
             in_flight: None,
             arriving: Vec::new(),
             probes: probe::ManagerProbes::default(),
+            terrains: Vec::new(),
         }
     }
 

@@ -79,6 +79,11 @@ impl SnowWorld {
         Ok(())
     }
 
+    /// A surface's slot in the pool (the manager keeps a terrain level's out of its planner's).
+    pub(crate) fn slot_of(&self, id: SurfaceId) -> Result<crate::pool::Slot> {
+        Ok(self.state(id)?.slot)
+    }
+
     /// The word offset of a surface's heights region and its layout (for the window's strips).
     pub(crate) fn level_slot(&self, id: SurfaceId) -> Result<(u32, SurfaceLayout, u32)> {
         let s = self.state(id)?;

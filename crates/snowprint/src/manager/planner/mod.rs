@@ -151,6 +151,8 @@ pub struct Planner {
     paged_bound: u64,
     /// Entries merged by [`super::queue::bound`] since the planner was made.
     merged_total: u64,
+    /// Updates a frame left to the manager's terrain window levels (`reserve_updates`).
+    reserved_updates: usize,
     plan: Plan,
 }
 
@@ -183,6 +185,7 @@ impl Planner {
             evicted_between: Vec::new(),
             paged_bound: 0,
             merged_total: 0,
+            reserved_updates: 0,
             plan: Plan::default(),
         })
     }
@@ -526,6 +529,33 @@ impl Planner {
         self.config.updates_per_frame = k.max(1);
     }
 
+    /// Leave `n` updates a frame to the manager's terrain window levels, which are updated every
+    /// frame: the planner schedules `updates_per_frame - n` surfaces ([`Planner::budget`]).
+    pub(crate) fn reserve_updates(&mut self, n: usize) {
+        self.reserved_updates = n;
+    }
+
+    /// Updates a frame the planner schedules: `updates_per_frame` less those left to terrain
+    /// window levels, at least 1.
+    pub fn budget(&self) -> usize {
+        self.config
+            .updates_per_frame
+            .saturating_sub(self.reserved_updates)
+            .max(1)
+    }
+
+    /// Keep `slot` (a terrain window level's, placed by the world) out of the planner's hands:
+    /// its copy of the world's allocator holds it, and no surface of the planner's is evicted for
+    /// it. False when the copy does not have that range free (the two disagree).
+    pub(crate) fn pin_slot(&mut self, slot: Slot) -> bool {
+        self.alloc.alloc_at(slot.offset, slot.bytes).is_some()
+    }
+
+    /// Give a pinned slot back to the planner's copy of the allocator.
+    pub(crate) fn unpin_slot(&mut self, slot: Slot) {
+        self.alloc.free(slot);
+    }
+
     /// Surfaces of loaded zones with imprints waiting (resident or not).
     pub fn pending_loaded_surfaces(&self) -> usize {
         self.queued
@@ -586,9 +616,9 @@ impl Planner {
     }
 
     /// Updates guaranteed to non-player surfaces each frame: `K - min(K - 1, player_slots)` for a
-    /// budget `K` of 2 or more, `1` for a budget of 1 (the player then gets no reserved slot).
+    /// budget `K` ([`Planner::budget`]) of 2 or more, `1` for a budget of 1 (the player then gets no reserved slot).
     pub fn non_player_slots(&self) -> usize {
-        let k = self.config.updates_per_frame;
+        let k = self.budget();
         let reserved = if k >= 2 {
             (k - 1).min(self.config.player_slots)
         } else {

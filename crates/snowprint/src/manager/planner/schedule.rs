@@ -39,7 +39,7 @@ impl Planner {
             due.push((since + slack, since, i, player));
         }
         self.plan.stats.due = due.len();
-        let k = self.config.updates_per_frame;
+        let k = self.budget();
         due.sort_unstable();
         let mut pick: Vec<u32> = Vec::with_capacity(k.min(due.len()));
         let mut max_wait = 0;

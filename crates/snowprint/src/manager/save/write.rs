@@ -17,6 +17,9 @@ impl SnowManager {
     /// recorded and not submitted.
     pub fn to_save_bytes(&self) -> Result<Vec<u8>> {
         self.not_pending()?;
+        if let Some(name) = self.terrain_names().next() {
+            return Err(crate::error::SnowError::SaveWithTerrain { name: name.into() });
+        }
         let conf = to_json(&SavedConfig::of(self.planner.config()))?;
         let plan = to_json(&self.planner.state())?;
         // Meshes: the manager's, and the earlier posings that queues still name.

@@ -1,0 +1,182 @@
+//! Terrain windows run by the manager (`crate::Terrain`, `docs/ARCHITECTURE.md`, "The sliding
+//! window"): their levels live in the manager's world, in the same pool and under the same
+//! budget as its surfaces.
+//!
+//! - **Pool.** A level's slot is taken when the terrain is added and kept until it is removed;
+//!   the planner's copy of the world's allocator holds it too (`Planner::pin_slot`), so the two
+//!   keep agreeing and no surface is evicted for it or admitted into it.
+//! - **Budget.** Every level is updated at every tick, with the tick's deformers and time (the
+//!   player walks in the window, and the window follows the player): the planner schedules
+//!   `updates_per_frame` less the levels (`Planner::budget`), so a tick updates at most
+//!   `updates_per_frame` surfaces, levels included (`TickStats::updated` names them last).
+//! - **Scrolling.** [`SnowManager::follow_terrain`] moves a window between ticks; its strips and
+//!   pages are the terrain's own (`window/store.rs`).
+
+use glam::Vec3;
+
+use super::SnowManager;
+use crate::error::{Result, SnowError};
+use crate::pool::Slot;
+use crate::surface::SurfaceId;
+use crate::window::{Terrain, TerrainDesc};
+use crate::world::SurfaceUpdate;
+
+/// Handle of a terrain window in a [`SnowManager`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ManagedTerrainId(u32);
+
+impl ManagedTerrainId {
+    /// Index of the terrain, in order of addition.
+    pub fn index(self) -> u32 {
+        self.0
+    }
+}
+
+/// A terrain of the manager's and the pool slots its levels hold.
+pub(super) struct ManagedTerrain {
+    terrain: Terrain,
+    slots: Vec<Slot>,
+}
+
+impl SnowManager {
+    /// Add a terrain's sliding window centred on `focus`, in the manager's pool and under its
+    /// budget (see the module docs): its levels take their slots now and keep them, and each is
+    /// updated at every tick. Refused, in one sentence, and nothing added, for what
+    /// [`Terrain::new`] refuses (the levels do not fit the pool's free room among them), while a
+    /// tick is pending, or when the levels would leave the other surfaces no update a frame
+    /// (`updates_per_frame` must exceed all the terrains' levels).
+    pub fn add_terrain(&mut self, desc: TerrainDesc, focus: Vec3) -> Result<ManagedTerrainId> {
+        self.not_pending()?;
+        let levels = self.terrain_levels() + desc.levels.len();
+        let budget = self.planner.config().updates_per_frame;
+        if levels >= budget {
+            return Err(SnowError::InvalidTerrain {
+                name: desc.name.clone(),
+                what: "its levels with the manager's other terrains'".into(),
+                value: format!("{levels} updates a frame"),
+                expected: format!(
+                    "fewer than ManagerConfig::updates_per_frame ({budget}), which counts every level at every frame: raise it to at least {}",
+                    levels + 1
+                ),
+            });
+        }
+        let terrain = Terrain::new(&mut self.world, desc, focus)?;
+        let ids = terrain.surfaces();
+        let mut slots = Vec::with_capacity(ids.len());
+        for &id in &ids {
+            let slot = self.world.slot_of(id)?;
+            if !self.planner.pin_slot(slot) {
+                // The planner's copy of the allocator disagrees with the world's: undo.
+                for &s in &slots {
+                    self.planner.unpin_slot(s);
+                }
+                for &id in &ids {
+                    self.world.remove_surface(id)?;
+                }
+                return Err(SnowError::InvalidTerrain {
+                    name: terrain.desc().name.clone(),
+                    what: "a level's slot".into(),
+                    value: format!("{} bytes at byte {}", slot.bytes, slot.offset),
+                    expected: "free in the manager's copy of the pool's accounting as in the world's (they disagree: nothing was added)".into(),
+                });
+            }
+            slots.push(slot);
+        }
+        self.terrains.push(Some(ManagedTerrain { terrain, slots }));
+        self.planner.reserve_updates(levels);
+        Ok(ManagedTerrainId(self.terrains.len() as u32 - 1))
+    }
+
+    /// Move a terrain's window to `focus` (see [`Terrain::follow`]); between ticks (refused with
+    /// [`SnowError::FramePending`] while one is pending).
+    pub fn follow_terrain(&mut self, id: ManagedTerrainId, focus: Vec3) -> Result<()> {
+        self.not_pending()?;
+        let t = self.terrain_entry(id)?;
+        let terrain = &mut self.terrains[t]
+            .as_mut()
+            .expect("checked by terrain_entry")
+            .terrain;
+        terrain.follow(&mut self.world, focus)
+    }
+
+    /// Land a terrain's strips still on their way (see [`Terrain::flush`]), for reads.
+    pub fn flush_terrain(&mut self, id: ManagedTerrainId) -> Result<()> {
+        self.not_pending()?;
+        let t = self.terrain_entry(id)?;
+        let terrain = &mut self.terrains[t]
+            .as_mut()
+            .expect("checked by terrain_entry")
+            .terrain;
+        terrain.flush(&mut self.world)
+    }
+
+    /// A terrain of the manager's (its levels are surfaces of [`SnowManager::world`]).
+    pub fn terrain(&self, id: ManagedTerrainId) -> Result<&Terrain> {
+        let t = self.terrain_entry(id)?;
+        Ok(&self.terrains[t].as_ref().expect("checked").terrain)
+    }
+
+    /// Remove a terrain: its levels leave the world and give their slots back. Its handle is
+    /// stale afterwards.
+    pub fn remove_terrain(&mut self, id: ManagedTerrainId) -> Result<()> {
+        self.not_pending()?;
+        let t = self.terrain_entry(id)?;
+        let gone = self.terrains[t].take().expect("checked");
+        for s in gone.terrain.surfaces() {
+            self.world.remove_surface(s)?;
+        }
+        for s in gone.slots {
+            self.planner.unpin_slot(s);
+        }
+        self.planner.reserve_updates(self.terrain_levels());
+        Ok(())
+    }
+
+    fn terrain_entry(&self, id: ManagedTerrainId) -> Result<usize> {
+        let i = id.0 as usize;
+        match self.terrains.get(i) {
+            Some(Some(_)) => Ok(i),
+            _ => Err(SnowError::StaleHandle {
+                what: "terrain",
+                index: id.0,
+            }),
+        }
+    }
+
+    /// Levels of all the manager's terrains.
+    pub(super) fn terrain_levels(&self) -> usize {
+        self.level_ids().count()
+    }
+
+    /// Every terrain level's surface, terrains in order of addition, finest level first.
+    pub(super) fn level_ids(&self) -> impl Iterator<Item = SurfaceId> + '_ {
+        self.terrains
+            .iter()
+            .flatten()
+            .flat_map(|t| t.terrain.surfaces())
+    }
+
+    /// Names of the terrains (a save refuses them, naming the first).
+    pub(super) fn terrain_names(&self) -> impl Iterator<Item = &str> {
+        self.terrains
+            .iter()
+            .flatten()
+            .map(|t| t.terrain.desc().name.as_str())
+    }
+}
+
+/// The updates of every level of `levels` this tick: `dt` of replenishment and every deformer.
+pub(super) fn level_updates<'a>(
+    levels: &[SurfaceId],
+    dt: f32,
+    deformers: &'a [crate::deformer::Deformer],
+) -> Vec<SurfaceUpdate<'a>> {
+    levels
+        .iter()
+        .map(|&surface| SurfaceUpdate {
+            surface,
+            elapsed: dt,
+            deformers,
+        })
+        .collect()
+}
