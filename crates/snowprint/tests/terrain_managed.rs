@@ -332,6 +332,7 @@ fn a_touch_volume_follows_the_ground() {
 /// Terrain windows run by the manager: their levels in its pool and under its budget.
 mod windows {
     use super::*;
+    use snowprint::manager::ManagedProbeStatus;
     use snowprint::{LevelDesc, Material, SnowError, SnowWorld, TerrainDesc, WorldConfig};
 
     fn valley() -> TerrainDesc {
@@ -503,6 +504,60 @@ mod windows {
                 "level {i}: {differ} texels differ from the plain world's"
             );
         }
+        // Probes over the levels: the manager answers as the plain world does, from the finest
+        // level that holds the point (the near level where it reaches, the far one beyond).
+        let end = hiker(119).pose.position;
+        let points: Vec<Vec3> = (0..12)
+            .map(|k| hiker(96 + 2 * k).pose.position)
+            .chain([end + Vec3::new(2.5, 0.0, 0.0), Vec3::new(100.0, 1.0, 0.0)])
+            .map(|p| p.with_y(1.0))
+            .collect();
+        let ticket = m.probe(&points).expect("probe");
+        let mut managed = None;
+        for _ in 0..3 {
+            m.tick(0.0, None, &[]).expect("tick");
+            if let ManagedProbeStatus::Ready(s) = m.probe_result(ticket).unwrap() {
+                managed = Some(s);
+                break;
+            }
+        }
+        let managed = managed.expect("the manager answered within three ticks");
+        let ticket = plain.probe(&points).expect("probe");
+        let mut theirs = None;
+        for _ in 0..3 {
+            if let snowprint::ProbeStatus::Ready(s) = plain.probe_result(ticket).unwrap() {
+                theirs = Some(s);
+                break;
+            }
+            plain.step(0.0, &[]).expect("step");
+        }
+        let theirs = theirs.expect("the world answered within three steps");
+        let level_of = |id: Option<snowprint::SurfaceId>, ids: &[snowprint::SurfaceId]| {
+            id.and_then(|id| ids.iter().position(|&l| l == id))
+        };
+        let plain_levels = pt.surfaces();
+        let mut pressed = 0;
+        for (k, (a, b)) in managed.iter().zip(&theirs).enumerate() {
+            let want = match k {
+                0..12 => Some(0),
+                12 => Some(1),
+                _ => None,
+            };
+            assert_eq!(a.surface, None, "point {k}: over no managed surface");
+            assert_eq!(level_of(a.sample.surface, &levels), want, "point {k}");
+            assert_eq!(level_of(b.surface, &plain_levels), want, "point {k}");
+            let (x, y) = (a.sample, *b);
+            assert_eq!(
+                (x.snow_depth_m, x.depression_m, x.displaced_m, x.normal),
+                (y.snow_depth_m, y.depression_m, y.displaced_m, y.normal),
+                "point {k}"
+            );
+            pressed += usize::from(x.depression_m > 0.02);
+        }
+        assert!(
+            pressed >= 6,
+            "only {pressed} of the trail's points were pressed"
+        );
     }
 
     /// What the manager refuses of terrains, in one sentence each, with nothing changed.

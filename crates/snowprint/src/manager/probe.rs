@@ -8,7 +8,10 @@
 //!   the snow before the tick's evictions free any slot), read back without waiting;
 //! - in the page store: on the CPU from the page, by the same rule as the GPU pass
 //!   (`world/probe/cpu.rs`);
-//! - never given a heightmap: untouched snow.
+//! - never given a heightmap: untouched snow;
+//! - a terrain window's level of the manager's (`terrain.rs`), when it is the topmost there:
+//!   by the world's probe pass, as a resident surface (the finest level, outside the coarser
+//!   levels' holes).
 //!
 //! A request with a point over a surface whose page is still on its way from the GPU waits for
 //! the next tick. Imprints still queued for a surface are not in its samples yet (as with
@@ -39,7 +42,8 @@ impl ManagedProbeTicket {
 /// The snow under one point probed through a [`SnowManager`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ManagedSample {
-    /// The managed surface under the point, `None` when no surface is.
+    /// The managed surface under the point, `None` when none is (a terrain window's level may
+    /// be: [`ProbeSample::surface`] then names it).
     pub surface: Option<ManagedId>,
     /// The snow there. Its [`ProbeSample::surface`] is the world's handle when the sample was
     /// read from the pool, `None` when it came from a page or untouched snow.
@@ -61,8 +65,9 @@ struct Request {
     ticket: u64,
     points: Vec<Vec3>,
     samples: Vec<Option<ManagedSample>>,
-    /// For points read by the world's pass: (point, index in the world batch, surface).
-    from_world: Vec<(usize, usize, ManagedId)>,
+    /// For points read by the world's pass: (point, index in the world batch, surface; `None`
+    /// over a terrain's level).
+    from_world: Vec<(usize, usize, Option<ManagedId>)>,
     world: Option<ProbeTicket>,
 }
 
@@ -194,6 +199,14 @@ impl SnowManager {
     ) -> Result<bool> {
         let under: Vec<Option<ManagedId>> =
             r.points.iter().map(|&p| self.managed_under(p)).collect();
+        // Points where a terrain level is the topmost: the world's pass answers them (it picks
+        // the level, or a resident surface above it).
+        let on_level: Vec<bool> = r
+            .points
+            .iter()
+            .zip(&under)
+            .map(|(&p, id)| self.level_is_topmost(p, *id))
+            .collect();
         if under
             .iter()
             .flatten()
@@ -202,6 +215,11 @@ impl SnowManager {
             return Ok(false);
         }
         for (k, (&point, id)) in r.points.iter().zip(under).enumerate() {
+            if on_level[k] {
+                r.from_world.push((k, world_points.len(), None));
+                world_points.push(point);
+                continue;
+            }
             let Some(id) = id else {
                 r.samples[k] = Some(ManagedSample {
                     surface: None,
@@ -210,7 +228,7 @@ impl SnowManager {
                 continue;
             };
             if self.world_id(id).is_some() {
-                r.from_world.push((k, world_points.len(), id));
+                r.from_world.push((k, world_points.len(), Some(id)));
                 world_points.push(point);
                 continue;
             }
@@ -240,6 +258,25 @@ impl SnowManager {
             });
         }
         Ok(true)
+    }
+
+    /// Whether a terrain level of the manager's lies over `point` (outside its hole) with its
+    /// ground not below that of `managed`, the topmost managed surface there.
+    fn level_is_topmost(&self, point: Vec3, managed: Option<ManagedId>) -> bool {
+        let top = |id: crate::SurfaceId| -> Option<f32> {
+            let desc = self.world.surface(id).ok()?;
+            let field = self.world.ground(id).ok()?;
+            let hole = self.world.hole(id).ok()?;
+            cpu::over_outside_hole(desc, field, hole, point)
+        };
+        let Some(level) = self.level_ids().filter_map(top).reduce(f32::max) else {
+            return false;
+        };
+        let managed = managed.and_then(|id| {
+            let desc = self.planner.surface(id).ok()?;
+            cpu::over_on(desc, self.ground_field(id), point)
+        });
+        managed.is_none_or(|m| level >= m)
     }
 
     /// The topmost registered surface over a point (see [`crate::ProbeSample::surface`]).
@@ -284,10 +321,14 @@ impl SnowManager {
             let t = r.world.expect("filtered above");
             let answer = &self.probes.world_answers[&t];
             for &(k, at, id) in &r.from_world {
-                r.samples[k] = Some(ManagedSample {
-                    surface: Some(id),
-                    sample: answer[at],
+                let sample = answer[at];
+                // Over a level, the world may have answered from a resident surface above it.
+                let surface = id.or_else(|| {
+                    let w = sample.surface?;
+                    let i = self.world_ids.iter().position(|&x| x == Some(w))?;
+                    Some(ManagedId(i as u32))
                 });
+                r.samples[k] = Some(ManagedSample { surface, sample });
             }
             if !self.probes.sent.iter().any(|s| s.world == Some(t)) {
                 self.probes.world_answers.remove(&t);

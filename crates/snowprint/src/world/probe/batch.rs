@@ -16,14 +16,15 @@ const QUERY_BYTES: u64 = std::mem::size_of::<ProbeQuery>() as u64;
 
 impl SnowWorld {
     /// The surface under a point (see [`super::ProbeSample::surface`]): the topmost whose
-    /// rectangle holds it and whose ground is not above it; its query and what decodes it.
+    /// rectangle holds it (outside its hole, where a finer terrain window level answers) and whose
+    /// ground is not above it; its query and what decodes it.
     fn surface_under(&self, point: Vec3) -> Option<(ProbeQuery, PointInfo)> {
         let precision = self.config.format.precision;
         let mut best: Option<(f32, usize)> = None;
         for (i, s) in self.surfaces.iter().enumerate() {
             let Some(s) = s else { continue };
             let field = s.ground.as_ref().map(|g| &g.field);
-            match cpu::over_on(&s.desc, field, point) {
+            match cpu::over_outside_hole(&s.desc, field, s.hole, point) {
                 Some(ground) if best.is_none_or(|b| b.0 < ground) => best = Some((ground, i)),
                 _ => {}
             }

@@ -36,6 +36,22 @@ pub(crate) fn over_on(desc: &SurfaceDesc, field: Option<&GroundField>, point: Ve
         .then_some(ground)
 }
 
+/// [`over_on`], and not in `hole` (local `(x0, z0, x1, z1)`: a coarser terrain window level
+/// leaves the finer one's extent to it, which answers there).
+pub(crate) fn over_outside_hole(
+    desc: &SurfaceDesc,
+    field: Option<&GroundField>,
+    hole: Option<[f32; 4]>,
+    point: Vec3,
+) -> Option<f32> {
+    let ground = over_on(desc, field, point)?;
+    let in_hole = hole.is_some_and(|h| {
+        let local = desc.world_to_local().transform_point3(point);
+        local.x >= h[0] && local.z >= h[1] && local.x < h[2] && local.z < h[3]
+    });
+    (!in_hole).then_some(ground)
+}
+
 /// The texel under a point over a surface (clamped to the heightmap) and the texel's sides,
 /// metres.
 pub(crate) fn texel_under(

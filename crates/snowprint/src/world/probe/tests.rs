@@ -90,3 +90,25 @@ fn decode_by_hand() {
         on_ground.normal
     );
 }
+
+/// A coarser window level's hole leaves its points to the finer level: a point in the hole is
+/// not over the coarse level, one beside it is (with its ground), whichever ground is higher.
+#[test]
+fn a_point_in_a_levels_hole_is_not_over_it() {
+    let coarse = crate::surface::SurfaceDesc::new("coarse", [10.0, 2.0, 0.0], [8.0, 8.0], 0.3);
+    // The hole, local: x in [-1, 1), z in [-2, 0).
+    let hole = Some([-1.0, -2.0, 1.0, 0.0]);
+    let over = |x: f32, z: f32| cpu::over_outside_hole(&coarse, None, hole, Vec3::new(x, 2.5, z));
+    assert_eq!(over(10.0, -1.0), None, "in the hole");
+    assert_eq!(
+        over(9.0, -2.0),
+        None,
+        "on its first corner (the hole holds its low edges)"
+    );
+    assert_eq!(over(11.0, -1.0), Some(2.0), "on its high edge: outside");
+    assert_eq!(over(12.0, 1.0), Some(2.0), "beside it");
+    assert_eq!(
+        cpu::over_outside_hole(&coarse, None, None, Vec3::new(10.0, 2.5, -1.0)),
+        Some(2.0)
+    );
+}
