@@ -293,7 +293,7 @@ pub struct ClassifyRecord {
     pub bits: u32,
     /// 1 when the surface takes the deformable material even untouched: on ground that is not
     /// flat (the basic one draws a flat top), or with a hole (the basic one cannot meet the step
-    /// at its edge, `surface.wgsl`'s `hole_step`), else 0.
+    /// at its edge, `surface.wgsl`'s `through_hole`), else 0.
     pub always_deformable: u32,
     /// Toroidal storage offsets ([`crate::pool::wrapped`]).
     pub wrap: u32,

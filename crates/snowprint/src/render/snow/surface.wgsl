@@ -292,7 +292,7 @@ fn fs_deformable(in: SurfaceVarying, @builtin(front_facing) front: bool) -> Snow
 
 // The view ray of a fragment of the box traced through the heightfield; the fragment is
 // discarded where it meets no snow, or where a finer terrain window level draws instead
-// (`SnowSurface::hole`).
+// (`SnowSurface::hole`; `through_hole`).
 fn trace_pixel(in: SurfaceVarying, front: bool) -> SnowHit {
     let eye = (surface.world_to_local * vec4<f32>(frame.eye.xyz, 1.0)).xyz;
     let top = snow_top(surface);
@@ -303,15 +303,9 @@ fn trace_pixel(in: SurfaceVarying, front: bool) -> SnowHit {
     let o = select(in.local, eye, inside);
     let d = normalize(in.local - eye);
     let moon = normalize((surface.world_to_local * vec4<f32>(frame.moon_dir.xyz, 0.0)).xyz);
-    var hit = snow_trace(surface, o, d, frame.options.z, moon);
+    var hit = through_hole(o, d, moon);
     if hit.found == 0u {
         discard;
-    }
-    if snow_in_hole(surface, hit.position.xz) {
-        hit = hole_step(o, d);
-        if hit.found == 0u {
-            discard;
-        }
     }
     if hit.side == 1u && !inside && snow_seam_side(surface, face_side(in.face)) {
         // Entered through a side where another surface's snow goes on: the step between the two
@@ -322,47 +316,70 @@ fn trace_pixel(in: SurfaceVarying, front: bool) -> SnowHit {
     return hit;
 }
 
-// Side k (local -x, +x, -z, +z) of a box face's normal (a side face's).
-fn face_side(face: vec3<f32>) -> u32 {
-    if abs(face.x) > 0.5 {
-        return select(0u, 1u, face.x > 0.0);
+// The ray from `o` along `d` traced through the heightfield, leaving the surface's hole to the
+// finer terrain window level that draws it. Where the first snow met lies in the hole, the ray
+// goes on from where it leaves the hole: under this level's snow there it meets the step
+// between the two levels' tops (the finer level lower at its edge, as in a print that this
+// coarser level holds shallower), drawn as this level's top there (the tessellated tier's seam
+// skirts, tessellate/seams.rs); above it, it is traced again beyond the hole. Not found (0)
+// where the ray meets no snow outside the hole.
+fn through_hole(o: vec3<f32>, d: vec3<f32>, moon: vec3<f32>) -> SnowHit {
+    var origin = o;
+    var gone = 0.0;
+    var hit: SnowHit;
+    for (var attempt = 0u; attempt < 2u; attempt++) {
+        hit = snow_trace(surface, origin, d, frame.options.z, moon);
+        hit.t += gone;
+        if hit.found == 0u || !snow_in_hole(surface, hit.position.xz) {
+            return hit;
+        }
+        let t = hole_exit(origin, d);
+        let p = origin + d * t;
+        if attempt == 1u || t <= 0.0 || any(abs(p.xz) > surface.half_size) {
+            break;
+        }
+        if snow_inside(surface, origin, d, t) {
+            // The step; under the ground it is the ground's, not the snow's.
+            if p.y < snow_ground_base(surface, snow_uv(surface, p.xz)) {
+                break;
+            }
+            hit.position = p;
+            hit.t = gone + t;
+            hit.side = 0u;
+            hit.water = 0u;
+            hit.taps += 1u;
+            hit.shadow = snow_light_visibility(surface, snow_uv(surface, p.xz));
+            return hit;
+        }
+        // A hair past the hole's line, so that the next trace starts outside it.
+        origin = p + d * 1e-4;
+        gone += t + 1e-4;
     }
-    return select(2u, 3u, face.z > 0.0);
+    hit.found = 0u;
+    return hit;
 }
 
-// A ray from `o` along `d` whose first snow lies in the surface's hole, where a finer terrain
-// window level draws: where it leaves the hole under this level's snow (the finer level lower at
-// its edge, as in a print that this coarser level holds shallower), it meets the step between
-// the two levels' tops, which is drawn as this level's top there (the tessellated tier's seam
-// skirts, tessellate/seams.rs). Found nowhere else: the finer level draws what the ray meets.
-fn hole_step(o: vec3<f32>, d: vec3<f32>) -> SnowHit {
-    var hit: SnowHit;
-    hit.found = 0u;
-    let far = 3.0e38;
+// Where a ray from `o` along `d` leaves the surface's hole (its far side along the ray), as a
+// distance along it (3e38 when it runs along both axes' lines).
+fn hole_exit(o: vec3<f32>, d: vec3<f32>) -> f32 {
     let lo = surface.hole.xy;
     let hi = surface.hole.zw;
-    var t = far;
+    var t = 3.0e38;
     if d.x != 0.0 {
         t = min(t, (select(lo.x, hi.x, d.x > 0.0) - o.x) / d.x);
     }
     if d.z != 0.0 {
         t = min(t, (select(lo.y, hi.y, d.z > 0.0) - o.z) / d.z);
     }
-    let p = o + d * t;
-    if t <= 0.0 || t >= far || any(abs(p.xz) > surface.half_size) || !snow_inside(surface, o, d, t) {
-        return hit;
+    return t;
+}
+
+// Side k (local -x, +x, -z, +z) of a box face's normal (a side face's).
+fn face_side(face: vec3<f32>) -> u32 {
+    if abs(face.x) > 0.5 {
+        return select(0u, 1u, face.x > 0.0);
     }
-    if p.y < snow_ground_base(surface, snow_uv(surface, p.xz)) {
-        return hit;
-    }
-    hit.position = p;
-    hit.t = t;
-    hit.found = 1u;
-    hit.side = 0u;
-    hit.water = 0u;
-    hit.taps = 1u;
-    hit.shadow = snow_light_visibility(surface, snow_uv(surface, p.xz));
-    return hit;
+    return select(2u, 3u, face.z > 0.0);
 }
 
 // The depth of a hit, as the scene's depth target stores it.
