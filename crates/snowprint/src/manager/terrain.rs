@@ -90,38 +90,47 @@ impl SnowManager {
     /// Move a terrain's window to `focus` (see [`Terrain::follow`]); between ticks (refused with
     /// [`SnowError::FramePending`] while one is pending).
     pub fn follow_terrain(&mut self, id: ManagedTerrainId, focus: Vec3) -> Result<()> {
-        self.not_pending()?;
-        let t = self.terrain_entry(id)?;
-        let terrain = &mut self.terrains[t]
-            .as_mut()
-            .expect("checked by terrain_entry")
-            .terrain;
-        terrain.follow(&mut self.world, focus)
+        self.with_terrain(id, |t, world| t.follow(world, focus))
     }
 
     /// Land a terrain's strips still on their way (see [`Terrain::flush`]), for reads.
     pub fn flush_terrain(&mut self, id: ManagedTerrainId) -> Result<()> {
+        self.with_terrain(id, Terrain::flush)
+    }
+
+    /// Run `f` on a terrain and the world, between ticks.
+    fn with_terrain(
+        &mut self,
+        id: ManagedTerrainId,
+        f: impl FnOnce(&mut Terrain, &mut crate::SnowWorld) -> Result<()>,
+    ) -> Result<()> {
         self.not_pending()?;
-        let t = self.terrain_entry(id)?;
-        let terrain = &mut self.terrains[t]
-            .as_mut()
-            .expect("checked by terrain_entry")
-            .terrain;
-        terrain.flush(&mut self.world)
+        let entry = self
+            .terrains
+            .get_mut(id.0 as usize)
+            .and_then(Option::as_mut)
+            .ok_or(stale(id))?;
+        f(&mut entry.terrain, &mut self.world)
     }
 
     /// A terrain of the manager's (its levels are surfaces of [`SnowManager::world`]).
     pub fn terrain(&self, id: ManagedTerrainId) -> Result<&Terrain> {
-        let t = self.terrain_entry(id)?;
-        Ok(&self.terrains[t].as_ref().expect("checked").terrain)
+        self.terrains
+            .get(id.0 as usize)
+            .and_then(Option::as_ref)
+            .map(|t| &t.terrain)
+            .ok_or(stale(id))
     }
 
     /// Remove a terrain: its levels leave the world and give their slots back. Its handle is
     /// stale afterwards.
     pub fn remove_terrain(&mut self, id: ManagedTerrainId) -> Result<()> {
         self.not_pending()?;
-        let t = self.terrain_entry(id)?;
-        let gone = self.terrains[t].take().expect("checked");
+        let gone = self
+            .terrains
+            .get_mut(id.0 as usize)
+            .and_then(Option::take)
+            .ok_or(stale(id))?;
         for s in gone.terrain.surfaces() {
             self.world.remove_surface(s)?;
         }
@@ -130,17 +139,6 @@ impl SnowManager {
         }
         self.planner.reserve_updates(self.terrain_levels());
         Ok(())
-    }
-
-    fn terrain_entry(&self, id: ManagedTerrainId) -> Result<usize> {
-        let i = id.0 as usize;
-        match self.terrains.get(i) {
-            Some(Some(_)) => Ok(i),
-            _ => Err(SnowError::StaleHandle {
-                what: "terrain",
-                index: id.0,
-            }),
-        }
     }
 
     /// Levels of all the manager's terrains.
@@ -162,6 +160,14 @@ impl SnowManager {
             .iter()
             .flatten()
             .map(|t| t.terrain.desc().name.as_str())
+    }
+}
+
+/// The error for a terrain handle the manager does not hold.
+fn stale(id: ManagedTerrainId) -> SnowError {
+    SnowError::StaleHandle {
+        what: "terrain",
+        index: id.0,
     }
 }
 
