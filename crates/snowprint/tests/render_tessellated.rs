@@ -452,3 +452,41 @@ fn bad_geometry_is_refused_with_a_sentence() {
     let e = Renderer::new(common::gpu(), config).unwrap_err();
     assert!(e.to_string().contains("dice"), "{e}");
 }
+
+/// A surface that nothing of the frame shows (behind the camera, far from the moon's near
+/// cascade around what it looks at) gets no heightfield, bank or dicing work: its fields are
+/// still the fresh renderer's zeros, and it is diced into no triangle; turned towards it, the
+/// same renderer computes its fields as a renderer that always saw it.
+#[test]
+fn a_surface_nothing_shows_is_not_shaded() {
+    let (world, roof) = trench_world();
+    let mut r = renderer(&world);
+    let away = render(
+        &mut r,
+        &world,
+        roof,
+        Vec3::new(0.0, 3.0, 40.0),
+        Vec3::new(0.0, 3.0, 80.0),
+    );
+    assert_eq!(away.surfaces[0].triangles, 0);
+    let fields = r.read_surface_fields(roof).expect("fields");
+    assert!(
+        fields
+            .depression
+            .iter()
+            .chain(&fields.bank)
+            .all(|&v| v == 0.0),
+        "the unseen roof's fields were computed"
+    );
+    let eye = Vec3::new(0.5, 5.0, 5.0);
+    render(&mut r, &world, roof, eye, TRENCH);
+    let turned = r.read_surface_fields(roof).expect("fields");
+    let mut always = renderer(&world);
+    render(&mut always, &world, roof, eye, TRENCH);
+    let seen = always.read_surface_fields(roof).expect("fields");
+    assert!(
+        turned.depression.iter().any(|&d| d > 0.5),
+        "no trench in the fields"
+    );
+    assert_eq!(turned, seen);
+}

@@ -301,8 +301,11 @@ pub struct ClassifyRecord {
     pub banks: u32,
     /// The texels the heightfield pass runs over, likewise.
     pub heightfield: u32,
+    /// 1 when anything of the frame can show the surface (`frame::seen`), else 0: its heightfield
+    /// and bank passes are not dispatched then.
+    pub seen: u32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.

@@ -544,7 +544,8 @@ impl Renderer {
 
     /// A surface's smoothed depression, displaced channel and bank heights as the latest frame's
     /// heightfield and bank passes wrote them (the banks only in the tessellated tier, and only
-    /// for a deformed surface; otherwise what an earlier frame left, or zeros).
+    /// for a deformed surface that the frame could show, `frame/seen.rs`; otherwise what an
+    /// earlier frame left, or zeros).
     pub fn read_surface_fields(&self, surface: SurfaceId) -> RenderResult<SurfaceFields> {
         self.last_slot(surface)?;
         self.heightfield
@@ -605,6 +606,13 @@ impl Renderer {
         self.shadow.near_hold = Some(shadow.hold);
         let uniform = frame::frame_uniform(&self.config, frame, &shadow);
         self.frame.prepare(&self.queue, &uniform);
+        let mut surfaces = surfaces;
+        let near = glam::Mat4::from_cols_array_2d(&uniform.shadow_near);
+        frame::seen::mark_seen(
+            &mut surfaces,
+            glam::Mat4::from_cols_array_2d(&uniform.view_proj),
+            tessellated_tier.then_some(near),
+        );
         laps.mark("surfaces");
 
         let (device, queue) = (&self.device, &self.queue);

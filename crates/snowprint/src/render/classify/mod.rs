@@ -75,7 +75,8 @@ impl ClassifyPass {
                 wrap: s.view.wrap,
                 banks: packed_size(s.bank_domain()),
                 heightfield: packed_size(s.heightfield_domain()),
-                _pad: [0; 3],
+                seen: u32::from(s.seen),
+                _pad: [0; 2],
             })
             .collect();
         if n > 0 {

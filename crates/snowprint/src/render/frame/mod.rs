@@ -4,6 +4,8 @@
 
 use glam::{Vec2, Vec3};
 
+pub(super) mod seen;
+
 use super::cascades::ShadowCascades;
 use super::config::{RenderConfig, Tier};
 use super::error::RenderResult;
@@ -38,6 +40,9 @@ pub(super) struct FrameSurface<'a> {
     pub sides: [Option<Beside<'a>>; SIDES],
     /// Whether it lies in a coarser terrain window level's hole (`tessellate::seams::enclosed`).
     pub enclosed: bool,
+    /// Whether anything of the frame can show it (`seen::mark_seen`): the heightfield and bank
+    /// passes and the dicing skip the others.
+    pub seen: bool,
 }
 
 impl FrameSurface<'_> {
@@ -335,6 +340,7 @@ pub(super) fn frame_surfaces<'a>(
                 tessellated: tessellated_tier && geometry.tessellate,
                 sides,
                 enclosed: super::tessellate::seams::enclosed(view, &drawn),
+                seen: true,
             })
         })
         .collect()

@@ -130,7 +130,7 @@ impl DicePass {
         let stride = UNIFORM_STRIDE as usize;
         let mut bytes = vec![0u8; n.max(1) * stride];
         for (s, surface) in surfaces.iter().enumerate() {
-            if !surface.tessellated {
+            if !(surface.tessellated && surface.seen) {
                 continue;
             }
             let (desc, layout, g) = (surface.view.desc, surface.view.layout, surface.geometry);
@@ -183,7 +183,7 @@ impl DicePass {
         let tv = wgpu::BindingResource::TextureView;
         for (s, surface) in surfaces.iter().enumerate() {
             let tex = heightfields.texture(surface.view.id);
-            let (true, Some(tex)) = (surface.tessellated, tex) else {
+            let (true, Some(tex)) = (surface.tessellated && surface.seen, tex) else {
                 self.bind_groups.push(None);
                 continue;
             };
