@@ -77,36 +77,48 @@ pub(crate) fn rectangle_triangles(half: Vec2, hole: Option<[f32; 4]>) -> Vec<Bas
         };
         SEAM_SIDE + side
     };
-    let mut triangles = Vec::new();
-    let mut corners = Vec::new();
+    // A cell's edge is a border where the cell beside it is missing (past the rectangle, or in
+    // the hole): known from the grid, without counting the edges' uses.
+    let kept = |c: i64, r: i64| {
+        (0..nx as i64).contains(&c) && (0..nz as i64).contains(&r) && !inside(c as u32, r as u32)
+    };
+    let corner = |(c, r): (u32, u32)| {
+        let p = at(c, r);
+        [p.x, p.y, p.z, 0.0]
+    };
+    let mut base = Vec::new();
     for r in 0..nz {
         for c in 0..nx {
             if inside(c, r) {
                 continue;
             }
-            // As SurfaceMesh::rectangle: counter-clockwise seen from above.
-            for t in [
-                [(c, r), (c, r + 1), (c + 1, r + 1)],
-                [(c, r), (c + 1, r + 1), (c + 1, r)],
-            ] {
-                triangles.push(t.map(|(c, r)| id(c, r)));
-                corners.push(t);
-            }
-        }
-    }
-    let mesh = SurfaceMesh {
-        positions: (0..=nz)
-            .flat_map(|r| (0..=nx).map(move |c| (c, r)))
-            .map(|(c, r)| at(c, r))
-            .collect(),
-        triangles,
-    };
-    let mut base = mesh.base_triangles();
-    for (t, corners) in base.iter_mut().zip(&corners) {
-        for e in 0..3 {
-            if t.ids[3] & (1 << e) != 0 {
-                let m = mark(corners[e], corners[(e + 1) % 3]);
-                t.ids[3] |= m << (SEAM_SHIFT + 4 * e as u32);
+            let (ci, ri) = (c as i64, r as i64);
+            // As SurfaceMesh::rectangle: counter-clockwise seen from above; each triangle's
+            // edges in order, with the cell beside each (none beside the diagonal).
+            let cells: [([(u32, u32); 3], [Option<(i64, i64)>; 3]); 2] = [
+                (
+                    [(c, r), (c, r + 1), (c + 1, r + 1)],
+                    [Some((ci - 1, ri)), Some((ci, ri + 1)), None],
+                ),
+                (
+                    [(c, r), (c + 1, r + 1), (c + 1, r)],
+                    [None, Some((ci + 1, ri)), Some((ci, ri - 1))],
+                ),
+            ];
+            for (t, beside) in cells {
+                let mut w = 0;
+                for e in 0..3 {
+                    if beside[e].is_some_and(|(c, r)| !kept(c, r)) {
+                        w |= 1 << e | mark(t[e], t[(e + 1) % 3]) << (SEAM_SHIFT + 4 * e as u32);
+                    }
+                }
+                let [a, b, c] = t;
+                base.push(BaseTriangle {
+                    a: corner(a),
+                    b: corner(b),
+                    c: corner(c),
+                    ids: [id(a.0, a.1), id(b.0, b.1), id(c.0, c.1), w],
+                });
             }
         }
     }

@@ -84,6 +84,33 @@ fn a_hole_is_cut_out_and_its_sides_are_marked() {
         }
     }
     assert!((perimeter - 4.0).abs() < 1e-5, "perimeter {perimeter}");
+    assert_borders_counted(&base);
+}
+
+/// The border bits, found from the grid, are those of counting each edge's uses
+/// (`SurfaceMesh::base_triangles` on the same triangles).
+fn assert_borders_counted(base: &[BaseTriangle]) {
+    let n = base
+        .iter()
+        .flat_map(|t| &t.ids[..3])
+        .max()
+        .map_or(0, |&m| m + 1) as usize;
+    let mut positions = vec![glam::Vec3::ZERO; n];
+    for t in base {
+        for (&id, p) in t.ids[..3].iter().zip([t.a, t.b, t.c]) {
+            positions[id as usize] = glam::Vec3::new(p[0], p[1], p[2]);
+        }
+    }
+    let mesh = SurfaceMesh {
+        positions,
+        triangles: base
+            .iter()
+            .map(|t| [t.ids[0], t.ids[1], t.ids[2]])
+            .collect(),
+    };
+    for (ours, counted) in base.iter().zip(mesh.base_triangles()) {
+        assert_eq!(ours.ids[3] & 7, counted.ids[3], "{ours:?}");
+    }
 }
 
 /// A hole line within a millimetre of a cell line takes its place (no sliver cells); a hole past
@@ -111,6 +138,7 @@ fn hole_lines_near_cell_lines_replace_them_and_holes_are_clipped() {
     }
     // The +x side is cut by the clipped hole: 4 m less its 1 m.
     assert!((on_right - 3.0).abs() < 1e-5, "{on_right}");
+    assert_borders_counted(&base);
     let total: f32 = base.iter().map(area).sum();
     assert!((total - (16.0 - 3.0004)).abs() < 1e-3, "area {total}");
 }
