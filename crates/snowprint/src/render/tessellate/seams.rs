@@ -95,7 +95,7 @@ pub(crate) fn rectangle_triangles(half: Vec2, hole: Option<[f32; 4]>) -> Vec<Bas
             let (ci, ri) = (c as i64, r as i64);
             // As SurfaceMesh::rectangle: counter-clockwise seen from above; each triangle's
             // edges in order, with the cell beside each (none beside the diagonal).
-            let cells: [([(u32, u32); 3], [Option<(i64, i64)>; 3]); 2] = [
+            let cells: [(Corners, Beside); 2] = [
                 (
                     [(c, r), (c, r + 1), (c + 1, r + 1)],
                     [Some((ci - 1, ri)), Some((ci, ri + 1)), None],
@@ -124,6 +124,11 @@ pub(crate) fn rectangle_triangles(half: Vec2, hole: Option<[f32; 4]>) -> Vec<Bas
     }
     base
 }
+
+/// A triangle's corners as grid points (column, row).
+type Corners = [(u32, u32); 3];
+/// The cell beside each of a triangle's edges (none beside the cell's diagonal).
+type Beside = [Option<(i64, i64)>; 3];
 
 /// `lines` (sorted, the rectangle's first and last included) with `extra` added: an inner line
 /// within [`SNAP`] of one of `extra` gives way to it; one of `extra` within [`SNAP`] of the first
