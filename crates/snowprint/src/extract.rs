@@ -53,6 +53,34 @@ pub struct FrameView<'a> {
     pub ground_buffer: &'a wgpu::Buffer,
 }
 
+#[cfg(test)]
+impl<'a> SurfaceView<'a> {
+    /// A view of `desc` for the renderer's pure tests: surface `index`, `texels` of 16 bits at
+    /// word 0 of the pool, on flat ground, stored plainly, with `hole`.
+    pub(crate) fn for_test(
+        desc: &'a SurfaceDesc,
+        index: u32,
+        texels: [u32; 2],
+        hole: Option<[f32; 4]>,
+    ) -> Self {
+        Self {
+            id: SurfaceId(index, 0),
+            desc,
+            layout: crate::surface::SurfaceLayout {
+                width: texels[0],
+                height: texels[1],
+            },
+            heights: 0,
+            normals: None,
+            precision: crate::Precision::Bits16,
+            ground: crate::low_level::ground::NO_GROUND,
+            ground_range: (0.0, 0.0),
+            wrap: 0,
+            hole,
+        }
+    }
+}
+
 impl<'a> FrameView<'a> {
     /// A surface of the view, or the error the world gives for a handle it does not hold.
     pub fn surface(&self, id: SurfaceId) -> Result<&SurfaceView<'a>> {

@@ -213,9 +213,8 @@ fn beside(a: &SurfaceView<'_>, b: &SurfaceView<'_>, index: usize) -> Option<(usi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Precision;
     use crate::extract::SurfaceView;
-    use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+    use crate::surface::SurfaceDesc;
 
     fn desc(center: [f32; 2], size: [f32; 2], yaw: f32) -> SurfaceDesc {
         SurfaceDesc {
@@ -225,21 +224,7 @@ mod tests {
     }
 
     fn view(desc: &SurfaceDesc, texels: [u32; 2]) -> SurfaceView<'_> {
-        SurfaceView {
-            id: SurfaceId(0, 0),
-            desc,
-            layout: SurfaceLayout {
-                width: texels[0],
-                height: texels[1],
-            },
-            heights: 0,
-            normals: None,
-            precision: Precision::Bits16,
-            ground: crate::low_level::ground::NO_GROUND,
-            ground_range: (0.0, 0.0),
-            wrap: 0,
-            hole: None,
-        }
+        SurfaceView::for_test(desc, 0, texels, None)
     }
 
     #[test]

@@ -1,29 +1,14 @@
 use glam::{Mat4, Vec3};
 
 use super::*;
-use crate::Precision;
 use crate::extract::SurfaceView;
 use crate::render::heightfield::Beside;
 use crate::render::tessellate::SurfaceGeometry;
-use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+use crate::surface::SurfaceDesc;
 use crate::view::GroundMaterial;
 
 fn view(desc: &SurfaceDesc) -> SurfaceView<'_> {
-    SurfaceView {
-        id: SurfaceId(0, 0),
-        desc,
-        layout: SurfaceLayout {
-            width: 64,
-            height: 64,
-        },
-        heights: 0,
-        normals: None,
-        precision: Precision::Bits16,
-        ground: crate::low_level::ground::NO_GROUND,
-        ground_range: (0.0, 0.0),
-        wrap: 0,
-        hole: None,
-    }
+    SurfaceView::for_test(desc, 0, [64, 64], None)
 }
 
 fn surface<'a>(view: &'a SurfaceView<'a>, geometry: &'a SurfaceGeometry) -> FrameSurface<'a> {

@@ -1,8 +1,7 @@
 use glam::Vec2;
 
 use super::*;
-use crate::Precision;
-use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
+use crate::surface::SurfaceDesc;
 
 /// Edge `e` of a base triangle: its endpoints and its seam mark.
 fn edge(t: &BaseTriangle, e: usize) -> (Vec2, Vec2, u32) {
@@ -144,21 +143,7 @@ fn hole_lines_near_cell_lines_replace_them_and_holes_are_clipped() {
 }
 
 fn view(desc: &SurfaceDesc, id: u32, texels: u32, hole: Option<[f32; 4]>) -> SurfaceView<'_> {
-    SurfaceView {
-        id: SurfaceId(id, 0),
-        desc,
-        layout: SurfaceLayout {
-            width: texels,
-            height: texels,
-        },
-        heights: 0,
-        normals: None,
-        precision: Precision::Bits16,
-        ground: crate::low_level::ground::NO_GROUND,
-        ground_range: (0.0, 0.0),
-        wrap: 0,
-        hole,
-    }
+    SurfaceView::for_test(desc, id, [texels; 2], hole)
 }
 
 /// A fine level is enclosed by the coarse level whose hole is its rectangle (inset by a quarter
