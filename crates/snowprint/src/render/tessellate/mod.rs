@@ -90,18 +90,12 @@ impl SurfaceMesh {
     /// The default mesh: the rectangle `[-half.x, half.x] x [-half.y, half.y]` cut into cells of
     /// about a metre (at most 64 a side), two triangles a cell.
     pub fn rectangle(half: Vec2) -> Self {
-        let nx = ((2.0 * half.x).ceil() as u32).clamp(1, 64);
-        let nz = ((2.0 * half.y).ceil() as u32).clamp(1, 64);
-        let mut positions = Vec::with_capacity(((nx + 1) * (nz + 1)) as usize);
-        for r in 0..=nz {
-            for c in 0..=nx {
-                positions.push(Vec3::new(
-                    -half.x + 2.0 * half.x * c as f32 / nx as f32,
-                    0.0,
-                    -half.y + 2.0 * half.y * r as f32 / nz as f32,
-                ));
-            }
-        }
+        let (xs, zs) = rectangle_lines(half);
+        let (nx, nz) = (xs.len() as u32 - 1, zs.len() as u32 - 1);
+        let positions = zs
+            .iter()
+            .flat_map(|&z| xs.iter().map(move |&x| Vec3::new(x, 0.0, z)))
+            .collect();
         let id = |c: u32, r: u32| r * (nx + 1) + c;
         let mut triangles = Vec::with_capacity((2 * nx * nz) as usize);
         for r in 0..nz {
@@ -208,6 +202,18 @@ impl SurfaceMesh {
             })
             .collect()
     }
+}
+
+/// The lines of [`SurfaceMesh::rectangle`]'s cells along x and along z, first and last
+/// included: about a metre apart, at most 64 cells a side.
+pub(crate) fn rectangle_lines(half: Vec2) -> (Vec<f32>, Vec<f32>) {
+    let lines = |h: f32| {
+        let n = ((2.0 * h).ceil() as u32).clamp(1, 64);
+        (0..=n)
+            .map(|i| -h + 2.0 * h * i as f32 / n as f32)
+            .collect()
+    };
+    (lines(half.x), lines(half.y))
 }
 
 /// How a snow surface is drawn in the tessellated tier. Set per surface with

@@ -17,7 +17,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BaseTriangle, SurfaceMesh};
+use super::BaseTriangle;
 use crate::extract::SurfaceView;
 
 /// An edge of the rectangle's side `k` (local -x, +x, -z, +z) is marked `SEAM_SIDE + k`.
@@ -32,18 +32,11 @@ pub(crate) const SEAM_SHIFT: u32 = crate::wgsl::consts::SEAM_SHIFT;
 const SNAP: f32 = 1e-3;
 
 /// The base triangles of a surface's rectangle of half sides `half` with `hole` (local
-/// `(x0, z0, x1, z1)`, clipped to the rectangle) cut out: [`SurfaceMesh::rectangle`]'s cells, cut
+/// `(x0, z0, x1, z1)`, clipped to the rectangle) cut out: [`super::SurfaceMesh::rectangle`]'s cells, cut
 /// again along the hole's lines, less the cells inside it. Every border edge is marked with the
 /// side it lies on, or as the hole's.
 pub(crate) fn rectangle_triangles(half: Vec2, hole: Option<[f32; 4]>) -> Vec<BaseTriangle> {
-    let cells = SurfaceMesh::rectangle(half);
-    let lines = |along: usize| -> Vec<f32> {
-        let mut v: Vec<f32> = cells.positions.iter().map(|p| [p.x, p.z][along]).collect();
-        v.sort_by(f32::total_cmp);
-        v.dedup();
-        v
-    };
-    let (mut xs, mut zs) = (lines(0), lines(1));
+    let (mut xs, mut zs) = super::rectangle_lines(half);
     let cut = hole.and_then(|h| {
         let lo = Vec2::new(h[0].max(-half.x), h[1].max(-half.y));
         let hi = Vec2::new(h[2].min(half.x), h[3].min(half.y));

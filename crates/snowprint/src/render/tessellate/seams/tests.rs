@@ -1,6 +1,7 @@
 use glam::Vec2;
 
 use super::*;
+use crate::render::tessellate::SurfaceMesh;
 use crate::surface::SurfaceDesc;
 
 /// Edge `e` of a base triangle: its endpoints and its seam mark.
