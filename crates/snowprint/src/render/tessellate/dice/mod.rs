@@ -25,7 +25,9 @@ use crate::surface::SurfaceId;
 
 /// A surface's base mesh on the GPU.
 struct BaseMeshGpu {
-    buffer: wgpu::Buffer,
+    /// Kept and written again when the mesh changes (a window level's hole moves with every
+    /// scroll); grown when the new mesh is larger.
+    buffer: Growable,
     triangles: u32,
     key: BaseMeshKey,
 }
@@ -143,7 +145,7 @@ impl DicePass {
                 hole: hole.map(|h| h.map(f32::to_bits)),
             };
             let id = surface.view.id;
-            self.upload_base_mesh(device, id, g.mesh.as_ref(), half, hole, key)?;
+            self.upload_base_mesh((device, queue), id, g.mesh.as_ref(), half, hole, key)?;
             let base = &self.base_meshes[&id];
             let local_to_world = desc.local_to_world();
             let eye = local_to_world.inverse().transform_point3(frame.camera.eye);
@@ -194,7 +196,7 @@ impl DicePass {
                 &self.layout,
                 &[
                     uniform_block(&self.params.buffer, s, std::mem::size_of::<DiceParams>()),
-                    base.buffer.as_entire_binding(),
+                    base.buffer.buffer.as_entire_binding(),
                     tv(&tex.shape),
                     tv(&tex.bank),
                     state.as_entire_binding(),
@@ -213,7 +215,7 @@ impl DicePass {
     /// the one on the GPU was built for the same `key`.
     fn upload_base_mesh(
         &mut self,
-        device: &wgpu::Device,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
         id: SurfaceId,
         mesh: Option<&SurfaceMesh>,
         half: glam::Vec2,
@@ -230,20 +232,21 @@ impl DicePass {
             }
             None => seams::rectangle_triangles(half, hole),
         };
-        use wgpu::util::DeviceExt;
-        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("snow base mesh"),
-            contents: bytemuck::cast_slice(&triangles),
-            usage: wgpu::BufferUsages::STORAGE,
+        let bytes: &[u8] = bytemuck::cast_slice(&triangles);
+        let base = self.base_meshes.entry(id).or_insert_with(|| BaseMeshGpu {
+            buffer: Growable::new(
+                device,
+                "snow base mesh",
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                bytes.len() as u64,
+            ),
+            triangles: 0,
+            key,
         });
-        self.base_meshes.insert(
-            id,
-            BaseMeshGpu {
-                buffer,
-                triangles: triangles.len() as u32,
-                key,
-            },
-        );
+        base.buffer.ensure(device, bytes.len() as u64);
+        queue.write_buffer(&base.buffer.buffer, 0, bytes);
+        base.triangles = triangles.len() as u32;
+        base.key = key;
         Ok(())
     }
 
