@@ -121,6 +121,21 @@ pub fn merge_channels(
     (new_depressed, new_displaced)
 }
 
+/// The refill pass (refill.wgsl) on one word of a heights region: every channel the word holds
+/// (four 8-bit lanes, two 16-bit lanes or one 32-bit word) replenished by `replenish_units`,
+/// saturating at the untouched top. Followed by [`merge_channels`] with no replenishment, it gives
+/// what `merge_channels` with the replenishment gives.
+pub fn refill_word(word: u32, replenish_units: u32, precision: Precision) -> u32 {
+    let lane = |v: u32| v.max(replenish_units) - replenish_units;
+    match precision {
+        Precision::Bits8 => (0..4).fold(0, |out, k| {
+            out | (lane((word >> (8 * k)) & 0xff) << (8 * k))
+        }),
+        Precision::Bits16 => lane(word & 0xffff) | (lane(word >> 16) << 16),
+        Precision::Bits32 => lane(word),
+    }
+}
+
 /// Stage 2 over a heightmap of channels (row-major depression and displaced).
 pub fn merge(
     depression: &[u32],
@@ -297,6 +312,40 @@ mod tests {
             let max = p.channel_max();
             let out = merge_channels((0, max - 1), Some(1.0), 0, p);
             assert_eq!(out, (max, max), "{p}");
+        }
+    }
+
+    /// Refilling the stored words, then merging without replenishment, equals merging with it, at
+    /// every precision, on a row of odd width (8-bit padding included) whose channels span the
+    /// range: what lets the fused pass leave the replenishment to the refill pass.
+    #[test]
+    fn refilled_words_then_merge_equal_the_merge_with_refill() {
+        use crate::pool::PoolFormat;
+        for p in Precision::ALL {
+            let max = p.channel_max();
+            let depression = [0, 1, 99, 100, 101, max / 2, max - 1, max, 7, 0, max];
+            let displaced = [max, 0, 100, 3, 250, max / 3, 1, max, 0, 101, 5];
+            let blurred = [0.0, 0.3, 0.0, 1.0, 0.5, 0.01, 0.9, 0.2, 0.0, 0.7, 0.5];
+            let format = PoolFormat::new(p);
+            let w = depression.len() as u32;
+            let words = format.encode(w, 1, &depression, &displaced).unwrap();
+            for rep in [0, 1, 100, 255, max / 2, max] {
+                let refilled: Vec<u32> = words.iter().map(|&v| refill_word(v, rep, p)).collect();
+                let (d, g) = format.decode(w, 1, &refilled).unwrap();
+                for i in 0..depression.len() {
+                    let old = (depression[i], displaced[i]);
+                    let b = Some(blurred[i]);
+                    assert_eq!(
+                        merge_channels((d[i], g[i]), b, 0, p),
+                        merge_channels(old, b, rep, p),
+                        "{p}, {rep} units, texel {i}"
+                    );
+                }
+                // The 8-bit row's padding texel stays zero.
+                if p == Precision::Bits8 {
+                    assert_eq!(refilled.last().unwrap() >> 16, 0);
+                }
+            }
         }
     }
 

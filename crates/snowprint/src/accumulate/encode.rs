@@ -1,7 +1,7 @@
 //! Recording a frame's accumulation chain: the records of the surfaces updated
 //! ([`AccumulatePlan`], built on the CPU by the world's frame plan) into one dispatch per stage.
 
-use super::{AccumulatePipelines, FUSED_WORKGROUP, WORKGROUP};
+use super::{AccumulatePipelines, FUSED_WORKGROUP, REFILL_CHUNK, WORKGROUP};
 use crate::gpu::resources::bind_group;
 use crate::gpu::timestamps::StageQueries;
 use crate::pool::SurfaceRecord;
@@ -15,10 +15,15 @@ pub struct AccumulatePlan {
     pub fused: bool,
     /// Whether the pool keeps normals (a normals pass follows).
     pub normals: bool,
-    /// With `fused`: records after the first `grid` are updated only over the tiles the capture
-    /// listed (a seal dispatch, then an indirect one).
+    /// With `fused`: the first `refill` records (those that refill snow) are replenished over
+    /// their whole heights regions by one streaming dispatch before the fused pass.
+    pub refill: u32,
+    /// Largest heights region of the `refill` records, words.
+    pub refill_words: u32,
+    /// With `fused`: the fused pass runs over the tiles the capture listed (a seal dispatch, then
+    /// an indirect one) rather than over a grid of every record's tiles.
     pub listed: bool,
-    /// Records the fused pass's grid covers (all of them when not `listed`).
+    /// Records the fused pass's grid covers (all of them when not `listed`, none when it is).
     pub grid: u32,
     /// Widest record, texels.
     pub max_width: u32,
@@ -32,6 +37,8 @@ impl AccumulatePlan {
     /// Empty it, keeping its memory.
     pub fn clear(&mut self) {
         self.records.clear();
+        self.refill = 0;
+        self.refill_words = 0;
         self.listed = false;
         self.grid = 0;
         self.max_width = 0;
@@ -101,9 +108,20 @@ pub fn encode_update(
             label: Some("fused"),
             timestamp_writes: queries.compute("fused"),
         });
+        // The snow that fell, over whole regions; then the captures, over the tiles they reached.
+        if plan.refill > 0 {
+            let refill_bg = bind_group(
+                device,
+                "refill",
+                &pipes.refill_layout,
+                &[b.records.as_entire_binding(), b.pool.as_entire_binding()],
+            );
+            let (x, y) = refill_groups(plan.refill_words);
+            pass.set_pipeline(&pipes.refill);
+            pass.set_bind_group(0, &refill_bg, &[]);
+            pass.dispatch_workgroups(x, y, plan.refill);
+        }
         pass.set_bind_group(0, &fused_bg, &[]);
-        // Every tile of the surfaces that refill snow; then only the listed tiles of the others,
-        // as many workgroups as the capture listed.
         if plan.grid > 0 {
             pass.set_pipeline(&pipes.fused);
             pass.dispatch_workgroups(
@@ -166,6 +184,14 @@ pub fn encode_update(
             );
         }
     }
+}
+
+/// Workgroups of the refill over a region of `words`: `REFILL_GROUP x REFILL_WORDS` words each
+/// (refill.wgsl), in rows of at most 65535.
+fn refill_groups(words: u32) -> (u32, u32) {
+    let groups = words.div_ceil(REFILL_CHUNK).max(1);
+    let rows = groups.div_ceil(u16::MAX as u32);
+    (groups.div_ceil(rows), rows)
 }
 
 /// The normals' part of [`encode`], when the pool keeps them: normals of every record's new top.

@@ -8,7 +8,9 @@
 //! 3. [`normals.wgsl`](NORMALS_SHADER), only when the pool keeps normals: normals of the new snow
 //!    top (reads the heights, writes the normals region).
 //!
-//! On GPUs, [`fused.wgsl`](FUSED_SHADER) does stages 1 and 2 in one pass. Every pass reads and
+//! On GPUs, [`refill.wgsl`](REFILL_SHADER) streams the replenishment over the regions of the
+//! surfaces that refill snow, then [`fused.wgsl`](FUSED_SHADER) does stages 1 and 2 in one pass
+//! over the tiles the capture reached. Every pass reads and
 //! writes heights through `pool/texel.wgsl`, at the pool's [`Precision`] (an override constant).
 //!
 //! CPU reference: [`cpu`].
@@ -29,6 +31,9 @@ pub const WORKGROUP: u32 = crate::wgsl::consts::WORKGROUP;
 /// Workgroup side of the fused pass: one of the pool's update tiles ([`crate::pool::TILE_SIDE`]).
 pub const FUSED_WORKGROUP: u32 = crate::pool::TILE_SIDE;
 
+/// Words of a heights region one workgroup of the refill takes (refill.wgsl).
+pub const REFILL_CHUNK: u32 = crate::wgsl::consts::REFILL_GROUP * crate::wgsl::consts::REFILL_WORDS;
+
 /// The three compute pipelines and their layouts.
 pub struct AccumulatePipelines {
     /// Stage 1.
@@ -37,14 +42,18 @@ pub struct AccumulatePipelines {
     pub merge: wgpu::ComputePipeline,
     /// Normals.
     pub normals: wgpu::ComputePipeline,
-    /// Blur and merge fused, over every tile of the records that refill snow.
+    /// Replenishment of whole heights regions, before the fused pass.
+    pub refill: wgpu::ComputePipeline,
+    /// Blur and merge fused, over every tile of every record (unflagged tiles leave at once).
     pub fused: wgpu::ComputePipeline,
-    /// Blur and merge fused, over the capture's listed tiles of the records that do not.
+    /// Blur and merge fused, over the capture's listed tiles.
     pub fused_listed: wgpu::ComputePipeline,
     /// Writes the listed pass's indirect dispatch.
     pub seal: wgpu::ComputePipeline,
     /// Layout of the seal's group 0: the tile list.
     pub seal_layout: wgpu::BindGroupLayout,
+    /// Layout of the refill's group 0: records, pool.
+    pub refill_layout: wgpu::BindGroupLayout,
     /// Layout of the blur's group 0.
     pub blur_layout: wgpu::BindGroupLayout,
     /// Layout of the merge's group 0.
@@ -58,12 +67,13 @@ pub struct AccumulatePipelines {
 impl AccumulatePipelines {
     /// Compile the passes for heightmaps of `precision`.
     pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
-        use crate::wgsl::{BLUR, FUSED, MERGE, NORMALS, SEAL};
+        use crate::wgsl::{BLUR, FUSED, MERGE, NORMALS, REFILL, SEAL};
         let blur_layout = BLUR.bind_group_layout(device, "blur", 0);
         let merge_layout = MERGE.bind_group_layout(device, "merge", 0);
         // One layout for both fused entry points: the module's group 0 covers what either reads.
         let fused_layout = FUSED.bind_group_layout(device, "fused", 0);
         let seal_layout = SEAL.bind_group_layout(device, "seal", 0);
+        let refill_layout = REFILL.bind_group_layout(device, "refill", 0);
         let normals_layout = NORMALS.bind_group_layout(device, "normals", 0);
         let constants = [("PRECISION", precision.bits() as f64)];
         let make = |name: &str, shader: &ShaderModule, layout: &wgpu::BindGroupLayout| {
@@ -93,10 +103,12 @@ impl AccumulatePipelines {
             blur: make("blur", &BLUR, &blur_layout),
             merge: make("merge", &MERGE, &merge_layout),
             normals: make("normals", &NORMALS, &normals_layout),
+            refill: make("refill", &REFILL, &refill_layout),
             fused: make("fused", &FUSED, &fused_layout),
             fused_listed: make("fused_listed", &FUSED, &fused_layout),
             seal: make("seal_tiles", &SEAL, &seal_layout),
             seal_layout,
+            refill_layout,
             blur_layout,
             merge_layout,
             normals_layout,
@@ -115,6 +127,7 @@ mod tests {
             ("blur", &crate::wgsl::BLUR),
             ("merge", &crate::wgsl::MERGE),
             ("normals", &crate::wgsl::NORMALS),
+            ("refill", &crate::wgsl::REFILL),
             ("fused", &crate::wgsl::FUSED),
             ("seal", &crate::wgsl::SEAL),
             ("capture", &crate::wgsl::CAPTURE),

@@ -13,6 +13,10 @@ const TILE: u32 = 16u;
 const APRON: u32 = 1u;
 // Workgroup side of the separate accumulation passes.
 const WORKGROUP: u32 = 8u;
+// Invocations of a workgroup of the refill (accumulate/refill.wgsl).
+const REFILL_GROUP: u32 = 256u;
+// Words of a heights region each invocation of the refill takes, all loaded before any is stored.
+const REFILL_WORDS: u32 = 8u;
 // Words before the entries of the capture's tile list: the dispatch arguments and the count.
 const TILE_LIST_HEADER: u32 = 4u;
 // `record` of a capture view whose flagged tiles are not listed (the update runs its grid).

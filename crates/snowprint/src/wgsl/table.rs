@@ -23,6 +23,7 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("blur", "accumulate/blur.wgsl", true),
     ("merge", "accumulate/merge.wgsl", true),
     ("normals", "accumulate/normals.wgsl", true),
+    ("refill", "accumulate/refill.wgsl", true),
     ("fused", "accumulate/fused.wgsl", true),
     ("seal", "accumulate/seal.wgsl", true),
     // Kicked-up snow: spawned from the update's data, simulated in a ring (`spray/`).

@@ -512,20 +512,34 @@ impl FramePlan {
             .iter()
             .take_while(|j| j.record.replenish_units > 0)
             .count();
-        let still_tiles: u64 = self.jobs[dense..]
+        let captured_tiles: u64 = self
+            .jobs
             .iter()
             .filter(|j| j.surface.captured)
             .map(|j| j.record.tile_count() as u64)
             .sum();
         let fused = settings.fused();
-        let listed = fused && still_tiles > 0 && still_tiles >= settings.list_tiles_from as u64;
+        let listed =
+            fused && captured_tiles > 0 && captured_tiles >= settings.list_tiles_from as u64;
         let a = &mut self.accumulate;
         a.fused = fused;
         a.normals = settings.format.normals;
         a.unit_texels = settings.format.precision.unit_texels();
+        // The fused pass replenishes nothing: the refill does, over the first `dense` records.
+        a.refill = if fused { dense as u32 } else { 0 };
+        a.refill_words = self.jobs[..a.refill as usize]
+            .iter()
+            .map(|j| {
+                (settings
+                    .format
+                    .heights_bytes(j.record.width, j.record.height)
+                    / 4) as u32
+            })
+            .max()
+            .unwrap_or(0);
         a.listed = listed;
-        // Without the list, the grid covers every record.
-        a.grid = if listed { dense } else { self.jobs.len() } as u32;
+        // Without the list, the grid covers every record; with it, none.
+        a.grid = if listed { 0 } else { self.jobs.len() as u32 };
         a.max_width = self.jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         a.max_height = self.jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
         let c = &mut self.capture;

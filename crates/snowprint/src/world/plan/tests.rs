@@ -323,7 +323,15 @@ fn surfaces_that_refill_come_first_and_the_rest_are_listed() {
     assert_eq!(order, vec![1, 0, 2]);
     let a = &plan.accumulate;
     assert!(a.fused && a.listed);
-    assert_eq!(a.grid, 1);
+    // The refilling surface is refilled over its whole region by the refill pass; with the list,
+    // the fused pass needs no grid.
+    assert_eq!(a.grid, 0);
+    assert_eq!(a.refill, 1);
+    let r = &a.records[0];
+    assert_eq!(
+        a.refill_words as u64,
+        s.format.heights_bytes(r.width, r.height) / 4
+    );
     assert_eq!(plan.capture.views[0].record, 1);
     // Never listing: the grid covers every record and the views say so.
     s.list_tiles_from = u32::MAX;
@@ -341,6 +349,7 @@ fn surfaces_that_refill_come_first_and_the_rest_are_listed() {
     s.list_tiles_from = 0;
     let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
     assert!(!plan.accumulate.fused && !plan.accumulate.listed);
+    assert_eq!(plan.accumulate.refill, 0, "the separate merge refills");
     assert_eq!(plan.sizes.scratch, plan.sizes.capture);
 }
 
