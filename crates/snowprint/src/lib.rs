@@ -187,8 +187,8 @@ pub mod low_level {
     /// The heightmap pool: slot allocator and the per-surface record the passes read.
     pub mod pool {
         pub use crate::pool::{
-            MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN, Slot, SlotAllocator,
-            SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+            MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN, Slot,
+            SlotAllocator, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
         };
     }
     /// The render graph: the pass table and its check.

@@ -12,7 +12,7 @@ struct SurfaceRecord {
     height: u32,
     atlas_x: u32,         // where the surface's capture lies in the capture atlas
     atlas_y: u32,
-    mode: u32,            // bit 0: mask capture (else depth); bit 1: MODE_MESHES; bit 2: MODE_GROUND
+    mode: u32,            // bit 0: mask capture (else depth); bit 1: MODE_MESHES; bit 2: MODE_GROUND; bit 3: MODE_REFILLED
     replenish_units: u32, // channel units (1/channel_max(PRECISION) of the snow depth) refilled
     batch: u32,           // capture batch; NO_CAPTURE when nothing touched the surface (0xfffffffe: the compute path)
     mask_fraction: f32,   // mask capture: fraction of the snow depth a covered texel is pressed

@@ -32,15 +32,18 @@ fn world_with(mode: CaptureMode, fused: bool) -> SnowWorld {
 }
 
 fn world_format(mode: CaptureMode, fused: bool, format: PoolFormat) -> SnowWorld {
-    world_listing(mode, fused, format, WorldConfig::default().list_tiles_from)
+    let d = WorldConfig::default();
+    world_listing(mode, fused, format, d.list_tiles_from, d.refill_stream_from)
 }
 
-/// A world whose fused update lists touched tiles from `list_tiles_from` tiles on (0: always).
+/// A world whose fused update lists touched tiles from `list_tiles_from` tiles on (0: always)
+/// and streams snowfall's refill from `refill_stream_from` words on (0: always).
 fn world_listing(
     mode: CaptureMode,
     fused: bool,
     format: PoolFormat,
     list_tiles_from: u32,
+    refill_stream_from: u32,
 ) -> SnowWorld {
     SnowWorld::new(
         common::gpu(),
@@ -58,6 +61,7 @@ fn world_listing(
             },
             format,
             list_tiles_from,
+            refill_stream_from,
             ..Default::default()
         },
     )
@@ -988,9 +992,16 @@ fn update_touches_only_the_listed_surfaces() {
 /// The fused pass (blur and merge in one dispatch, in place) gives what the CPU references give in
 /// sequence, and what the separate passes give, at every precision; normals follow it. Without
 /// snowfall it skips the tiles the capture did not flag: every texel still matches, so no tile
-/// that a deformer reached was skipped and the skipped ones kept their earlier prints.
+/// that a deformer reached was skipped and the skipped ones kept their earlier prints. Snowfall is
+/// refilled both ways: by the fused pass, and by the refill pass streaming whole regions.
 #[test]
 fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
+    for refill_stream_from in [u32::MAX, 0] {
+        fused_against_cpu_and_separate(refill_stream_from);
+    }
+}
+
+fn fused_against_cpu_and_separate(refill_stream_from: u32) {
     for (size, yaw, precision, rate) in [
         ([4.0, 3.0], 20.0, Precision::Bits16, 0.3),
         ([1.3, 2.7], 0.0, Precision::Bits8, 0.3),
@@ -1003,7 +1014,7 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
             normals: true,
         };
         // Always listing: the cases without snowfall update only the listed tiles.
-        let mut fused = world_listing(CaptureMode::Depth, true, format, 0);
+        let mut fused = world_listing(CaptureMode::Depth, true, format, 0, refill_stream_from);
         let mut separate = world_format(CaptureMode::Depth, false, format);
         let mut desc = SurfaceDesc::new("f", [0.5, 2.0, 1.0], size, 0.3);
         desc.yaw_degrees = yaw;
@@ -1046,7 +1057,7 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
             };
             assert!(
                 off_by(&gpu, &cpu) <= slack,
-                "fused vs CPU at {precision}, frame {frame}"
+                "fused vs CPU at {precision}, frame {frame}, streaming from {refill_stream_from}"
             );
             assert!(
                 off_by(&gpu, &separate.read_channels(b).unwrap()) <= slack,
@@ -1080,20 +1091,28 @@ fn fused_pass_matches_the_cpu_chain_and_the_separate_passes() {
     }
 }
 
-/// One fused update of surfaces that refill snow (every tile, by the grid) and surfaces that do not
-/// (only the tiles the capture listed, or the grid skipping unflagged tiles): each agrees with the
-/// separate passes, frame after frame, and the still surfaces keep their earlier prints where
-/// nothing presses them again.
+/// One fused update of surfaces that refill snow (every tile, by the grid, or every word, by the
+/// refill pass) and surfaces that do not (only the tiles the capture listed, or the grid skipping
+/// unflagged tiles): each agrees with the separate passes, frame after frame, and the still
+/// surfaces keep their earlier prints where nothing presses them again.
 #[test]
 fn fused_update_mixes_snowing_and_still_surfaces() {
     for list_tiles_from in [0, u32::MAX] {
-        mixed_frames(list_tiles_from);
+        for refill_stream_from in [0, u32::MAX] {
+            mixed_frames(list_tiles_from, refill_stream_from);
+        }
     }
 }
 
-fn mixed_frames(list_tiles_from: u32) {
+fn mixed_frames(list_tiles_from: u32, refill_stream_from: u32) {
     let format = PoolFormat::default();
-    let mut fused = world_listing(CaptureMode::Depth, true, format, list_tiles_from);
+    let mut fused = world_listing(
+        CaptureMode::Depth,
+        true,
+        format,
+        list_tiles_from,
+        refill_stream_from,
+    );
     let mut separate = world_with(CaptureMode::Depth, false);
     let mut ids = Vec::new();
     for (i, rate) in [0.0, 0.4, 0.0, 0.2].into_iter().enumerate() {
@@ -1124,7 +1143,7 @@ fn mixed_frames(list_tiles_from: u32) {
                 .unwrap_or(0);
             assert!(
                 worst <= 1,
-                "listing from {list_tiles_from} tiles, frame {frame}, surface at {:?} (refill {}): {worst} units apart",
+                "listing from {list_tiles_from} tiles, streaming from {refill_stream_from} words, frame {frame}, surface at {:?} (refill {}): {worst} units apart",
                 desc.center,
                 desc.replenish_rate
             );

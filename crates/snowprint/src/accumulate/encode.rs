@@ -15,15 +15,17 @@ pub struct AccumulatePlan {
     pub fused: bool,
     /// Whether the pool keeps normals (a normals pass follows).
     pub normals: bool,
-    /// With `fused`: the first `refill` records (those that refill snow) are replenished over
-    /// their whole heights regions by one streaming dispatch before the fused pass.
+    /// With `fused`: the first `refill` records (those that refill snow, marked
+    /// [`MODE_REFILLED`](crate::pool::MODE_REFILLED)) are replenished over their whole heights
+    /// regions by one streaming dispatch before the fused pass (0: the fused pass refills).
     pub refill: u32,
     /// Largest heights region of the `refill` records, words.
     pub refill_words: u32,
-    /// With `fused`: the fused pass runs over the tiles the capture listed (a seal dispatch, then
-    /// an indirect one) rather than over a grid of every record's tiles.
+    /// With `fused`: records after the first `grid` are updated only over the tiles the capture
+    /// listed (a seal dispatch, then an indirect one).
     pub listed: bool,
-    /// Records the fused pass's grid covers (all of them when not `listed`, none when it is).
+    /// Records the fused pass's grid covers: all of them when not `listed`, else those it refills
+    /// (none when the refill pass streams).
     pub grid: u32,
     /// Widest record, texels.
     pub max_width: u32,

@@ -3,12 +3,15 @@
 // workgroup memory, blurs each texel from there, then merges the tile's units (two texels along x
 // at 8 bits, one otherwise; 16 is even, so a unit never straddles tiles) into the heights region.
 // A texel's new value depends only on its own old value, so updating in place is safe whatever
-// order the workgroups run in. Only tiles the capture flagged change here: the snow that fell is
-// added before, over whole regions, by refill.wgsl, so the merge replenishes nothing (deepening
-// a refilled texel equals merging with the refill, accumulate::cpu::refill_word).
-// Two entry points share that work: `fused`, a grid over every tile of every record (a tile the
-// capture did not flag leaves at once), and `fused_listed`, one workgroup per tile in the
-// capture's tile list, dispatched indirectly (seal.wgsl writes the arguments).
+// order the workgroups run in.
+// Snowfall: a record marked MODE_REFILLED was refilled over its whole region by refill.wgsl
+// before this pass, so here it replenishes nothing and changes only where the capture reached
+// (deepening a refilled texel equals merging with the refill: accumulate::cpu::refill_word);
+// any other record that refills snow has every tile refilled here.
+// Two entry points share that work: `fused`, a grid over every tile of the first records (a tile
+// with nothing to deepen or refill leaves at once), and `fused_listed`, one workgroup per tile in
+// the capture's tile list for the records whose every tile the grid does not take (a record
+// refilled here and not by refill.wgsl), dispatched indirectly (seal.wgsl writes the arguments).
 // Reads: `records`, `tiles`, `tile_list`, `capture`, `winding`, each record's heights in `pool`.
 // Writes: the same heights regions.
 // CPU reference: accumulate::cpu::blur then merge_channels. Maths: maths.wgsl, capture_read.wgsl.
@@ -38,15 +41,18 @@ fn fused(
     if i32(wid.x) * SIDE >= i32(rec.width) || i32(wid.y) * SIDE >= i32(rec.height) {
         return;
     }
-    // Nothing to deepen: the tile stays as it is (uniform per workgroup, before any barrier).
-    if rec.batch == NO_CAPTURE {
+    var has_capture = rec.batch != NO_CAPTURE;
+    if has_capture {
+        let tiles_x = (rec.width + u32(SIDE) - 1u) / u32(SIDE);
+        has_capture = tiles[rec.tiles + wid.y * tiles_x + wid.x] != 0u;
+    }
+    // Nothing to deepen and nothing to refill: the tile stays as it is (uniform per workgroup,
+    // before any barrier).
+    let rep = replenished(rec);
+    if !has_capture && rep == 0u {
         return;
     }
-    let tiles_x = (rec.width + u32(SIDE) - 1u) / u32(SIDE);
-    if tiles[rec.tiles + wid.y * tiles_x + wid.x] == 0u {
-        return;
-    }
-    update_tile(rec, wid.xy, lid, local.xy);
+    update_tile(rec, wid.xy, has_capture, rep, lid, local.xy);
 }
 
 @compute @workgroup_size(TILE, TILE, 1)
@@ -60,25 +66,40 @@ fn fused_listed(
         return;
     }
     let rec = records[tile_list[4u + 2u * i]];
+    // A record refilled here has all its tiles updated by `fused`.
+    let rep = replenished(rec);
+    if rep != 0u {
+        return;
+    }
     let t = tile_list[5u + 2u * i];
-    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), lid, local.xy);
+    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, 0u, lid, local.xy);
 }
 
-// Blur and merge one tile of a surface, in place. Called from uniform control flow.
-fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, lid: u32, local: vec2<u32>) {
+// Units this pass replenishes a record by: none where refill.wgsl refilled it.
+fn replenished(rec: SurfaceRecord) -> u32 {
+    return select(rec.replenish_units, 0u, (rec.mode & MODE_REFILLED) != 0u);
+}
+
+// Blur and merge one tile of a surface, replenished by `rep` units, in place. Called from uniform
+// control flow.
+fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, rep: u32, lid: u32, local: vec2<u32>) {
     let tile = vec2<i32>(tile_id) * SIDE;
     let dep_origin = tile - vec2<i32>(1);
-    for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
-        depressions[k] = depression(rec, dep_origin.x + k % DEP, dep_origin.y + k / DEP);
+    if has_capture {
+        for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
+            depressions[k] = depression(rec, dep_origin.x + k % DEP, dep_origin.y + k / DEP);
+        }
     }
     workgroupBarrier();
-    // Texel (local.x, local.y) of the tile sits at (local + 1) in the depression tile.
-    let i = (i32(local.y) + 1) * DEP + i32(local.x) + 1;
-    blurred[lid] = blur_taps(
-        depressions[i - DEP - 1], depressions[i - DEP], depressions[i - DEP + 1],
-        depressions[i - 1], depressions[i], depressions[i + 1],
-        depressions[i + DEP - 1], depressions[i + DEP], depressions[i + DEP + 1],
-    );
+    if has_capture {
+        // Texel (local.x, local.y) of the tile sits at (local + 1) in the depression tile.
+        let i = (i32(local.y) + 1) * DEP + i32(local.x) + 1;
+        blurred[lid] = blur_taps(
+            depressions[i - DEP - 1], depressions[i - DEP], depressions[i - DEP + 1],
+            depressions[i - 1], depressions[i], depressions[i + 1],
+            depressions[i + DEP - 1], depressions[i + DEP], depressions[i + DEP + 1],
+        );
+    }
     workgroupBarrier();
     let per = unit_texels(PRECISION);
     let units = u32(SIDE * SIDE) / per;
@@ -94,16 +115,16 @@ fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, lid: u32, local: vec2<u32
     if x >= rec.width || y >= rec.height {
         return;
     }
-    let a = merged(rec, x, y, blurred[uy * u32(SIDE) + ux]);
+    let a = merged(rec, has_capture, rep, x, y, blurred[uy * u32(SIDE) + ux]);
     var b = vec2<u32>(0u);
     if per == 2u && x + 1u < rec.width {
-        b = merged(rec, x + 1u, y, blurred[uy * u32(SIDE) + ux + 1u]);
+        b = merged(rec, has_capture, rep, x + 1u, y, blurred[uy * u32(SIDE) + ux + 1u]);
     }
     pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y, a, b);
 }
 
-// A texel deepened by its blurred capture `b` (already refilled by refill.wgsl).
-fn merged(rec: SurfaceRecord, x: u32, y: u32, b: f32) -> vec2<u32> {
+// A texel replenished by `rep` units, then deepened by its blurred capture `b` when it has one.
+fn merged(rec: SurfaceRecord, has_capture: bool, rep: u32, x: u32, y: u32, b: f32) -> vec2<u32> {
     let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y);
-    return merge_channels(old, b, true, 0u);
+    return merge_channels(old, b, has_capture, rep);
 }

@@ -8,9 +8,9 @@
 //! 3. [`normals.wgsl`](NORMALS_SHADER), only when the pool keeps normals: normals of the new snow
 //!    top (reads the heights, writes the normals region).
 //!
-//! On GPUs, [`refill.wgsl`](REFILL_SHADER) streams the replenishment over the regions of the
-//! surfaces that refill snow, then [`fused.wgsl`](FUSED_SHADER) does stages 1 and 2 in one pass
-//! over the tiles the capture reached. Every pass reads and
+//! On GPUs, [`fused.wgsl`](FUSED_SHADER) does stages 1 and 2 in one pass; when many words of
+//! heights refill snow, [`refill.wgsl`](REFILL_SHADER) streams their replenishment first and the
+//! fused pass visits only the tiles the capture reached. Every pass reads and
 //! writes heights through `pool/texel.wgsl`, at the pool's [`Precision`] (an override constant).
 //!
 //! CPU reference: [`cpu`].
@@ -44,9 +44,10 @@ pub struct AccumulatePipelines {
     pub normals: wgpu::ComputePipeline,
     /// Replenishment of whole heights regions, before the fused pass.
     pub refill: wgpu::ComputePipeline,
-    /// Blur and merge fused, over every tile of every record (unflagged tiles leave at once).
+    /// Blur and merge fused, over every tile of the first records (tiles with nothing to deepen or
+    /// refill leave at once).
     pub fused: wgpu::ComputePipeline,
-    /// Blur and merge fused, over the capture's listed tiles.
+    /// Blur and merge fused, over the capture's listed tiles of the records the grid leaves.
     pub fused_listed: wgpu::ComputePipeline,
     /// Writes the listed pass's indirect dispatch.
     pub seal: wgpu::ComputePipeline,

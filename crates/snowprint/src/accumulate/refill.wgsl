@@ -9,9 +9,10 @@
 // changed (untouched snow stays as it is).
 // The fused pass (fused.wgsl) then merges the blurred capture into the refilled words with no
 // replenishment of its own: replenishing by r and then deepening equals merge_channels(old,
-// blurred, r) (CPU reference: accumulate::cpu::refill_word).
-// Reads: `records` (the first records of the frame's update, those that refill; `z` of the
-// dispatch), their heights regions in `pool`. Writes: the same regions.
+// blurred, r) (CPU reference: accumulate::cpu::refill_word). The world streams the refill only
+// over many words (WorldConfig::refill_stream_from): it costs a few microseconds more in all.
+// Reads: `records` (the first records of the frame's update, those marked MODE_REFILLED; `z` of
+// the dispatch), their heights regions in `pool`. Writes: the same regions.
 
 // import shared
 
@@ -59,7 +60,7 @@ fn refill(
     let n = region_words(rec);
     let chunk = wid.x + wid.y * groups.x;
     let first = chunk * REFILL_GROUP * REFILL_WORDS;
-    if first >= n || rec.replenish_units == 0u {
+    if first >= n || (rec.mode & MODE_REFILLED) == 0u {
         return;
     }
     var words: array<u32, REFILL_WORDS>;

@@ -245,7 +245,8 @@ pub struct SurfaceRecord {
     pub atlas_x: u32,
     /// Capture atlas y of the surface's capture region.
     pub atlas_y: u32,
-    /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`]; bit 2: [`MODE_GROUND`].
+    /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`]; bit 2: [`MODE_GROUND`]; bit 3:
+    /// [`MODE_REFILLED`].
     pub mode: u32,
     /// Depression units refilled this update.
     pub replenish_units: u32,
@@ -312,6 +313,9 @@ pub const MODE_MESHES: u32 = crate::wgsl::consts::MODE_MESHES;
 /// its capture and winding regions are then twice its texels, the winding's second half holding
 /// the capture code of the ground at each texel (what a texel inside a solid is pressed to).
 pub const MODE_GROUND: u32 = crate::wgsl::consts::MODE_GROUND;
+/// Bit of [`SurfaceRecord::mode`] set when the update's refill pass replenishes the surface over
+/// its whole heights region (accumulate/refill.wgsl): the fused pass then replenishes nothing.
+pub const MODE_REFILLED: u32 = crate::wgsl::consts::MODE_REFILLED;
 /// `normals` of a record in a pool that keeps no normals.
 pub const NO_NORMALS: u32 = crate::wgsl::consts::NO_NORMALS;
 

@@ -35,6 +35,9 @@ const MODE_MASK: u32 = 1u;
 const MODE_MESHES: u32 = 2u;
 // Mode bit of a surface record: meshes press a surface on ground that is not flat (pool/mod.rs).
 const MODE_GROUND: u32 = 4u;
+// Mode bit of a surface record: its snowfall is refilled by the streaming refill pass this update,
+// so the fused pass replenishes nothing and updates only the tiles the capture reached.
+const MODE_REFILLED: u32 = 8u;
 // Primitive kind of a capture primitive (`kind.x`): a capsule (a sphere is a capsule of zero length).
 const PRIM_CAPSULE: u32 = 0u;
 // Primitive kind of a capture primitive: an oriented box.

@@ -30,6 +30,14 @@ pub struct WorldConfig {
     /// nanosecond: default 16384 (sixteen 512^2 surfaces), from the H100 figures in
     /// `docs/PERFORMANCE.md`. 0 always lists; `u32::MAX` never does.
     pub list_tiles_from: u32,
+    /// With [`PassMode::Fused`], the fewest words of heights (4 bytes each) of the surfaces that
+    /// refill snow in one update from which their snowfall is refilled by a pass of its own
+    /// streaming whole regions (then the fused pass visits only the tiles the capture reached);
+    /// below it, the fused pass refills every tile of theirs itself. The refill pass moves bytes
+    /// at about a copy's rate but costs a few microseconds more in all: default 8 Mi words (32
+    /// MiB, a hundred and twenty-eight 512^2 surfaces at 16 bits), from the H100 figures in
+    /// `docs/PERFORMANCE.md`. 0 always streams; `u32::MAX` never does.
+    pub refill_stream_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
     /// Which path captures analytic deformers: `Compute` ray-casts them in one dispatch for every
@@ -66,6 +74,7 @@ impl Default for WorldConfig {
             max_resolution: crate::surface::MAX_RESOLUTION,
             passes: PassMode::Auto,
             list_tiles_from: 16384,
+            refill_stream_from: 1 << 23,
             format: PoolFormat::default(),
             capture_path: CapturePath::Auto,
             spray: None,

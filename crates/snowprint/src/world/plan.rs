@@ -23,8 +23,8 @@ use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::pool::{
-    MODE_GROUND, MODE_MESHES, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord, TILE_LIST_HEADER,
-    TILE_SIDE,
+    MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord,
+    TILE_LIST_HEADER, TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
@@ -43,6 +43,8 @@ pub struct PlanSettings {
     pub passes: PassMode,
     /// See [`WorldConfig::list_tiles_from`].
     pub list_tiles_from: u32,
+    /// See [`WorldConfig::refill_stream_from`].
+    pub refill_stream_from: u32,
     /// Largest side of the capture atlas, texels.
     pub atlas_side: u32,
     /// Which path captures analytic deformers.
@@ -57,6 +59,7 @@ impl PlanSettings {
             format: config.format,
             passes: config.passes,
             list_tiles_from: config.list_tiles_from,
+            refill_stream_from: config.refill_stream_from,
             atlas_side: config.atlas_side,
             capture_path: config.capture_path,
         }
@@ -512,40 +515,49 @@ impl FramePlan {
             .iter()
             .take_while(|j| j.record.replenish_units > 0)
             .count();
-        let captured_tiles: u64 = self
-            .jobs
+        let fused = settings.fused();
+        let words = |j: &Job| {
+            settings
+                .format
+                .heights_bytes(j.record.width, j.record.height)
+                / 4
+        };
+        let refill_words: u64 = self.jobs[..dense].iter().map(words).sum();
+        // Snowfall over many words is refilled by the streaming pass (the records so marked);
+        // over few, by the fused pass's grid over every tile of the refilling records.
+        let stream = fused && dense > 0 && refill_words >= settings.refill_stream_from as u64;
+        let tiled = if stream { 0 } else { dense };
+        // The fused pass visits the other records' tiles only where the capture reached.
+        let flagged: u64 = self.jobs[tiled..]
             .iter()
             .filter(|j| j.surface.captured)
             .map(|j| j.record.tile_count() as u64)
             .sum();
-        let fused = settings.fused();
-        let listed =
-            fused && captured_tiles > 0 && captured_tiles >= settings.list_tiles_from as u64;
+        let listed = fused && flagged > 0 && flagged >= settings.list_tiles_from as u64;
         let a = &mut self.accumulate;
         a.fused = fused;
         a.normals = settings.format.normals;
         a.unit_texels = settings.format.precision.unit_texels();
-        // The fused pass replenishes nothing: the refill does, over the first `dense` records.
-        a.refill = if fused { dense as u32 } else { 0 };
+        a.refill = if stream { dense as u32 } else { 0 };
         a.refill_words = self.jobs[..a.refill as usize]
             .iter()
-            .map(|j| {
-                (settings
-                    .format
-                    .heights_bytes(j.record.width, j.record.height)
-                    / 4) as u32
-            })
+            .map(|j| words(j) as u32)
             .max()
             .unwrap_or(0);
         a.listed = listed;
-        // Without the list, the grid covers every record; with it, none.
-        a.grid = if listed { 0 } else { self.jobs.len() as u32 };
+        // Without the list, the grid covers every record; with it, the records whose every tile
+        // it refills.
+        a.grid = if listed { tiled } else { self.jobs.len() } as u32;
         a.max_width = self.jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         a.max_height = self.jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
         let c = &mut self.capture;
         for (j, job) in self.jobs.iter().enumerate() {
             self.surfaces.push(job.surface);
-            a.records.push(job.record);
+            let mut record = job.record;
+            if j < a.refill as usize {
+                record.mode |= MODE_REFILLED;
+            }
+            a.records.push(record);
             if !job.surface.captured {
                 continue;
             }

@@ -323,16 +323,29 @@ fn surfaces_that_refill_come_first_and_the_rest_are_listed() {
     assert_eq!(order, vec![1, 0, 2]);
     let a = &plan.accumulate;
     assert!(a.fused && a.listed);
-    // The refilling surface is refilled over its whole region by the refill pass; with the list,
-    // the fused pass needs no grid.
-    assert_eq!(a.grid, 0);
-    assert_eq!(a.refill, 1);
+    // A few words of snowfall: the fused pass's grid refills the refilling surface's every tile.
+    assert_eq!((a.grid, a.refill), (1, 0));
+    assert_eq!(a.records[0].mode & MODE_REFILLED, 0);
+    assert_eq!(plan.capture.views[0].record, 1);
+    // Streamed from 0 words: the refill pass takes that surface's whole region, marked so, and
+    // the list every surface's tiles, so the fused pass needs no grid.
+    s.refill_stream_from = 0;
+    let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
+    let a = &plan.accumulate;
+    assert!(a.listed);
+    assert_eq!((a.grid, a.refill), (0, 1));
     let r = &a.records[0];
+    assert_eq!(r.mode & MODE_REFILLED, MODE_REFILLED);
+    assert!(a.records[1..].iter().all(|r| r.mode & MODE_REFILLED == 0));
     assert_eq!(
         a.refill_words as u64,
         s.format.heights_bytes(r.width, r.height) / 4
     );
-    assert_eq!(plan.capture.views[0].record, 1);
+    // Just above the surface's words, the fused pass refills it again.
+    s.refill_stream_from = a.refill_words + 1;
+    let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
+    assert_eq!((plan.accumulate.grid, plan.accumulate.refill), (1, 0));
+    s.refill_stream_from = 0;
     // Never listing: the grid covers every record and the views say so.
     s.list_tiles_from = u32::MAX;
     let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
