@@ -188,8 +188,8 @@ pub fn encode_update(
     }
 }
 
-/// Workgroups of the refill over a region of `words`: `REFILL_GROUP x REFILL_WORDS` words each
-/// (refill.wgsl), in rows of at most 65535.
+/// Workgroups of the refill over a region of `words`: [`REFILL_CHUNK`] words each (refill.wgsl),
+/// in rows of at most 65535.
 fn refill_groups(words: u32) -> (u32, u32) {
     let groups = words.div_ceil(REFILL_CHUNK).max(1);
     let rows = groups.div_ceil(u16::MAX as u32);

@@ -32,7 +32,11 @@ pub const WORKGROUP: u32 = crate::wgsl::consts::WORKGROUP;
 pub const FUSED_WORKGROUP: u32 = crate::pool::TILE_SIDE;
 
 /// Words of a heights region one workgroup of the refill takes (refill.wgsl).
-pub const REFILL_CHUNK: u32 = crate::wgsl::consts::REFILL_GROUP * crate::wgsl::consts::REFILL_WORDS;
+pub const REFILL_CHUNK: u32 =
+    crate::wgsl::consts::REFILL_GROUP * crate::wgsl::consts::REFILL_VECTORS * 4;
+
+// The refill reads and writes 16-byte vectors from each slot's start to the end of its last one.
+const _: () = assert!(crate::pool::SLOT_ALIGN % 16 == 0);
 
 /// The three compute pipelines and their layouts.
 pub struct AccumulatePipelines {

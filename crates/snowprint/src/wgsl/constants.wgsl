@@ -15,8 +15,9 @@ const APRON: u32 = 1u;
 const WORKGROUP: u32 = 8u;
 // Invocations of a workgroup of the refill (accumulate/refill.wgsl).
 const REFILL_GROUP: u32 = 256u;
-// Words of a heights region each invocation of the refill takes, all loaded before any is stored.
-const REFILL_WORDS: u32 = 8u;
+// 16-byte vectors of a heights region each invocation of the refill takes, all loaded before any
+// is stored.
+const REFILL_VECTORS: u32 = 4u;
 // Words before the entries of the capture's tile list: the dispatch arguments and the count.
 const TILE_LIST_HEADER: u32 = 4u;
 // `record` of a capture view whose flagged tiles are not listed (the update runs its grid).
