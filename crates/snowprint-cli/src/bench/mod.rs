@@ -9,7 +9,7 @@ use glam::Vec3;
 use serde::Serialize;
 use snowprint::{
     CapturePath, Deformer, GpuContext, GpuOptions, PassMode, PoolFormat, Pose, Precision, Shape,
-    SnowWorld, StageTimes, SurfaceDesc, SurfaceUpdate, WorldConfig,
+    SnowWorld, StageTimes, SurfaceDesc, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
 };
 
 mod baseline;
@@ -53,9 +53,13 @@ pub struct Row {
     pub fused: bool,
     /// Bits a channel of the pool.
     pub precision_bits: u32,
-    /// Snow refilling fast enough that every texel changes every frame, so no tile is skipped
-    /// (else only the tiles the deformers reach are updated).
+    /// Snow refilling (30 % of the depth a second, at least a unit a frame), so every texel is
+    /// read every frame (else only the tiles the deformers reach are updated). A texel of
+    /// untouched snow stays as it is and is not written back.
     pub snowing: bool,
+    /// Every texel starts pressed to the ground, so that with snow falling every texel changes and
+    /// is written every frame: the update's worst case, byte for byte what a copy moves.
+    pub pressed: bool,
     /// Median GPU time of the whole update, microseconds (or whole frames timed on the CPU).
     pub update_us: f64,
     /// Median GPU time per stage, microseconds.
@@ -132,6 +136,24 @@ fn deformers_over(center: Vec3, side: f32, count: u32, frame: u32) -> Vec<Deform
     out
 }
 
+/// A surface whose every texel is pressed to the ground (nothing displaced): 200 frames of the
+/// bench's snowfall from untouched.
+fn pressed(desc: SurfaceDesc, format: PoolFormat, side: u32) -> Result<SurfaceSnapshot, String> {
+    let texels = (side * side) as usize;
+    let max = format.precision.channel_max();
+    let words = format
+        .encode(side, side, &vec![max; texels], &vec![0; texels])
+        .map_err(|e| e.to_string())?;
+    Ok(SurfaceSnapshot {
+        desc,
+        width: side,
+        height: side,
+        format,
+        carry: 0.0,
+        words,
+    })
+}
+
 struct Config {
     sweep: &'static str,
     surfaces: u32,
@@ -140,6 +162,7 @@ struct Config {
     passes: PassMode,
     precision: Precision,
     snowing: bool,
+    pressed: bool,
     capture: CapturePath,
 }
 
@@ -169,13 +192,17 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             0.0,
             (i / 64) as f32 * (side + 1.0),
         );
-        let id = world
-            .add_surface(SurfaceDesc {
-                // 30% of the depth a second: at least one unit a frame at 60 Hz even at 8 bits.
-                replenish_rate: if c.snowing { 0.3 } else { 0.0 },
-                ..SurfaceDesc::new(&format!("s{i}"), center.into(), [side, side], 0.3)
-            })
-            .map_err(|e| e.to_string())?;
+        let desc = SurfaceDesc {
+            // 30% of the depth a second: at least one unit a frame at 60 Hz even at 8 bits.
+            replenish_rate: if c.snowing { 0.3 } else { 0.0 },
+            ..SurfaceDesc::new(&format!("s{i}"), center.into(), [side, side], 0.3)
+        };
+        let id = if c.pressed {
+            world.restore_surface(&pressed(desc, format, c.resolution)?, None)
+        } else {
+            world.add_surface(desc)
+        }
+        .map_err(|e| e.to_string())?;
         ids.push(id);
         centers.push(center);
     }
@@ -276,6 +303,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         fused: world.config().passes == PassMode::Fused,
         precision_bits: c.precision.bits(),
         snowing: c.snowing,
+        pressed: c.pressed,
         update_us,
         stages_us: timestamps.then(|| StageTimesUs {
             capture: median(&mut cap),
@@ -377,6 +405,7 @@ fn configs(quick: bool) -> Vec<Config> {
         passes,
         precision: Precision::Bits16,
         snowing: false,
+        pressed: false,
         capture: CapturePath::Auto,
     };
     let at = |precision, c: Config| Config { precision, ..c };
@@ -400,7 +429,7 @@ fn configs(quick: bool) -> Vec<Config> {
             &[1, 10, 100, 1000],
         )
     };
-    // The sweeps keep snow falling so that every texel is updated, as the copy baseline is.
+    // The sweeps keep snow falling so that every texel is read, as the copy baseline reads it.
     configs.extend(
         counts
             .iter()
@@ -437,6 +466,13 @@ fn configs(quick: bool) -> Vec<Config> {
             Precision::Bits8,
             cfg("many_512", 1024, 512, 1, fused),
         )));
+        // The same with every texel pressed: every word changes and is written every frame.
+        let pressed = |c: Config| Config { pressed: true, ..c };
+        configs.push(pressed(snowing(cfg("many_512", 1024, 512, 1, fused))));
+        configs.push(pressed(snowing(at(
+            Precision::Bits8,
+            cfg("many_512", 1024, 512, 1, fused),
+        ))));
     }
     configs
 }
@@ -482,7 +518,11 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
             r.sweep,
             if r.fused { "fused" } else { "split" },
             r.precision_bits,
-            if r.snowing { "yes" } else { "no" },
+            match (r.snowing, r.pressed) {
+                (false, _) => "no",
+                (true, false) => "yes",
+                (true, true) => "all",
+            },
             r.surfaces,
             r.resolution,
             r.deformers_per_surface,
