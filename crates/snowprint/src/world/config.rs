@@ -34,9 +34,9 @@ pub struct WorldConfig {
     /// refill snow in one update from which their snowfall is refilled by a pass of its own
     /// streaming whole regions (then the fused pass visits only the tiles the capture reached);
     /// below it, the fused pass refills every tile of theirs itself. The refill pass moves bytes
-    /// at about a copy's rate but costs a few microseconds more in all: default 8 Mi words (32
-    /// MiB, a hundred and twenty-eight 512^2 surfaces at 16 bits), from the H100 figures in
-    /// `docs/PERFORMANCE.md`. 0 always streams; `u32::MAX` never does.
+    /// faster than a copy (it writes back only what changed) but costs a few microseconds more in
+    /// all: default 2 Mi words (8 MiB, thirty-two 512^2 surfaces at 16 bits), where the two ways
+    /// cost the same on the H100 (`docs/PERFORMANCE.md`). 0 always streams; `u32::MAX` never does.
     pub refill_stream_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
@@ -74,7 +74,7 @@ impl Default for WorldConfig {
             max_resolution: crate::surface::MAX_RESOLUTION,
             passes: PassMode::Auto,
             list_tiles_from: 16384,
-            refill_stream_from: 1 << 23,
+            refill_stream_from: 1 << 21,
             format: PoolFormat::default(),
             capture_path: CapturePath::Auto,
             spray: None,
