@@ -264,8 +264,11 @@ fn a_saved_walk_goes_on_alike_and_brings_back_the_trail_paged_out() {
     }
 }
 
+/// A save's sections as `(tag, data)`.
+type Sections = Vec<([u8; 4], Vec<u8>)>;
+
 /// The sections of a save as `(tag, data)`.
-fn sections(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
+fn sections(bytes: &[u8]) -> Sections {
     SaveFile::parse(bytes)
         .expect("parse")
         .sections
@@ -321,7 +324,7 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
         s[k].1.truncate(len);
         s
     };
-    let cases: Vec<(Vec<([u8; 4], Vec<u8>)>, &str)> = vec![
+    let cases: Vec<(Sections, &str)> = vec![
         (edit(at - 4, &3u32.to_le_bytes()), "3 levels saved"),
         (
             edit(at + 24, &2.0f64.to_le_bytes()),

@@ -454,7 +454,9 @@ impl Terrain {
             if !wait && !f.read.is_ready() {
                 break;
             }
-            let f = self.in_flight.pop_front().expect("checked above");
+            let Some(f) = self.in_flight.pop_front() else {
+                break;
+            };
             let (pairs, written) = f.read.wait(world.device())?;
             if f.fold {
                 self.stats.bytes_folded += written;

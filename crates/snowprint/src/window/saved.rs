@@ -30,37 +30,45 @@ pub(crate) struct LevelState<'a> {
 }
 
 /// A page of a terrain's store as saved: `(level, chunk column, chunk row)` and its LZ4 bytes.
-pub(crate) type PageState = ((usize, i64, i64), Vec<u8>);
+pub(crate) type PageState = (super::store::PageKey, Vec<u8>);
+
+/// What a save keeps of a terrain besides its description and its levels' words.
+pub(crate) struct WindowState {
+    /// Each level's window origin, finest first.
+    pub(crate) origins: Vec<[i64; 2]>,
+    /// The scroll statistics (the store's own counts left out: they come back with the store).
+    pub(crate) stats: ScrollStats,
+    /// Pool bytes of the last scroll whose readback arrived.
+    pub(crate) last_written: u64,
+    /// Every page of the store, in key order.
+    pub(crate) pages: Vec<PageState>,
+}
 
 impl Terrain {
-    /// What a save keeps of the terrain besides its levels' words: each level's origin, the
-    /// scroll statistics (the store's own counts left out: they come back with the store), the
-    /// bytes of the last scroll and every page, in key order. Refused while a scroll or fold is
-    /// still on its way (call [`Terrain::flush`] first).
-    pub(crate) fn saved_state(&self) -> Result<(Vec<[i64; 2]>, ScrollStats, u64, Vec<PageState>)> {
+    /// What a save keeps of the terrain besides its levels' words (see [`WindowState`]).
+    /// Refused while a scroll or fold is still on its way (call [`Terrain::flush`] first).
+    pub(crate) fn saved_state(&self) -> Result<WindowState> {
         if !self.in_flight.is_empty() {
             return Err(SnowError::SaveContent(format!(
                 "terrain {:?} has strips on their way from the GPU: flush it before saving",
                 self.desc.name
             )));
         }
-        let stats = ScrollStats {
-            store_bytes: 0,
-            store_chunks: 0,
-            ..self.stats
-        };
-        let pages = self
-            .store
-            .pages()
-            .into_iter()
-            .map(|(k, b)| (k, b.to_vec()))
-            .collect();
-        Ok((
-            self.levels.iter().map(|l| l.origin).collect(),
-            stats,
-            self.last_written,
-            pages,
-        ))
+        Ok(WindowState {
+            origins: self.levels.iter().map(|l| l.origin).collect(),
+            stats: ScrollStats {
+                store_bytes: 0,
+                store_chunks: 0,
+                ..self.stats
+            },
+            last_written: self.last_written,
+            pages: self
+                .store
+                .pages()
+                .into_iter()
+                .map(|(k, b)| (k, b.to_vec()))
+                .collect(),
+        })
     }
 
     /// Add a saved terrain's levels to `world` as they were: each at its slot, its window at

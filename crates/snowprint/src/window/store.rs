@@ -36,10 +36,13 @@ impl ChunkPage {
     }
 }
 
+/// Where a page lies: (level, chunk column, chunk row).
+pub(crate) type PageKey = (usize, i64, i64);
+
 /// Pages of every level of a terrain, by (level, chunk column, chunk row).
 #[derive(Clone, Debug, Default)]
 pub struct StripStore {
-    pages: HashMap<(usize, i64, i64), ChunkPage>,
+    pages: HashMap<PageKey, ChunkPage>,
     bytes: u64,
 }
 
@@ -100,7 +103,7 @@ impl StripStore {
 
     /// Every page with its compressed bytes, by (level, chunk column, chunk row) in order (what a
     /// save keeps: the same store gives the same bytes).
-    pub(crate) fn pages(&self) -> Vec<((usize, i64, i64), &[u8])> {
+    pub(crate) fn pages(&self) -> Vec<(PageKey, &[u8])> {
         let mut pages: Vec<_> = self
             .pages
             .iter()

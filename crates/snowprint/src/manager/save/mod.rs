@@ -36,7 +36,7 @@ mod write;
 pub(crate) const MAGIC: [u8; 8] = *b"SNOWSAVE";
 /// The format version this build writes and the newest it reads.
 pub(crate) const VERSION: u32 = 3;
-/// Most sections a save may have (a section per surface, plus three).
+/// Most sections a save may have (a section per surface and per terrain, plus three).
 pub(crate) const MAX_SECTIONS: u32 = 1 << 20;
 /// Most bytes a section may expand to (a 512^2 surface at 32 bits with normals is 3 MiB; the
 /// JSON sections of a city of 10,000 surfaces with long queues stay far below).

@@ -103,25 +103,7 @@ impl SaveFile {
             });
         }
         r.done("the file")?;
-        let tags: Vec<&[u8; 4]> = sections.iter().map(|s| &s.tag).collect();
-        let heightmaps = 3 + tags[3..].iter().take_while(|t| **t == b"SURF").count();
-        let ground_end = heightmaps
-            + tags[heightmaps..]
-                .iter()
-                .take_while(|t| **t == b"GRND")
-                .count();
-        if tags[0] != b"CONF"
-            || tags[1] != b"PLAN"
-            || tags[2] != b"MESH"
-            || tags[ground_end..].iter().any(|t| *t != b"TERR")
-            || (version < 2 && heightmaps < tags.len())
-            || (version < 3 && ground_end < tags.len())
-        {
-            return Err(
-                "its sections are not CONF, PLAN, MESH, SURF, (from version 2) GRND and (from version 3) TERR in that order"
-                    .into(),
-            );
-        }
+        let (heightmaps, ground_end) = section_order(&sections, version)?;
         let saved: SavedConfig = serde_json::from_slice(&sections[0].data)
             .map_err(|e| format!("its settings (CONF) do not read: {e}"))?;
         let config = saved
@@ -201,6 +183,32 @@ impl SaveFile {
     pub fn mesh_count(&self) -> usize {
         self.meshes.managed.len()
     }
+}
+
+/// Where the heightmaps end and the grounds end among the sections, once their order is checked:
+/// `CONF, PLAN, MESH, SURF..., GRND..., TERR...`, `GRND` from version 2, `TERR` from 3.
+fn section_order(
+    sections: &[Section],
+    version: u32,
+) -> std::result::Result<(usize, usize), String> {
+    let tags: Vec<&[u8; 4]> = sections.iter().map(|s| &s.tag).collect();
+    let run =
+        |from: usize, tag: &[u8; 4]| from + tags[from..].iter().take_while(|t| **t == tag).count();
+    let heightmaps = run(3, b"SURF");
+    let ground_end = run(heightmaps, b"GRND");
+    if tags[0] != b"CONF"
+        || tags[1] != b"PLAN"
+        || tags[2] != b"MESH"
+        || tags[ground_end..].iter().any(|t| *t != b"TERR")
+        || (version < 2 && heightmaps < tags.len())
+        || (version < 3 && ground_end < tags.len())
+    {
+        return Err(
+            "its sections are not CONF, PLAN, MESH, SURF, (from version 2) GRND and (from version 3) TERR in that order"
+                .into(),
+        );
+    }
+    Ok((heightmaps, ground_end))
 }
 
 pub(super) fn read_meshes(data: &[u8]) -> std::result::Result<SavedMeshes, String> {

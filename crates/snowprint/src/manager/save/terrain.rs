@@ -21,13 +21,17 @@ use crate::manager::ManagerConfig;
 use crate::manager::planner::PlannerState;
 use crate::material::Material;
 use crate::pool::SlotAllocator;
-use crate::window::saved::PageState;
+use crate::window::saved::{PageState, WindowState};
 use crate::window::store::check_page;
 use crate::window::{LevelDesc, ScrollStats, Terrain, TerrainDesc, TerrainGround};
 
 /// Most chunks away from the world's origin a saved page may lie (a window is at most 10,000 km
 /// from it, chunks at least 64 texels of 1 mm).
 const MAX_CHUNK: i64 = 1 << 40;
+
+/// Handles a save holds: a terrain's handle is below this (a loaded manager keeps a place for
+/// every handle up to the last, as the saved one did).
+pub(super) const MAX_HANDLES: u32 = 1 << 16;
 
 /// One level of a [`SavedTerrain`].
 #[derive(Clone, Debug, PartialEq)]
@@ -68,7 +72,18 @@ pub(super) fn put_terrain(
     terrain: &Terrain,
     levels: &[(u64, f64, &[u32])],
 ) -> crate::error::Result<Vec<u8>> {
-    let (origins, stats, last_written, pages) = terrain.saved_state()?;
+    if index >= MAX_HANDLES {
+        return Err(crate::error::SnowError::SaveContent(format!(
+            "terrain {:?}'s handle {index} is past the {MAX_HANDLES} terrains a save holds: nothing was written",
+            terrain.desc().name
+        )));
+    }
+    let WindowState {
+        origins,
+        stats,
+        last_written,
+        pages,
+    } = terrain.saved_state()?;
     let d = terrain.desc();
     let head = SavedDesc {
         name: d.name.clone(),
@@ -136,6 +151,11 @@ pub(super) fn read_terrain(
 ) -> std::result::Result<SavedTerrain, String> {
     let mut r = Reader::new(data);
     let index = r.u32("its handle")?;
+    if index >= MAX_HANDLES {
+        return Err(format!(
+            "its handle {index} is past the {MAX_HANDLES} terrains a save holds"
+        ));
+    }
     let n = r.count(1, "its description")?;
     let head: SavedDesc = serde_json::from_slice(r.take(n, "its description")?)
         .map_err(|e| format!("its description does not read: {e}"))?;
