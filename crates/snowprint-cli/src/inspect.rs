@@ -76,5 +76,27 @@ pub fn run(args: &Args) -> Result<(), String> {
             .map_or(String::new(), |v| format!(", {v:.1} texel-depths pressed"));
         println!("    {name:<24} {holds:<9} {queued} imprints queued{pressed}");
     }
+    if !save.terrains.is_empty() {
+        println!("  terrains: {}", save.terrains.len());
+    }
+    for t in &save.terrains {
+        let windows: Vec<String> = t
+            .origins()
+            .iter()
+            .zip(&t.desc.levels)
+            .map(|(o, l)| {
+                format!(
+                    "{} x {} of {} m at texel ({}, {})",
+                    l.texels[0], l.texels[1], l.texel_size, o[0], o[1]
+                )
+            })
+            .collect();
+        println!(
+            "    {:<24} levels {}; {} chunks paged out",
+            t.desc.name,
+            windows.join(", "),
+            t.chunks()
+        );
+    }
     Ok(())
 }

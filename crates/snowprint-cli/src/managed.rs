@@ -179,7 +179,12 @@ pub fn simulate(
     let (mut snow, ids) = start(&ctx, scene, config, persist.load.as_deref())?;
     // Frames continue from the save's clock.
     let first = snow.planner().next_frame();
-    let windows = crate::terrain::ManagedWindows::new(&mut snow, scene, first as f32 * dt)?;
+    let windows = crate::terrain::ManagedWindows::new(
+        &mut snow,
+        scene,
+        first as f32 * dt,
+        persist.load.as_deref(),
+    )?;
     // An animated mesh is posed each frame before the tick (on the CPU, so that a surface the
     // budget leaves waiting is pressed later with each frame's own pose); a save keeps a mesh's
     // last posing, and its skeleton is given back here.

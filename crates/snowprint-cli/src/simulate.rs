@@ -57,15 +57,6 @@ pub fn run(gpu: &GpuOptions, args: &Args) -> Result<(), String> {
             camera.line
         );
     }
-    if (args.save.is_some() || args.load.is_some())
-        && let Some(t) = scene.terrains.first()
-    {
-        return Err(format!(
-            "{}:{}: a save does not hold [[terrain]] windows yet; remove --save and --load, or the terrain",
-            scene.path.display(),
-            t.line
-        ));
-    }
     let outputs = Outputs::prepare(&scene, &args.dump, args.report.as_deref())?;
     if let Some(save) = &args.save {
         crate::output::check_file_target(save, "--save")?;

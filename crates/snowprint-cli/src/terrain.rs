@@ -3,6 +3,8 @@
 //! `.json` beside the surfaces; in a plain world ([`Windows`]) or run by the surface manager
 //! ([`ManagedWindows`]: its pool and budget).
 
+use std::path::Path;
+
 use snowprint::manager::{ManagedTerrainId, SnowManager};
 use snowprint::scene::{Scene, SceneTerrain};
 use snowprint::{SnowWorld, Terrain};
@@ -90,14 +92,62 @@ pub struct ManagedWindows {
 }
 
 impl ManagedWindows {
-    /// Add every terrain of `scene` to `snow`, centred on its focus at time `t`.
-    pub fn new(snow: &mut SnowManager, scene: &Scene, t: f32) -> Result<Self, String> {
+    /// Add every terrain of `scene` to `snow`, centred on its focus at time `t`; after `--load`
+    /// (`loaded`, the save's path), find them in the loaded manager by name instead, where the
+    /// save left them: each must be there with the scene's description, and no other.
+    pub fn new(
+        snow: &mut SnowManager,
+        scene: &Scene,
+        t: f32,
+        loaded: Option<&Path>,
+    ) -> Result<Self, String> {
+        if let Some(path) = loaded {
+            return Self::loaded(snow, scene, path);
+        }
         let mut ids = Vec::new();
         for st in &scene.terrains {
             let id = snow
                 .add_terrain(st.desc.clone(), st.focus(scene, t))
                 .map_err(|e| format!("{}:{}: {e}", scene.path.display(), st.line))?;
             ids.push(id);
+        }
+        Ok(Self { ids })
+    }
+
+    /// The scene's terrains in a manager loaded from the save at `path`, checked against the
+    /// scene.
+    fn loaded(snow: &SnowManager, scene: &Scene, path: &Path) -> Result<Self, String> {
+        let mut ids = Vec::new();
+        for st in &scene.terrains {
+            let id = snow.terrain_named(&st.desc.name).ok_or_else(|| {
+                format!(
+                    "--load {}: the save has no terrain {:?} of {}:{}; load it with the scene it was saved from",
+                    path.display(),
+                    st.desc.name,
+                    scene.path.display(),
+                    st.line
+                )
+            })?;
+            let saved = snow.terrain(id).map_err(|e| e.to_string())?;
+            if saved.desc() != &st.desc {
+                return Err(format!(
+                    "--load {}: terrain {:?} differs between the save and {}:{}; load it with the scene it was saved from",
+                    path.display(),
+                    st.desc.name,
+                    scene.path.display(),
+                    st.line
+                ));
+            }
+            ids.push(id);
+        }
+        let held = snow.terrain_ids().count();
+        if held != ids.len() {
+            return Err(format!(
+                "--load {}: the save holds {held} terrains, {} has {}; load it with the scene it was saved from",
+                path.display(),
+                scene.path.display(),
+                ids.len()
+            ));
         }
         Ok(Self { ids })
     }

@@ -63,7 +63,7 @@ fn pressed_manager(gpu: &GpuContext) -> SnowManager {
 
 fn saves(c: &mut Criterion) {
     let gpu = GpuContext::new(&GpuOptions::default()).expect("GPU");
-    let m = pressed_manager(&gpu);
+    let mut m = pressed_manager(&gpu);
     let bytes = m.to_save_bytes().expect("save");
     let raw = SURFACES as u64 * PoolFormat::default().heights_bytes(512, 512);
     println!(

@@ -105,14 +105,6 @@ pub enum SnowError {
         /// What would be accepted.
         expected: String,
     },
-    /// A manager that runs a terrain window was asked for a save: saves do not hold windows yet.
-    #[error(
-        "the manager runs terrain {name:?}, and a save does not hold terrain windows yet: nothing was written; save before adding it, or remove it with SnowManager::remove_terrain (its trails are lost then)"
-    )]
-    SaveWithTerrain {
-        /// Name of the terrain.
-        name: String,
-    },
     /// A window level was moved while a frame was encoded and not yet reported submitted.
     #[error(
         "terrain {name:?} cannot scroll while a snow frame is encoded and not reported submitted: call SnowWorld::submitted first"

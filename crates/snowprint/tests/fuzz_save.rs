@@ -1,7 +1,7 @@
 //! Fuzzing of the save loader (`SaveFile::parse`, then `SnowManager::from_save` for what parses):
 //! a real save mutated byte-wise (flips, insertions, deletions, cuts, splices), and mutated inside
 //! its sections with every length and checksum fixed up afterwards, so that the inputs reach the
-//! settings, the planner's state, the meshes and the heightmaps rather than stopping at a
+//! settings, the planner's state, the meshes, the heightmaps and the terrain window rather than stopping at a
 //! checksum. Every input runs under the fuzzers' watchdog (`fuzz_support`: a panic or a hang fails
 //! it) and must be answered with a manager or one sentence; the process's peak memory must stay
 //! under `fuzz_support::RSS_BOUND`.
@@ -29,16 +29,31 @@ use snowprint::{Deformer, Mesh, Pose, Shape, SurfaceDesc};
 const LIMIT: Duration = Duration::from_secs(10);
 
 /// A small real save: three surfaces (one paged out), queued imprints, a mesh re-posed while
-/// queued (so an earlier posing is saved too).
+/// queued (so an earlier posing is saved too), and a terrain window of one 16^2 level that
+/// follows the sphere (so its store holds pages).
 fn seed() -> &'static [u8] {
     static SEED: OnceLock<Vec<u8>> = OnceLock::new();
     SEED.get_or_init(|| {
+        let f = snowprint::PoolFormat::default();
         let config = ManagerConfig {
-            updates_per_frame: 1,
-            pool_bytes: 2 * snowprint::PoolFormat::default().slot_bytes(25, 25) + 256,
+            updates_per_frame: 2,
+            pool_bytes: 2 * f.slot_bytes(25, 25) + f.slot_bytes(16, 16) + 256,
             ..ManagerConfig::default()
         };
         let mut m = SnowManager::new(common::gpu(), config).unwrap();
+        let valley = snowprint::TerrainDesc {
+            name: "valley".into(),
+            ground_height: 0.0,
+            ground: None,
+            snow_depth: 0.2,
+            replenish_rate: 0.0,
+            material: snowprint::Material::snow(),
+            levels: vec![snowprint::LevelDesc {
+                texels: [16, 16],
+                texel_size: 0.1,
+            }],
+        };
+        let t = m.add_terrain(valley, Vec3::new(-0.4, 0.0, 0.0)).unwrap();
         for i in 0..3 {
             let d = SurfaceDesc::new(
                 &format!("s{i}"),
@@ -60,6 +75,7 @@ fn seed() -> &'static [u8] {
         let mesh = m.add_mesh("tet", &tet).unwrap();
         for f in 0..8 {
             let x = f as f32 * 0.6 - 0.4;
+            m.follow_terrain(t, Vec3::new(x, 0.0, 0.0)).unwrap();
             let ds = [
                 ManagedDeformer::new(Deformer::new(
                     Shape::Sphere { radius: 0.1 },
@@ -261,7 +277,8 @@ fn load_one(input: Vec<u8>) -> Result<(), String> {
 fn the_save_loader_answers_every_input() {
     let seed = seed();
     // The re-assembled seed is a valid save: the fix-up is right, so mutations go deep.
-    assert!(SaveFile::parse(&common::assemble_save(1, &sections(seed))).is_ok());
+    let file = SaveFile::parse(&common::assemble_save(3, &sections(seed))).unwrap();
+    assert!(file.terrains.len() == 1 && file.terrains[0].chunks() > 0);
     let n = cases(2000);
     let start = Instant::now();
     let watchdog = Watchdog::new(load_one, LIMIT);

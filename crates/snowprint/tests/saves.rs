@@ -202,7 +202,7 @@ fn a_bad_save_file_leaves_the_running_world_as_it_was() {
     running.save(&good).unwrap();
     let bytes = std::fs::read(&good).unwrap();
     let mut newer = bytes.clone();
-    newer[8..12].copy_from_slice(&3u32.to_le_bytes());
+    newer[8..12].copy_from_slice(&4u32.to_le_bytes());
     let crc = crc32(&newer[..16]);
     newer[16..20].copy_from_slice(&crc.to_le_bytes());
     let cases: [(&str, Vec<u8>, &str); 4] = [
@@ -277,7 +277,7 @@ fn a_save_keeps_every_setting() {
         format: PoolFormat::new(Precision::Bits8),
         ..ManagerConfig::default()
     };
-    let m = SnowManager::new(common::gpu(), config.clone()).unwrap();
+    let mut m = SnowManager::new(common::gpu(), config.clone()).unwrap();
     let file = SaveFile::parse(&m.to_save_bytes().unwrap()).unwrap();
     assert_eq!(file.config, config);
 }

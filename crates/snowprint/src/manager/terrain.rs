@@ -30,6 +30,12 @@ impl ManagedTerrainId {
     pub fn index(self) -> u32 {
         self.0
     }
+
+    /// The handle of the terrain added `index`-th (a handle that names no terrain is reported
+    /// as [`SnowError::StaleHandle`] where it is used).
+    pub fn from_index(index: u32) -> Self {
+        Self(index)
+    }
 }
 
 /// A terrain of the manager's and the pool slots its levels hold.
@@ -154,12 +160,63 @@ impl SnowManager {
             .flat_map(|t| t.terrain.surfaces())
     }
 
-    /// Names of the terrains (a save refuses them, naming the first).
-    pub(super) fn terrain_names(&self) -> impl Iterator<Item = &str> {
-        self.terrains
-            .iter()
-            .flatten()
-            .map(|t| t.terrain.desc().name.as_str())
+    /// Every terrain the manager runs, in order of addition, with its name: after
+    /// [`SnowManager::load`] the same handles as in the manager that was saved (a removed
+    /// terrain's handle stays stale).
+    pub fn terrain_ids(&self) -> impl Iterator<Item = (ManagedTerrainId, &str)> {
+        self.terrains.iter().enumerate().filter_map(|(i, t)| {
+            t.as_ref()
+                .map(|t| (ManagedTerrainId(i as u32), t.terrain.desc().name.as_str()))
+        })
+    }
+
+    /// The handle of the terrain named `name`, if any (the first, if several).
+    pub fn terrain_named(&self, name: &str) -> Option<ManagedTerrainId> {
+        self.terrain_ids().find(|t| t.1 == name).map(|t| t.0)
+    }
+
+    /// Land every terrain's strips still on their way (a save needs them in the stores).
+    pub(super) fn flush_terrains(&mut self) -> Result<()> {
+        for t in self.terrains.iter_mut().flatten() {
+            t.terrain.flush(&mut self.world)?;
+        }
+        Ok(())
+    }
+
+    /// The live terrains with their handles' indices, in order.
+    pub(super) fn live_terrains(&self) -> impl Iterator<Item = (u32, &Terrain)> {
+        self.terrain_ids()
+            .filter_map(|(id, _)| self.terrain(id).ok().map(|t| (id.0, t)))
+    }
+
+    /// Put a terrain restored from a save under handle `index` (after the terrains of lower
+    /// handles): its levels' slots pinned in the planner as `add_terrain` pins them, the levels'
+    /// updates reserved. Refused when the planner's copy of the pool does not have the slots
+    /// free (the save is checked against that before anything is built).
+    pub(super) fn put_restored_terrain(&mut self, index: u32, terrain: Terrain) -> Result<()> {
+        let i = index as usize;
+        if i < self.terrains.len() {
+            return Err(SnowError::SaveContent(format!(
+                "terrain {:?}'s handle {index} is taken",
+                terrain.desc().name
+            )));
+        }
+        let mut slots = Vec::new();
+        for id in terrain.surfaces() {
+            let slot = self.world.slot_of(id)?;
+            if !self.planner.pin_slot(slot) {
+                return Err(SnowError::SaveContent(format!(
+                    "terrain {:?}'s level slot at byte {} overlaps a surface's",
+                    terrain.desc().name,
+                    slot.offset
+                )));
+            }
+            slots.push(slot);
+        }
+        self.terrains.resize_with(i, || None);
+        self.terrains.push(Some(ManagedTerrain { terrain, slots }));
+        self.planner.reserve_updates(self.terrain_levels());
+        Ok(())
     }
 }
 

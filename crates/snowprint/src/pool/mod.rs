@@ -304,6 +304,22 @@ pub fn unwrap_channel(wrap: u32, width: u32, height: u32, stored: &[u32]) -> Vec
     out
 }
 
+/// Channels in logical order put where a slot stored with the offsets `wrap` keeps them: the
+/// inverse of [`unwrap_channel`] (a saved window level written back into its slot).
+pub fn wrap_channel(wrap: u32, width: u32, height: u32, logical: &[u32]) -> Vec<u32> {
+    if wrap == 0 {
+        return logical.to_vec();
+    }
+    let mut out = vec![0; logical.len()];
+    for y in 0..height {
+        for x in 0..width {
+            let (px, py) = wrapped(wrap, width, height, x, y);
+            out[(py * width + px) as usize] = logical[(y * width + x) as usize];
+        }
+    }
+    out
+}
+
 /// `batch` of a record whose surface had nothing to capture this update.
 pub const NO_CAPTURE: u32 = crate::wgsl::consts::NO_CAPTURE;
 /// Bit of [`SurfaceRecord::mode`] set when mesh solids were drawn over the surface this update:
@@ -449,6 +465,19 @@ impl SlotAllocator {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn wrapping_a_channel_undoes_unwrapping_it() {
+        let (w, h) = (6u32, 4u32);
+        let stored: Vec<u32> = (0..w * h).collect();
+        for wrap in [0, pack_wrap(1, 0), pack_wrap(5, 3), pack_wrap(0, 2)] {
+            let logical = unwrap_channel(wrap, w, h, &stored);
+            assert_eq!(wrap_channel(wrap, w, h, &logical), stored, "{wrap:#x}");
+            if wrap != 0 {
+                assert_ne!(logical, stored);
+            }
+        }
+    }
 
     #[test]
     fn record_is_68_bytes() {

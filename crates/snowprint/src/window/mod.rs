@@ -16,6 +16,7 @@
 
 mod fold;
 pub mod plan;
+pub(crate) mod saved;
 pub mod store;
 pub mod strip;
 
@@ -146,19 +147,7 @@ impl Terrain {
                 l.texels,
                 world.pool_format().precision.unit_texels(),
             );
-            let layout = SurfaceLayout {
-                width: l.texels[0],
-                height: l.texels[1],
-            };
-            let surface = SurfaceDesc {
-                name: format!("{}.{i}", desc.name),
-                center: center_of(&desc, l, origin),
-                size: Vec2::new(l.texels[0] as f32, l.texels[1] as f32) * l.texel_size,
-                yaw_degrees: 0.0,
-                snow_depth: desc.snow_depth,
-                replenish_rate: desc.replenish_rate,
-                material: desc.material,
-            };
+            let (surface, layout) = level_surface(&desc, i, origin);
             let added = world.add_level(surface, layout).and_then(|id| {
                 world.move_level(
                     id,
@@ -181,13 +170,24 @@ impl Terrain {
                 }
             }
         }
+        Self::finish(world, desc, levels, Default::default())
+    }
+
+    /// The terrain of `levels` (added to `world`) with its store and statistics: the levels'
+    /// holes set and their grounds laid.
+    fn finish(
+        world: &mut SnowWorld,
+        desc: TerrainDesc,
+        levels: Vec<Level>,
+        kept: saved::Kept,
+    ) -> Result<Self> {
         let terrain = Self {
             strips: StripGpu::new(world.device(), world.pool_format().precision),
             desc,
             levels,
-            store: Default::default(),
-            stats: Default::default(),
-            last_written: 0,
+            store: kept.store,
+            stats: kept.stats,
+            last_written: kept.last_written,
             in_flight: Default::default(),
         };
         terrain.set_holes(world)?;
@@ -454,7 +454,9 @@ impl Terrain {
             if !wait && !f.read.is_ready() {
                 break;
             }
-            let f = self.in_flight.pop_front().expect("checked above");
+            let Some(f) = self.in_flight.pop_front() else {
+                break;
+            };
             let (pairs, written) = f.read.wait(world.device())?;
             if f.fold {
                 self.stats.bytes_folded += written;
@@ -486,6 +488,29 @@ fn ground_height(g: &TerrainGround, l: &LevelDesc, t: [i64; 2]) -> f32 {
         (((t[k] as f64 + 0.5) * s - g.origin[k] as f64) / g.size[k] as f64).clamp(0.0, 1.0) as f32
     };
     g.grid.sample(uv(0), uv(1))
+}
+
+/// Level `i` of `desc` as a surface of the world, its window's first world texel at `origin`.
+pub(crate) fn level_surface(
+    desc: &TerrainDesc,
+    i: usize,
+    origin: [i64; 2],
+) -> (SurfaceDesc, SurfaceLayout) {
+    let l = &desc.levels[i];
+    let surface = SurfaceDesc {
+        name: format!("{}.{i}", desc.name),
+        center: center_of(desc, l, origin),
+        size: Vec2::new(l.texels[0] as f32, l.texels[1] as f32) * l.texel_size,
+        yaw_degrees: 0.0,
+        snow_depth: desc.snow_depth,
+        replenish_rate: desc.replenish_rate,
+        material: desc.material,
+    };
+    let layout = SurfaceLayout {
+        width: l.texels[0],
+        height: l.texels[1],
+    };
+    (surface, layout)
 }
 
 /// The world centre of a level's rectangle whose first world texel is `origin`, on the ground.
@@ -525,6 +550,22 @@ fn check_focus(name: &str, focus: Vec3) -> Result<()> {
 
 /// Check a terrain against the world it goes into, naming the first thing that is wrong.
 fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
+    validate_for(
+        desc,
+        world.pool_format(),
+        world.config().atlas_side,
+        world.memory().pool_budget,
+    )
+}
+
+/// [`validate`] against a world's pool format, capture atlas side and pool budget (a save's
+/// terrains are checked against its settings before any world is made).
+pub(crate) fn validate_for(
+    desc: &TerrainDesc,
+    format: crate::pool::PoolFormat,
+    atlas_side: u32,
+    budget: u64,
+) -> Result<()> {
     let bad = |what: String, value: String, expected: String| {
         Err(SnowError::InvalidTerrain {
             name: desc.name.clone(),
@@ -557,9 +598,8 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
             );
         }
     }
-    let format = world.pool_format();
     // A level's capture region (its texels and the apron) must fit the atlas.
-    let side = world.config().atlas_side - 2 * crate::capture::APRON;
+    let side = atlas_side.saturating_sub(2 * crate::capture::APRON);
     let mut bytes = 0u64;
     for (i, l) in desc.levels.iter().enumerate() {
         let [w, h] = l.texels;
@@ -591,7 +631,6 @@ fn validate(desc: &TerrainDesc, world: &SnowWorld) -> Result<()> {
         }
         bytes += format.slot_bytes(w, h);
     }
-    let budget = world.memory().pool_budget;
     if bytes > budget {
         return bad(
             "the levels' heightmaps".into(),

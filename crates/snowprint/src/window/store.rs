@@ -36,10 +36,13 @@ impl ChunkPage {
     }
 }
 
+/// Where a page lies: (level, chunk column, chunk row).
+pub(crate) type PageKey = (usize, i64, i64);
+
 /// Pages of every level of a terrain, by (level, chunk column, chunk row).
 #[derive(Clone, Debug, Default)]
 pub struct StripStore {
-    pages: HashMap<(usize, i64, i64), ChunkPage>,
+    pages: HashMap<PageKey, ChunkPage>,
     bytes: u64,
 }
 
@@ -97,6 +100,54 @@ impl StripStore {
     pub fn chunks(&self) -> usize {
         self.pages.len()
     }
+
+    /// Every page with its compressed bytes, by (level, chunk column, chunk row) in order (what a
+    /// save keeps: the same store gives the same bytes).
+    pub(crate) fn pages(&self) -> Vec<(PageKey, &[u8])> {
+        let mut pages: Vec<_> = self
+            .pages
+            .iter()
+            .map(|(&k, p)| (k, p.compressed.as_slice()))
+            .collect();
+        pages.sort_by_key(|p| p.0);
+        pages
+    }
+
+    /// A store of saved pages (each checked by [`check_page`], no key twice).
+    pub(crate) fn from_pages(
+        pages: impl IntoIterator<Item = ((usize, i64, i64), Vec<u8>)>,
+    ) -> Self {
+        let mut store = Self::default();
+        for (key, compressed) in pages {
+            store.bytes += compressed.len() as u64;
+            if let Some(old) = store.pages.insert(key, ChunkPage { compressed }) {
+                store.bytes -= old.compressed.len() as u64;
+            }
+        }
+        store
+    }
+}
+
+/// Whether `compressed` is a page the store could have written: LZ4 of exactly a chunk's
+/// `(depression, displaced)` pairs, no channel above `max`. One clause for what is wrong.
+pub(crate) fn check_page(compressed: &[u8], max: u32) -> std::result::Result<(), String> {
+    let bytes = lz4_flex::block::decompress(compressed, CHUNK_TEXELS * 8)
+        .map_err(|e| format!("does not decompress ({e})"))?;
+    if bytes.len() != CHUNK_TEXELS * 8 {
+        return Err(format!(
+            "holds {} bytes, a chunk {}",
+            bytes.len(),
+            CHUNK_TEXELS * 8
+        ));
+    }
+    let over = bytes
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .find(|&v| v > max);
+    match over {
+        Some(v) => Err(format!("holds a channel of {v}, above the pool's {max}")),
+        None => Ok(()),
+    }
 }
 
 /// The world texels of a rectangle grouped by chunk: `f(chunk, texels)` once a chunk.
@@ -140,5 +191,19 @@ mod tests {
         assert_eq!(&beside[6..10], &[0; 4]);
         assert_eq!(&beside[10..12], &pairs[0..2]);
         assert!(s.bytes() > 0 && s.chunks() == 2);
+        // Its pages, saved and read back, are the same store.
+        let pages: Vec<_> = s
+            .pages()
+            .into_iter()
+            .map(|(k, b)| (k, b.to_vec()))
+            .collect();
+        for (_, b) in &pages {
+            assert_eq!(check_page(b, u32::MAX), Ok(()));
+        }
+        assert!(check_page(&pages[0].1, 5).unwrap_err().contains("above"));
+        assert!(check_page(&pages[0].1[..3], u32::MAX).is_err());
+        let mut back = StripStore::from_pages(pages);
+        assert_eq!((back.bytes(), back.chunks()), (s.bytes(), s.chunks()));
+        assert_eq!(back.get(1, [-10, 60], cols, rows), pairs);
     }
 }

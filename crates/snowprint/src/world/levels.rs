@@ -16,6 +16,17 @@ impl SnowWorld {
         desc: SurfaceDesc,
         layout: SurfaceLayout,
     ) -> Result<SurfaceId> {
+        self.add_level_at(desc, layout, None)
+    }
+
+    /// [`SnowWorld::add_level`] with its slot at byte `at` of the pool when given (a save's
+    /// placement), else first fit.
+    fn add_level_at(
+        &mut self,
+        desc: SurfaceDesc,
+        layout: SurfaceLayout,
+        at: Option<u64>,
+    ) -> Result<SurfaceId> {
         desc.validate()?;
         // The level's capture region (its texels and the apron) must fit the atlas.
         let side = self.config.atlas_side - 2 * crate::capture::APRON;
@@ -29,7 +40,7 @@ impl SnowWorld {
                 ),
             });
         }
-        let slot = self.reserve_slot(&desc.name, &layout, None)?;
+        let slot = self.reserve_slot(&desc.name, &layout, at)?;
         self.queue
             .write_buffer(&self.pool, slot.offset, &vec![0u8; slot.bytes as usize]);
         Ok(self.insert_state(SurfaceState {
@@ -42,6 +53,56 @@ impl SnowWorld {
             wrap: 0,
             hole: None,
         }))
+    }
+
+    /// Add a window level holding a saved state (a save's `TERR` section): its slot at byte
+    /// `at` of the pool, stored with toroidal offsets `wrap`, its `words` (heights, then normals
+    /// when the pool keeps them) given in logical order as a snapshot gives them, and its
+    /// replenishment `carry`. Refused, nothing added, when the words or the carry do not fit the
+    /// level at this world's format or the slot's range is not free.
+    pub(crate) fn restore_level(
+        &mut self,
+        desc: SurfaceDesc,
+        layout: SurfaceLayout,
+        (at, wrap): (u64, u32),
+        carry: f64,
+        words: &[u32],
+    ) -> Result<SurfaceId> {
+        let bad = |reason: String| SnowError::Snapshot {
+            name: desc.name.clone(),
+            reason,
+        };
+        let payload = self.payload_bytes(&layout);
+        if words.len() as u64 * 4 != payload {
+            return Err(bad(format!(
+                "it holds {} words, a {}x{} level needs {}",
+                words.len(),
+                layout.width,
+                layout.height,
+                payload / 4
+            )));
+        }
+        if !(carry.is_finite() && (0.0..1.0).contains(&carry)) {
+            return Err(bad(format!(
+                "its replenishment carry {carry} is not a fraction in [0, 1)"
+            )));
+        }
+        let stored = super::snapshot::stored_words(
+            self.config.format,
+            (layout.width, layout.height),
+            wrap,
+            words,
+        )
+        .ok_or_else(|| bad("its words do not decode at this world's format".into()))?;
+        let id = self.add_level_at(desc, layout, Some(at))?;
+        let slot = self.state(id)?.slot;
+        self.queue
+            .write_buffer(&self.pool, slot.offset, bytemuck::cast_slice(&stored));
+        if let Some(s) = self.surfaces[id.0 as usize].as_mut() {
+            s.carry = carry;
+            s.wrap = wrap;
+        }
+        Ok(id)
     }
 
     /// Move a window level: its rectangle's centre and its storage's toroidal offsets

@@ -154,6 +154,27 @@ fn logical_words(meta: &SurfaceSnapshot, wrap: u32, words: Vec<u32>) -> Vec<u32>
     out
 }
 
+/// A slot's words in logical order (as [`logical_words`] gives them) put where a slot stored
+/// with toroidal offsets `wrap` keeps them; `None` when they do not decode at `format`.
+pub(super) fn stored_words(
+    format: PoolFormat,
+    (w, h): (u32, u32),
+    wrap: u32,
+    words: &[u32],
+) -> Option<Vec<u32>> {
+    if wrap == 0 {
+        return Some(words.to_vec());
+    }
+    let n = (format.heights_bytes(w, h) / 4) as usize;
+    let (dep, disp) = format.decode(w, h, words.get(..n)?).ok()?;
+    let wrap_c = |c: &[u32]| crate::pool::wrap_channel(wrap, w, h, c);
+    let mut out = format.encode(w, h, &wrap_c(&dep), &wrap_c(&disp)).ok()?;
+    if words.len() > n {
+        out.extend(wrap_c(&words[n..]));
+    }
+    Some(out)
+}
+
 impl SnowWorld {
     /// Copy the stored state of surfaces to the CPU in one GPU round trip: their slots' words
     /// (heights, and normals when the pool keeps them) and the replenishment carried between

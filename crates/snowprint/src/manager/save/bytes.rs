@@ -43,6 +43,10 @@ impl<'a> Reader<'a> {
         ))
     }
 
+    pub(super) fn i64(&mut self, what: &str) -> std::result::Result<i64, String> {
+        Ok(self.u64(what)? as i64)
+    }
+
     pub(super) fn f32(&mut self, what: &str) -> std::result::Result<f32, String> {
         Ok(f32::from_bits(self.u32(what)?))
     }

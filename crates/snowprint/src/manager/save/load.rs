@@ -12,6 +12,8 @@ use crate::manager::pages::Page;
 use crate::manager::planner::Planner;
 use crate::manager::{ManagedMesh, SnowManager};
 use crate::mesh::MeshId;
+use crate::window::Terrain;
+use crate::window::saved::LevelState;
 use crate::world::SnowWorld;
 
 impl SnowManager {
@@ -154,8 +156,16 @@ impl SnowManager {
                 )));
             }
         }
+        m.restore_grounds(file.grounds)?;
+        m.restore_terrains(file.terrains)?;
+        Ok(m)
+    }
+
+    /// Lay the saved grounds on their surfaces (rebuilt as `GroundField::build` built them).
+    fn restore_grounds(&mut self, grounds: Vec<super::SavedGround>) -> Result<()> {
+        let m = self;
         m.grounds = vec![None; m.planner.len()];
-        for g in file.grounds {
+        for g in grounds {
             let id = crate::manager::ManagedId(g.index);
             let desc = m.planner.surface(id)?.clone();
             if m.grounds[g.index as usize].is_some() {
@@ -179,6 +189,33 @@ impl SnowManager {
                 }),
             )?;
         }
-        Ok(m)
+        Ok(())
+    }
+
+    /// Build the saved terrains again, each under its handle: levels at their slots (pinned in
+    /// the planner), windows at their origins, words, carries, grounds, pages and statistics as
+    /// they were.
+    fn restore_terrains(&mut self, terrains: Vec<super::SavedTerrain>) -> Result<()> {
+        for t in terrains {
+            let levels: Vec<LevelState<'_>> = t
+                .levels
+                .iter()
+                .map(|l| LevelState {
+                    origin: l.origin,
+                    offset: l.offset,
+                    carry: l.carry,
+                    words: &l.words,
+                })
+                .collect();
+            let terrain = Terrain::restore(
+                &mut self.world,
+                t.desc,
+                &levels,
+                (t.stats, t.last_written),
+                t.pages,
+            )?;
+            self.put_restored_terrain(t.index, terrain)?;
+        }
+        Ok(())
     }
 }

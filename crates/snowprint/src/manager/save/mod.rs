@@ -12,10 +12,13 @@
 //! surface that holds a heightmap, resident or paged (binary: the slot's words and the
 //! replenishment carry), then (from version 2) one `GRND` per surface on ground that is not flat
 //! (binary: its ground height at every texel and its slope rule; the field is rebuilt from them
-//! as [`crate::GroundField::build`] built it). Version 1 files, which have no `GRND`, still read.
-//! Reading checks everything before anything is built: a corrupt,
-//! truncated, foreign or newer file is one
-//! [`SnowError::SaveFile`](crate::SnowError::SaveFile) sentence.
+//! as [`crate::GroundField::build`] built it), then (from version 3) one `TERR` per terrain
+//! window the manager runs (binary, `terrain.rs`: its description, each level's window origin,
+//! slot, carry and words, its scroll statistics and the pages of its store; the terrain is built
+//! again from them exactly, under the same [`ManagedTerrainId`](super::ManagedTerrainId)).
+//! Version 1 files, which have no `GRND`, and version 2 files, which have no `TERR`, still read.
+//! Reading checks everything before anything is built: a corrupt, truncated, foreign or newer
+//! file is one [`SnowError::SaveFile`](crate::SnowError::SaveFile) sentence.
 
 use super::ManagerConfig;
 use super::planner::PlannerState;
@@ -26,13 +29,14 @@ mod bytes;
 mod config;
 mod load;
 mod parse;
+mod terrain;
 mod write;
 
 /// The first eight bytes of every save.
 pub(crate) const MAGIC: [u8; 8] = *b"SNOWSAVE";
 /// The format version this build writes and the newest it reads.
-pub(crate) const VERSION: u32 = 2;
-/// Most sections a save may have (a section per surface, plus three).
+pub(crate) const VERSION: u32 = 3;
+/// Most sections a save may have (a section per surface and per terrain, plus three).
 pub(crate) const MAX_SECTIONS: u32 = 1 << 20;
 /// Most bytes a section may expand to (a 512^2 surface at 32 bits with normals is 3 MiB; the
 /// JSON sections of a city of 10,000 surfaces with long queues stay far below).
@@ -71,6 +75,34 @@ pub struct SaveFile {
     pub surfaces: Vec<SavedSurface>,
     /// The grounds that are not flat, by managed surface index.
     pub grounds: Vec<SavedGround>,
+    /// The terrain windows, in order of their handles (version 3).
+    pub terrains: Vec<SavedTerrain>,
+}
+
+/// One terrain window in a save (a `TERR` section): what rebuilds it exactly.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SavedTerrain {
+    /// Its handle's index ([`ManagedTerrainId::index`](super::ManagedTerrainId::index)): the
+    /// loaded manager gives it the same handle.
+    pub index: u32,
+    /// Its description, as [`SnowManager::add_terrain`](super::SnowManager::add_terrain) took it.
+    pub desc: crate::TerrainDesc,
+    pub(crate) levels: Vec<terrain::SavedLevel>,
+    pub(crate) stats: crate::window::ScrollStats,
+    pub(crate) last_written: u64,
+    pub(crate) pages: Vec<crate::window::saved::PageState>,
+}
+
+impl SavedTerrain {
+    /// Each level's window: the world texel of its logical texel (0, 0), finest first.
+    pub fn origins(&self) -> Vec<[i64; 2]> {
+        self.levels.iter().map(|l| l.origin).collect()
+    }
+
+    /// Chunks of 64 x 64 texels its page store holds (what its windows paged out).
+    pub fn chunks(&self) -> usize {
+        self.pages.len()
+    }
 }
 
 /// One surface's ground in a save: its height at every texel and the slope rule.

@@ -2,6 +2,7 @@
 
 use super::bytes::{Reader, read_mesh, read_string};
 use super::config::SavedConfig;
+use super::terrain::{check_terrains, read_terrain};
 use super::{
     CODEC_LZ4, CODEC_RAW, HEADER, MAGIC, MAX_SECTION_BYTES, MAX_SECTIONS, SECTION_HEADER, SaveFile,
     SavedGround, SavedMeshes, SavedSurface, Section, VERSION,
@@ -102,19 +103,7 @@ impl SaveFile {
             });
         }
         r.done("the file")?;
-        let tags: Vec<&[u8; 4]> = sections.iter().map(|s| &s.tag).collect();
-        let heightmaps = 3 + tags[3..].iter().take_while(|t| **t == b"SURF").count();
-        if tags[0] != b"CONF"
-            || tags[1] != b"PLAN"
-            || tags[2] != b"MESH"
-            || tags[heightmaps..].iter().any(|t| *t != b"GRND")
-            || (version < 2 && heightmaps < tags.len())
-        {
-            return Err(
-                "its sections are not CONF, PLAN, MESH, SURF and (from version 2) GRND in that order"
-                    .into(),
-            );
-        }
+        let (heightmaps, ground_end) = section_order(&sections, version)?;
         let saved: SavedConfig = serde_json::from_slice(&sections[0].data)
             .map_err(|e| format!("its settings (CONF) do not read: {e}"))?;
         let config = saved
@@ -132,9 +121,18 @@ impl SaveFile {
             );
         }
         let mut grounds = Vec::new();
-        for s in &sections[heightmaps..] {
+        for s in &sections[heightmaps..ground_end] {
             grounds.push(read_ground(&s.data, &plan).map_err(|e| format!("a ground (GRND): {e}"))?);
         }
+        let mut terrains = Vec::new();
+        for (k, s) in sections.iter().enumerate().skip(ground_end) {
+            terrains.push(read_terrain(&s.data, &config).map_err(|e| {
+                format!("section {k}, a terrain window (TERR): {e}; the save is damaged or was altered: load an earlier one")
+            })?);
+        }
+        check_terrains(&terrains, &config, &plan).map_err(|e| {
+            format!("its terrain windows (TERR): {e}; the save is damaged or was altered: load an earlier one")
+        })?;
         Ok(Self {
             version,
             config,
@@ -143,6 +141,7 @@ impl SaveFile {
             meshes,
             surfaces,
             grounds,
+            terrains,
         })
     }
 
@@ -184,6 +183,32 @@ impl SaveFile {
     pub fn mesh_count(&self) -> usize {
         self.meshes.managed.len()
     }
+}
+
+/// Where the heightmaps end and the grounds end among the sections, once their order is checked:
+/// `CONF, PLAN, MESH, SURF..., GRND..., TERR...`, `GRND` from version 2, `TERR` from 3.
+fn section_order(
+    sections: &[Section],
+    version: u32,
+) -> std::result::Result<(usize, usize), String> {
+    let tags: Vec<&[u8; 4]> = sections.iter().map(|s| &s.tag).collect();
+    let run =
+        |from: usize, tag: &[u8; 4]| from + tags[from..].iter().take_while(|t| **t == tag).count();
+    let heightmaps = run(3, b"SURF");
+    let ground_end = run(heightmaps, b"GRND");
+    if tags[0] != b"CONF"
+        || tags[1] != b"PLAN"
+        || tags[2] != b"MESH"
+        || tags[ground_end..].iter().any(|t| *t != b"TERR")
+        || (version < 2 && heightmaps < tags.len())
+        || (version < 3 && ground_end < tags.len())
+    {
+        return Err(
+            "its sections are not CONF, PLAN, MESH, SURF, (from version 2) GRND and (from version 3) TERR in that order"
+                .into(),
+        );
+    }
+    Ok((heightmaps, ground_end))
 }
 
 pub(super) fn read_meshes(data: &[u8]) -> std::result::Result<SavedMeshes, String> {

@@ -12,14 +12,14 @@ use crate::mesh::Mesh;
 use crate::world::SurfaceSnapshot;
 
 impl SnowManager {
-    /// The whole snow state as the bytes of a save (see the module docs). Pages still on their
-    /// way from the GPU are waited for; refused with [`SnowError::FramePending`] while a tick is
-    /// recorded and not submitted.
-    pub fn to_save_bytes(&self) -> Result<Vec<u8>> {
+    /// The whole snow state as the bytes of a save (see the module docs), terrain windows
+    /// included. Pages still on their way from the GPU are waited for, and every terrain's
+    /// strips on their way are landed first (as [`SnowManager::flush_terrain`] lands them), so
+    /// that the manager saved and one loaded from the save go on alike; refused with
+    /// [`SnowError::FramePending`] while a tick is recorded and not submitted.
+    pub fn to_save_bytes(&mut self) -> Result<Vec<u8>> {
         self.not_pending()?;
-        if let Some(name) = self.terrain_names().next() {
-            return Err(crate::error::SnowError::SaveWithTerrain { name: name.into() });
-        }
+        self.flush_terrains()?;
         let conf = to_json(&SavedConfig::of(self.planner.config()))?;
         let plan = to_json(&self.planner.state())?;
         // Meshes: the manager's, and the earlier posings that queues still name.
@@ -36,16 +36,24 @@ impl SnowManager {
             put_u32(&mut meshes, *id);
             put_mesh(&mut meshes, mesh);
         }
-        // Heightmaps: resident ones read back in one round trip, paged ones from their pages.
+        // Heightmaps: resident ones and the terrains' levels read back in one round trip, paged
+        // ones from their pages.
         let resident: Vec<(u32, crate::SurfaceId)> = self
             .world_ids
             .iter()
             .enumerate()
             .filter_map(|(i, w)| w.map(|w| (i as u32, w)))
             .collect();
-        let snaps = self
-            .world
-            .snapshot_surfaces(&resident.iter().map(|r| r.1).collect::<Vec<_>>())?;
+        let levels: Vec<crate::SurfaceId> = self.level_ids().collect();
+        let mut snaps = self.world.snapshot_surfaces(
+            &resident
+                .iter()
+                .map(|r| r.1)
+                .chain(levels.iter().copied())
+                .collect::<Vec<_>>(),
+        )?;
+        let level_snaps = snaps.split_off(resident.len());
+        let terrains = self.terrain_sections(&levels, &level_snaps)?;
         let mut surfaces: Vec<(u32, Option<u64>, SurfaceSnapshot)> = resident
             .iter()
             .zip(snaps)
@@ -73,7 +81,10 @@ impl SnowManager {
             .enumerate()
             .filter_map(|(i, g)| g.as_ref().map(|g| (i, g)))
             .collect();
-        put_u32(&mut out, (3 + surfaces.len() + grounds.len()) as u32);
+        put_u32(
+            &mut out,
+            (3 + surfaces.len() + grounds.len() + terrains.len()) as u32,
+        );
         let crc = crc32fast::hash(&out[..16]);
         put_u32(&mut out, crc);
         section(&mut out, b"CONF", &conf);
@@ -101,6 +112,31 @@ impl SnowManager {
             b.extend_from_slice(bytemuck::cast_slice(&g.field.ground));
             section(&mut out, b"GRND", &b);
         }
+        for t in &terrains {
+            section(&mut out, b"TERR", t);
+        }
+        Ok(out)
+    }
+
+    /// The `TERR` sections of the live terrains, in order of their handles: `levels` are every
+    /// level's surface (as [`SnowManager::level_ids`] lists them) and `snaps` their snapshots.
+    fn terrain_sections(
+        &self,
+        levels: &[crate::SurfaceId],
+        snaps: &[SurfaceSnapshot],
+    ) -> Result<Vec<Vec<u8>>> {
+        let mut at = 0;
+        let mut out = Vec::new();
+        for (index, t) in self.live_terrains() {
+            let n = t.surfaces().len();
+            let (ids, snaps) = (&levels[at..at + n], &snaps[at..at + n]);
+            at += n;
+            let mut parts = Vec::with_capacity(n);
+            for (&id, s) in ids.iter().zip(snaps) {
+                parts.push((self.world.slot_of(id)?.offset, s.carry, s.words.as_slice()));
+            }
+            out.push(super::terrain::put_terrain(index, t, &parts)?);
+        }
         Ok(out)
     }
 
@@ -114,8 +150,9 @@ impl SnowManager {
 
     /// Write a save to `path` atomically: a temporary file beside it, flushed to disk, then
     /// renamed over it, so a reader finds the old save or the new one, never a part. Returns the
-    /// bytes written.
-    pub fn save(&self, path: &Path) -> Result<u64> {
+    /// bytes written. Lands the terrains' strips on their way first (see
+    /// [`SnowManager::to_save_bytes`]).
+    pub fn save(&mut self, path: &Path) -> Result<u64> {
         let bytes = self.to_save_bytes()?;
         let out = |reason: String| SnowError::Output {
             path: path.to_owned(),
