@@ -36,7 +36,7 @@ pub const REFILL_CHUNK: u32 =
     crate::wgsl::consts::REFILL_GROUP * crate::wgsl::consts::REFILL_VECTORS * 4;
 
 // The refill reads and writes 16-byte vectors from each slot's start to the end of its last one.
-const _: () = assert!(crate::pool::SLOT_ALIGN % 16 == 0);
+const _: () = assert!(crate::pool::SLOT_ALIGN.is_multiple_of(16));
 
 /// The three compute pipelines and their layouts.
 pub struct AccumulatePipelines {
