@@ -84,6 +84,24 @@ fn replenished(rec: SurfaceRecord) -> u32 {
 // control flow.
 fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, rep: u32, lid: u32, local: vec2<u32>) {
     let tile = vec2<i32>(tile_id) * SIDE;
+    // Unit lid of the tile: row lid / (SIDE / per), first texel column (lid % (SIDE / per)) * per.
+    let per = unit_texels(PRECISION);
+    let row_units = u32(SIDE) / per;
+    let ux = (lid % row_units) * per;
+    let uy = lid / row_units;
+    let x = u32(tile.x) + ux;
+    let y = u32(tile.y) + uy;
+    let writes = lid < u32(SIDE * SIDE) / per && x < rec.width && y < rec.height;
+    // The unit's old texels are loaded first, so that their reads wait beside the capture's
+    // rather than after the blur.
+    var old_a = vec2<u32>(0u);
+    var old_b = vec2<u32>(0u);
+    if writes {
+        old_a = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y);
+        if per == 2u && x + 1u < rec.width {
+            old_b = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x + 1u, y);
+        }
+    }
     let dep_origin = tile - vec2<i32>(1);
     if has_capture {
         for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
@@ -101,30 +119,14 @@ fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, rep: u
         );
     }
     workgroupBarrier();
-    let per = unit_texels(PRECISION);
-    let units = u32(SIDE * SIDE) / per;
-    if lid >= units {
+    if !writes {
         return;
     }
-    // Unit lid of the tile: row lid / (SIDE / per), first texel column (lid % (SIDE / per)) * per.
-    let row_units = u32(SIDE) / per;
-    let ux = (lid % row_units) * per;
-    let uy = lid / row_units;
-    let x = u32(tile.x) + ux;
-    let y = u32(tile.y) + uy;
-    if x >= rec.width || y >= rec.height {
-        return;
-    }
-    let a = merged(rec, has_capture, rep, x, y, blurred[uy * u32(SIDE) + ux]);
+    let a = merge_channels(old_a, blurred[uy * u32(SIDE) + ux], has_capture, rep);
     var b = vec2<u32>(0u);
     if per == 2u && x + 1u < rec.width {
-        b = merged(rec, has_capture, rep, x + 1u, y, blurred[uy * u32(SIDE) + ux + 1u]);
+        b = merge_channels(old_b, blurred[uy * u32(SIDE) + ux + 1u], has_capture, rep);
     }
     pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y, a, b);
 }
 
-// A texel replenished by `rep` units, then deepened by its blurred capture `b` when it has one.
-fn merged(rec: SurfaceRecord, has_capture: bool, rep: u32, x: u32, y: u32, b: f32) -> vec2<u32> {
-    let old = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y);
-    return merge_channels(old, b, has_capture, rep);
-}
