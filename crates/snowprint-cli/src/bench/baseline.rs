@@ -153,6 +153,36 @@ impl CopyTimer {
     }
 }
 
+/// Timing of a `clear_buffer` of `bytes`, as the update clears its capture buffer before its first
+/// pass (outside the passes' timestamps), with encoder timestamps when the device has them.
+pub(super) struct ClearTimer {
+    buffer: wgpu::Buffer,
+    watch: Option<Stopwatch>,
+}
+
+impl ClearTimer {
+    pub(super) fn new(gpu: &GpuContext, bytes: u64) -> Self {
+        Self {
+            buffer: buffers(gpu, bytes).1,
+            watch: Stopwatch::new(gpu, wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
+        }
+    }
+
+    /// One clear, microseconds.
+    pub(super) fn time(&self, gpu: &GpuContext) -> Result<f64, String> {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        if let Some(w) = &self.watch {
+            enc.write_timestamp(&w.set, 0);
+        }
+        enc.clear_buffer(&self.buffer, 0, None);
+        if let Some(w) = &self.watch {
+            enc.write_timestamp(&w.set, 1);
+            w.resolve(&mut enc);
+        }
+        finish(gpu, enc, self.watch.as_ref())
+    }
+}
+
 /// Timing of the compute copy, with pass timestamps when the device has them.
 pub(super) struct ComputeCopyTimer {
     pipeline: wgpu::ComputePipeline,

@@ -16,7 +16,7 @@ mod baseline;
 
 use crate::output::OutputSet;
 use crate::progress::Progress;
-use baseline::{ComputeCopyTimer, CopyTimer};
+use baseline::{ClearTimer, ComputeCopyTimer, CopyTimer};
 
 /// Arguments of `snowprint bench`.
 #[derive(clap::Args, Debug)]
@@ -77,6 +77,12 @@ pub struct Row {
     pub compute_copy_us: f64,
     /// `update_us / compute_copy_us`.
     pub ratio_to_compute_copy: f64,
+    /// Median GPU time of clearing the capture buffer over the frame's capture regions (4 bytes a
+    /// texel of every captured surface and the apron around it), which the update records before
+    /// its first pass, outside the passes' timestamps and so outside `update_us`, microseconds.
+    pub capture_clear_us: f64,
+    /// `(update_us + capture_clear_us) / compute_copy_us`: the update with its capture cleared.
+    pub ratio_with_clear_to_compute_copy: f64,
     /// Pool bytes of the surfaces.
     pub pool_bytes: u64,
     /// Bytes per surface in the pool (both channels, slot alignment included).
@@ -279,18 +285,24 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     let bytes = c.surfaces as u64 * format.heights_bytes(c.resolution, c.resolution);
     let copy = CopyTimer::new(gpu, bytes);
     let compute_copy = ComputeCopyTimer::new(gpu, bytes);
-    let (mut copies, mut compute_copies) = (Vec::new(), Vec::new());
+    // Every surface is captured every frame (each has deformers over it).
+    let (rw, rh) = snowprint::low_level::capture::region(c.resolution, c.resolution);
+    let clear = ClearTimer::new(gpu, c.surfaces as u64 * rw as u64 * rh as u64 * 4);
+    let (mut copies, mut compute_copies, mut clears) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..args.warmup + args.frames {
         let t = copy.time(gpu)?;
-        let c = compute_copy.time(gpu)?;
+        let cc = compute_copy.time(gpu)?;
+        let cl = clear.time(gpu)?;
         if i >= args.warmup {
             copies.push(t);
-            compute_copies.push(c);
+            compute_copies.push(cc);
+            clears.push(cl);
         }
     }
     let update_us = median(&mut total);
     let copy_us = median(&mut copies);
     let compute_copy_us = median(&mut compute_copies);
+    let capture_clear_us = median(&mut clears);
     Ok(Row {
         sweep: c.sweep,
         surfaces: c.surfaces,
@@ -318,6 +330,8 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         ratio_to_copy: update_us / copy_us,
         compute_copy_us,
         ratio_to_compute_copy: update_us / compute_copy_us,
+        capture_clear_us,
+        ratio_with_clear_to_compute_copy: (update_us + capture_clear_us) / compute_copy_us,
         pool_bytes: world.memory().pool_used,
         bytes_per_surface: slot,
         memory: world.memory(),
@@ -490,7 +504,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         }
     );
     println!(
-        "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7}",
+        "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7} {:>9} {:>11}",
         "sweep",
         "mode",
         "bits",
@@ -508,13 +522,15 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         "copy_us",
         "x_copy",
         "ccopy_us",
-        "x_ccopy"
+        "x_ccopy",
+        "clear_us",
+        "x_ccopy+clr"
     );
     for r in rows {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2}",
+            "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2} {:>9.1} {:>11.2}",
             r.sweep,
             if r.fused { "fused" } else { "split" },
             r.precision_bits,
@@ -536,7 +552,9 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
             r.copy_us,
             r.ratio_to_copy,
             r.compute_copy_us,
-            r.ratio_to_compute_copy
+            r.ratio_to_compute_copy,
+            r.capture_clear_us,
+            r.ratio_with_clear_to_compute_copy
         );
     }
 }
