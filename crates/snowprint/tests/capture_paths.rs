@@ -241,3 +241,60 @@ fn analytic_deformers_alone_need_no_pass_over_the_atlas() {
     let stats = w.step(1.0 / 30.0, &[deformer(0, 0, 1, 0.5)]).unwrap();
     assert_eq!((stats.captured, stats.capture_batches), (1, 1));
 }
+
+/// The compute path leaves the capture buffer uncleared: it writes every texel of the tiles it
+/// takes and of the tiles beside them, all that the update may read. A surface pressed at one spot,
+/// whose region now lies where another surface's capture, pressed all over, lay the frame before,
+/// updates as the raster path (whose regions are cleared) updates it: none of the earlier capture
+/// is read back, with the fused pass on its grid or on its list of tiles.
+#[test]
+fn a_region_over_an_earlier_frames_capture_reads_none_of_it() {
+    for listed in [false, true] {
+        let mut worlds = [
+            world(CapturePath::Raster, listed),
+            world(CapturePath::Compute, listed),
+        ];
+        let first = SurfaceDesc::new("first", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3);
+        let second = SurfaceDesc::new("second", [10.0, 0.0, 0.0], [2.0, 2.0], 0.3);
+        let a = worlds[0].add_surface(first.clone()).unwrap();
+        let texel = 2.0 / worlds[0].layout(a).unwrap().width as f32;
+        worlds[1].add_surface(first.clone()).unwrap();
+        let ids = [
+            worlds[0].add_surface(second.clone()).unwrap(),
+            worlds[1].add_surface(second.clone()).unwrap(),
+        ];
+        // Frame 1: a ball 5 m across presses the first surface all over (to 10 cm above the ground
+        // at its corners), and a small one the second. Frame 2: only the small one, so the second
+        // surface's region comes first in the capture buffer, where the first's lay. It presses
+        // region tile 1 only (surface texels 16 to 19, the footprint's margin included), and flags
+        // surface tile 0 too, whose blur reads region tile 0.
+        let small = Deformer::new(
+            Shape::Sphere { radius: 0.05 },
+            Pose::at([10.0 - 1.0 + 18.0 * texel, 0.2, 0.0]),
+        );
+        let big = Deformer::new(Shape::Sphere { radius: 5.0 }, Pose::at([0.0, 4.95, 0.0]));
+        for w in &mut worlds {
+            w.step(1.0 / 30.0, &[big, small]).unwrap();
+            w.step(1.0 / 30.0, &[small]).unwrap();
+        }
+        let maps: Vec<_> = worlds
+            .iter()
+            .zip(ids)
+            .map(|(w, id)| w.read_heightmap(id).unwrap())
+            .collect();
+        assert!(
+            maps[0].depression.iter().any(|&d| d > 0),
+            "the small ball pressed"
+        );
+        let differ = |a: &[u16], b: &[u16]| a.iter().zip(b).filter(|(x, y)| x != y).count();
+        let (d, g) = (
+            differ(&maps[0].depression, &maps[1].depression),
+            differ(&maps[0].displaced, &maps[1].displaced),
+        );
+        assert_eq!(
+            (d, g),
+            (0, 0),
+            "texels that differ (depression, displaced), listed: {listed}"
+        );
+    }
+}

@@ -74,6 +74,10 @@ pub struct CapturePlan {
     pub texels: u32,
     /// Tile flags of the captured surfaces.
     pub tile_flags: u32,
+    /// Clear the capture over every captured region (the separate passes blur every texel of
+    /// them); else only over the raster path's, the compute path writing every texel it may be
+    /// read at.
+    pub clear_all: bool,
     /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
     /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`; the
     /// codes are laid out as the capture regions, apron included):
@@ -95,6 +99,28 @@ impl CapturePlan {
         self.texels = 0;
         self.tile_flags = 0;
         self.ground_copies.clear();
+        self.clear_all = false;
+    }
+
+    /// The capture buffer's ranges to clear before the capture, `(first texel, texels)`: the
+    /// regions of the surfaces the raster path captures (all of them with `clear_all`), those
+    /// that follow one another merged.
+    pub fn clears(&self) -> Vec<(u32, u32)> {
+        if self.clear_all {
+            return vec![(0, self.texels.max(1))];
+        }
+        let mut out: Vec<(u32, u32)> = Vec::new();
+        for (s, v) in self.surfaces.iter().zip(&self.views) {
+            if s.compute {
+                continue;
+            }
+            let texels = super::region_texels(s.width, s.height);
+            match out.last_mut() {
+                Some((start, len)) if *start + *len == v.offset => *len += texels,
+                _ => out.push((v.offset, texels)),
+            }
+        }
+        out
     }
 
     /// Texels of the winding buffer: it counts only mesh solids, so a frame of analytic deformers
@@ -174,7 +200,9 @@ pub fn encode(
         )],
     );
     // Nothing captured yet: 0 is the code of "no deformer over this texel".
-    enc.clear_buffer(buffers.capture, 0, Some(plan.texels.max(1) as u64 * 4));
+    for (first, texels) in plan.clears() {
+        enc.clear_buffer(buffers.capture, first as u64 * 4, Some(texels as u64 * 4));
+    }
     let winding = plan.winding_texels();
     if winding > 0 {
         enc.clear_buffer(buffers.winding, 0, Some(winding as u64 * 4));

@@ -167,8 +167,10 @@ pub fn footprint(p: &GpuPrimitive) -> [f32; 4] {
 /// Append to `work` an entry `[view, tile y << 16 | tile x]` for every 16 x 16 tile of the
 /// capture [`region`] of a `width` x `height` surface of half sides `half` that a footprint of
 /// `prims` reaches (a texel of margin around each, so that rounding never leaves out a texel the
-/// ray cast would hit); `seen` is scratch. The tiles are the region's (its first row and column
-/// are the apron), as the compute path's workgroups cover it.
+/// ray cast would hit), and then for every tile beside one of those (the update reads the capture
+/// one texel around the tiles the writes flag, and the compute path writes every texel of the
+/// tiles it takes, so that its regions need no clear); `seen` is scratch. The tiles are the
+/// region's (its first row and column are the apron), as the compute path's workgroups cover it.
 pub fn tiles_reached(
     prims: &[GpuPrimitive],
     (width, height): (u32, u32),
@@ -178,6 +180,7 @@ pub fn tiles_reached(
     work: &mut Vec<[u32; 2]>,
 ) {
     let tile = crate::pool::TILE_SIDE;
+    let first = work.len();
     let (rw, rh) = region(width, height);
     let (tx, ty) = (rw.div_ceil(tile), rh.div_ceil(tile));
     seen.clear();
@@ -212,6 +215,18 @@ pub fn tiles_reached(
                 if !seen[i] {
                     seen[i] = true;
                     work.push([view, r << 16 | c]);
+                }
+            }
+        }
+    }
+    for k in first..work.len() {
+        let (c, r) = (work[k][1] & 0xffff, work[k][1] >> 16);
+        for nr in r.saturating_sub(1)..=(r + 1).min(ty - 1) {
+            for nc in c.saturating_sub(1)..=(c + 1).min(tx - 1) {
+                let i = (nr * tx + nc) as usize;
+                if !seen[i] {
+                    seen[i] = true;
+                    work.push([view, nr << 16 | nc]);
                 }
             }
         }

@@ -3,7 +3,10 @@
 // list), every invocation one texel. The workgroup first
 // gathers the primitives whose footprints reach its tile; each texel then ray-casts those whose
 // footprint holds its centre and keeps the lowest, as the raster path's fragments do
-// (`write.wgsl`, shared). Surfaces that meshes press, or with more
+// (`write.wgsl`, shared), and writes it once, 0 where nothing presses. The work list holds each
+// tile once, with the tiles beside every reached one (`capture::tiles_reached`), so every texel
+// the update may read of a compute path's region is written this frame, and that region is not
+// cleared before. Surfaces that meshes press, or with more
 // primitives than `COMPUTE_PRIMS_MAX`, take the raster path (`capture.wgsl`); their views have no
 // primitives here and no entry in the work list.
 //
@@ -80,6 +83,8 @@ fn capture_prims(
     let c = vec2<f32>(cell) + vec2<f32>(0.5);
     let x = texel_center_of(v, c);
     let end = v.prims.x + v.prims.y;
+    var hit = false;
+    var best = 0u;
     for (var base = v.prims.x; base < end; base += 256u) {
         if li == 0u {
             atomicStore(&hit_count, 0u);
@@ -103,8 +108,20 @@ fn capture_prims(
             if any(x < max(f.xy, -reach)) || any(x > min(f.zw, reach)) {
                 continue;
             }
-            capture_prim(v, p, cell, c);
+            let code = prim_code(v, p, cell, c);
+            if code != NO_HIT {
+                hit = true;
+                best = max(best, code);
+            }
         }
         workgroupBarrier();
+    }
+    // The workgroup is the only one of the frame on its tile: it writes every texel, 0 where
+    // nothing presses, so the capture buffer needs no clear over the compute path's regions.
+    if inside {
+        atomicStore(&capture[texel_index_of(v, cell)], best);
+        if hit {
+            mark_tiles_of(v, cell);
+        }
     }
 }

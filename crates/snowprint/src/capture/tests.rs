@@ -53,7 +53,8 @@ proptest! {
 proptest! {
     /// The tiles listed are those of the capture region (the surface and its apron) whose cells
     /// the footprints (a texel wider) reach, cells taken with `floor` as the compute shader's
-    /// texels are: every tile once, in the order the footprints reach them.
+    /// texels are: every tile once, in the order the footprints reach them; then every tile of the
+    /// region beside one of those (its eight neighbours), once, in the reached tiles' order.
     #[test]
     fn tiles_reached_are_the_tiles_the_footprints_cover(
         caps in prop::collection::vec(
@@ -90,6 +91,17 @@ proptest! {
                     if !expected.contains(&[7, r << 16 | c]) {
                         expected.push([7, r << 16 | c]);
                     }
+                }
+            }
+        }
+        let (tiles_x, tiles_y) = ((w + 2).div_ceil(tile) as i64, (h + 2).div_ceil(tile) as i64);
+        for k in 0..expected.len() {
+            let (c, r) = ((expected[k][1] & 0xffff) as i64, (expected[k][1] >> 16) as i64);
+            for (dr, dc) in (-1..=1).flat_map(|dr| (-1..=1).map(move |dc| (dr, dc))) {
+                let (nr, nc) = (r + dr, c + dc);
+                let entry = [7, (nr as u32) << 16 | nc as u32];
+                if (0..tiles_y).contains(&nr) && (0..tiles_x).contains(&nc) && !expected.contains(&entry) {
+                    expected.push(entry);
                 }
             }
         }

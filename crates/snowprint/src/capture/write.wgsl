@@ -112,9 +112,15 @@ fn texel_index_of(v: CaptureView, cell: vec2<u32>) -> u32 {
     return v.offset + cell.y * region_of(v).x + cell.x;
 }
 
+// The code of a depth in [0, 1].
+fn depth_code(depth: f32) -> u32 {
+    return ONE_BITS - bitcast<u32>(clamp(depth, 0.0, 1.0));
+}
+
+// Keep a depth at region texel `cell`: its tiles flagged, the lowest code kept.
 fn keep_lowest_of(v: CaptureView, cell: vec2<u32>, depth: f32) {
     mark_tiles_of(v, cell);
-    atomicMax(&capture[texel_index_of(v, cell)], ONE_BITS - bitcast<u32>(clamp(depth, 0.0, 1.0)));
+    atomicMax(&capture[texel_index_of(v, cell)], depth_code(depth));
 }
 
 const BIG: f32 = 1e30;
@@ -222,8 +228,19 @@ fn region_half_of(v: CaptureView) -> vec2<f32> {
 }
 
 // Ray-cast primitive `p` under region texel `cell` (its centre `c` = cell + 0.5) and keep what it
-// presses.
+// presses (the raster path's fragment).
 fn capture_prim(v: CaptureView, p: Primitive, cell: vec2<u32>, c: vec2<f32>) {
+    let code = prim_code(v, p, cell, c);
+    if code != NO_HIT {
+        mark_tiles_of(v, cell);
+        atomicMax(&capture[texel_index_of(v, cell)], code);
+    }
+}
+
+// What primitive `p` presses under region texel `cell` (its centre `c` = cell + 0.5): the code of
+// its lowest point in the frustum, or NO_HIT where it leaves nothing (a code may be 0, a point at
+// the frustum's top, which still flags its tiles).
+fn prim_code(v: CaptureView, p: Primitive, cell: vec2<u32>, c: vec2<f32>) -> u32 {
     let x = texel_center_of(v, c);
     var iv: vec2<f32>;
     if p.kind.x == PRIM_CAPSULE {
@@ -237,9 +254,9 @@ fn capture_prim(v: CaptureView, p: Primitive, cell: vec2<u32>, c: vec2<f32>) {
     let g = ground_of(v, cell);
     iv -= vec2<f32>(g.x);
     if iv.x > iv.y || iv.y < g.y || iv.x >= v.frustum_height {
-        return;
+        return NO_HIT;
     }
-    keep_lowest_of(v, cell, max(iv.x, g.y) / v.frustum_height);
+    return depth_code(max(iv.x, g.y) / v.frustum_height);
 }
 
 // A primitive's footprint on the surface (local x, z): its bounding rectangle's corners.

@@ -20,6 +20,9 @@ const REFILL_GROUP: u32 = 256u;
 const REFILL_VECTORS: u32 = 4u;
 // Words before the entries of the capture's tile list: the dispatch arguments and the count.
 const TILE_LIST_HEADER: u32 = 4u;
+// What a primitive leaves at a texel it does not press (capture/write.wgsl's `prim_code`): above
+// every code of a depth in [0, 1].
+const NO_HIT: u32 = 0xffffffffu;
 // `record` of a capture view whose flagged tiles are not listed (the update runs its grid).
 const NO_LIST: u32 = 0xffffffffu;
 // `ground` of a capture view whose surface lies on flat ground (no ground field is read).

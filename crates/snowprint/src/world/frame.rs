@@ -156,7 +156,7 @@ impl SnowWorld {
             StageQueries::new(measured.filter(|_| slot.is_some()).map(|r| r.timestamps()));
         self.probes.footsteps.clear();
         for (j, updates) in layers.iter().enumerate() {
-            let plan = match first.take() {
+            let mut plan = match first.take() {
                 Some(plan) => plan,
                 None => {
                     let mut plan = std::mem::take(&mut self.scratch_cpu.plan);
@@ -171,7 +171,8 @@ impl SnowWorld {
             if !plan.is_empty() {
                 self.upload(&plan, (j > 0).then_some(&mut *encoder));
                 self.record(encoder, &plan, &mut queries, (j, dt));
-                remember_captures(&mut self.scratch_cpu.captured, &plan);
+                let s = &mut self.scratch_cpu;
+                remember_captures((&mut s.captured, &mut s.written), &mut plan);
             } else {
                 self.record_spray(encoder, &plan, j, dt, &mut queries);
             }
@@ -324,6 +325,7 @@ impl SnowWorld {
         self.scratch_cpu.settles.clear();
         self.probes_submitted();
         std::mem::swap(&mut self.last.captured, &mut self.scratch_cpu.captured);
+        std::mem::swap(&mut self.last.written, &mut self.scratch_cpu.written);
         self.free_deferred();
         // Probe answers that came back while the frame was being submitted.
         self.poll_probes_only();
@@ -620,7 +622,13 @@ fn uniform_blocks<T: bytemuck::Pod>(bytes: &mut Vec<u8>, items: &[T], min: usize
 }
 
 /// The captured surfaces of a frame, for the debug readbacks once it is submitted.
-fn remember_captures(captured: &mut Vec<(usize, SurfaceRecord)>, plan: &FramePlan) {
+fn remember_captures(
+    (captured, written): (&mut Vec<(usize, SurfaceRecord)>, &mut Vec<[u32; 2]>),
+    plan: &mut FramePlan,
+) {
+    // The work list is rebuilt next frame: the two lists trade places, each keeping its memory.
+    written.clear();
+    std::mem::swap(written, &mut plan.capture.work);
     captured.clear();
     captured.extend(plan.capture.surfaces.iter().map(|s| {
         let j = s.record as usize;

@@ -73,6 +73,8 @@ struct SurfaceState {
 struct LastFrame {
     /// (surface index, record) of every captured surface.
     captured: Vec<(usize, SurfaceRecord)>,
+    /// The compute path's work list (`[view, tile]`): the only tiles of its regions it wrote.
+    written: Vec<[u32; 2]>,
 }
 
 /// CPU memory one update reuses from the last, so that its cost does not grow with allocations.
@@ -89,6 +91,8 @@ struct FrameScratch {
     /// The settle states before a pending frame (see `carries`).
     settles: Vec<(usize, crate::relax::Settle)>,
     captured: Vec<(usize, SurfaceRecord)>,
+    /// A pending frame's compute work list (see `LastFrame::written`).
+    written: Vec<[u32; 2]>,
     /// By surface index, whether `carries` ([`KEPT_CARRY`]) and `settles` ([`KEPT_SETTLE`])
     /// already hold its state from before the frame (a flag a surface, not a search of the lists:
     /// a frame of thousands of surfaces would be quadratic).

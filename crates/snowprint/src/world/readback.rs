@@ -106,11 +106,12 @@ impl SnowWorld {
     /// `(c, r)` the surface's `(c - 1, r - 1)`).
     pub fn read_last_capture_region(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
         self.state(id)?;
-        let Some(&(_, r)) = self.last.captured.iter().find(|c| c.0 == id.0 as usize) else {
+        let Some(view) = self.last.captured.iter().position(|c| c.0 == id.0 as usize) else {
             return Ok(None);
         };
+        let r = self.last.captured[view].1;
         let texels = capture::region_texels(r.width, r.height);
-        let bytes = self.download(
+        let mut bytes = self.download(
             &self.capture.buffer,
             r.scratch as u64 * 4,
             texels as u64 * 4,
@@ -125,6 +126,9 @@ impl SnowWorld {
         } else {
             vec![0; texels as usize * 4]
         };
+        if r.batch == capture::COMPUTED {
+            self.unwritten_to_zero(view as u32, (r.width, r.height), &mut bytes);
+        }
         let codes: &[u32] = bytemuck::cast_slice(&bytes);
         let winding: &[i32] = bytemuck::cast_slice(&winding);
         // As capture_read.wgsl reads it: inside a mesh solid at the ground, depth 0, or on ground
@@ -152,6 +156,29 @@ impl SnowWorld {
                 })
                 .collect(),
         ))
+    }
+
+    /// The codes of a compute-path region (`bytes`, little-endian words) outside the tiles its
+    /// workgroups wrote, which the buffer holds from an earlier frame, read as 0 ("nothing"), as the
+    /// update, which never reads them, would find them.
+    fn unwritten_to_zero(&self, view: u32, (width, height): (u32, u32), bytes: &mut [u8]) {
+        let tile = crate::pool::TILE_SIDE;
+        let (rw, rh) = capture::region(width, height);
+        let tiles_x = rw.div_ceil(tile);
+        let mut written = vec![false; (tiles_x * rh.div_ceil(tile)) as usize];
+        for &[_, packed] in self.last.written.iter().filter(|w| w[0] == view) {
+            if let Some(w) =
+                written.get_mut(((packed >> 16) * tiles_x + (packed & 0xffff)) as usize)
+            {
+                *w = true;
+            }
+        }
+        for (i, word) in bytes.chunks_exact_mut(4).enumerate() {
+            let (x, y) = (i as u32 % rw, i as u32 / rw);
+            if written.get(((y / tile) * tiles_x + x / tile) as usize) != Some(&true) {
+                word.fill(0);
+            }
+        }
     }
 
     /// Debug readback of the last step: the blurred capture (stage 1 output) of a surface, when it
