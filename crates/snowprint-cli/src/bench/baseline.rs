@@ -157,6 +157,7 @@ impl CopyTimer {
 /// pass (outside the passes' timestamps), with encoder timestamps when the device has them.
 pub(super) struct ClearTimer {
     buffer: wgpu::Buffer,
+    bytes: u64,
     watch: Option<Stopwatch>,
 }
 
@@ -164,12 +165,16 @@ impl ClearTimer {
     pub(super) fn new(gpu: &GpuContext, bytes: u64) -> Self {
         Self {
             buffer: buffers(gpu, bytes).1,
+            bytes,
             watch: Stopwatch::new(gpu, wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
         }
     }
 
-    /// One clear, microseconds.
+    /// One clear, microseconds (0 for a clear of nothing).
     pub(super) fn time(&self, gpu: &GpuContext) -> Result<f64, String> {
+        if self.bytes == 0 {
+            return Ok(0.0);
+        }
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         if let Some(w) = &self.watch {
             enc.write_timestamp(&w.set, 0);

@@ -77,9 +77,10 @@ pub struct Row {
     pub compute_copy_us: f64,
     /// `update_us / compute_copy_us`.
     pub ratio_to_compute_copy: f64,
-    /// Median GPU time of clearing the capture buffer over the frame's capture regions (4 bytes a
-    /// texel of every captured surface and the apron around it), which the update records before
-    /// its first pass, outside the passes' timestamps and so outside `update_us`, microseconds.
+    /// Median GPU time of a clear of as many bytes as the update cleared of its capture buffer
+    /// (`FrameStats::cleared_capture_bytes`: the raster path's regions, every region with
+    /// separate passes), which it records before its first pass, outside the passes' timestamps
+    /// and so outside `update_us`, microseconds (0 when nothing was cleared).
     pub capture_clear_us: f64,
     /// `(update_us + capture_clear_us) / compute_copy_us`: the update with its capture cleared.
     pub ratio_with_clear_to_compute_copy: f64,
@@ -216,7 +217,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     let timestamps = world.has_timestamps();
     let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals, mut fused) =
         (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
-    let (mut gpu_times, mut measured_from) = (Vec::new(), u64::MAX);
+    let (mut gpu_times, mut measured_from, mut cleared) = (Vec::new(), u64::MAX, 0);
     for f in 0..args.warmup + args.frames {
         // Each surface is given the deformers over it, as a manager's spatial lookup would.
         let deformers: Vec<Vec<Deformer>> = centers
@@ -249,6 +250,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             continue;
         }
         cpu.push(stats.cpu_encode_ms * 1e3);
+        cleared = stats.cleared_capture_bytes;
         if !timestamps {
             total.push(wall);
         }
@@ -285,9 +287,8 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     let bytes = c.surfaces as u64 * format.heights_bytes(c.resolution, c.resolution);
     let copy = CopyTimer::new(gpu, bytes);
     let compute_copy = ComputeCopyTimer::new(gpu, bytes);
-    // Every surface is captured every frame (each has deformers over it).
-    let (rw, rh) = snowprint::low_level::capture::region(c.resolution, c.resolution);
-    let clear = ClearTimer::new(gpu, c.surfaces as u64 * rw as u64 * rh as u64 * 4);
+    // What the update's last frame cleared of the capture buffer.
+    let clear = ClearTimer::new(gpu, cleared);
     let (mut copies, mut compute_copies, mut clears) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..args.warmup + args.frames {
         let t = copy.time(gpu)?;

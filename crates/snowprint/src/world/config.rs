@@ -127,6 +127,10 @@ pub struct FrameStats {
     pub primitives: u32,
     /// Mesh draws.
     pub mesh_draws: u32,
+    /// Bytes of the capture buffer cleared before the capture: the raster path's regions (every
+    /// captured region with [`PassMode::Separate`]; the compute path writes all it may be read
+    /// at). The clear is recorded before the first pass, outside [`FrameStats::gpu`]'s times.
+    pub cleared_capture_bytes: u64,
     /// CPU time spent building and encoding the frame, milliseconds.
     pub cpu_encode_ms: f64,
     /// The world's number of this frame: 1 for its first update, one more for each after.
@@ -148,6 +152,7 @@ impl FrameStats {
         self.capture_batches += layer.capture_batches;
         self.primitives += layer.primitives;
         self.mesh_draws += layer.mesh_draws;
+        self.cleared_capture_bytes += layer.cleared_capture_bytes;
     }
 }
 

@@ -302,6 +302,7 @@ impl FramePlan {
             capture_batches: self.capture.batches,
             primitives: self.capture.prims.len() as u32,
             mesh_draws: self.capture.draws.len() as u32,
+            cleared_capture_bytes: self.capture.clears().iter().map(|c| c.1 as u64 * 4).sum(),
             ..Default::default()
         }
     }
@@ -534,6 +535,7 @@ impl FramePlan {
             .map(|j| j.record.tile_count() as u64)
             .sum();
         let listed = fused && flagged > 0 && flagged >= settings.list_tiles_from as u64;
+        self.capture.clear_all = !fused;
         let a = &mut self.accumulate;
         a.fused = fused;
         a.normals = settings.format.normals;
