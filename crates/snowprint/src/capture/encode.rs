@@ -46,6 +46,9 @@ pub struct CapturedSurface {
     pub draws: Range<u32>,
     /// Whether the compute path captures it (its view's `prims` and `rect`; no viewport).
     pub compute: bool,
+    /// Whether its region is cleared before the capture: always on the raster path; on the compute
+    /// path unless its work list took the tiles beside the reached ones ([`super::tiles_reached`]).
+    pub cleared: bool,
 }
 
 /// What a frame's capture draws: one [`CapturedSurface`] and one [`CaptureView`] per captured
@@ -75,8 +78,7 @@ pub struct CapturePlan {
     /// Tile flags of the captured surfaces.
     pub tile_flags: u32,
     /// Clear the capture over every captured region (the separate passes blur every texel of
-    /// them); else only over the raster path's, the compute path writing every texel it may be
-    /// read at.
+    /// them); else only over those marked `cleared`.
     pub clear_all: bool,
     /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
     /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`; the
@@ -103,15 +105,15 @@ impl CapturePlan {
     }
 
     /// The capture buffer's ranges to clear before the capture, `(first texel, texels)`: the
-    /// regions of the surfaces the raster path captures (all of them with `clear_all`), those
-    /// that follow one another merged.
+    /// regions of the surfaces marked `cleared` (all of them with `clear_all`), those that follow
+    /// one another merged.
     pub fn clears(&self) -> Vec<(u32, u32)> {
         if self.clear_all {
             return vec![(0, self.texels.max(1))];
         }
         let mut out: Vec<(u32, u32)> = Vec::new();
         for (s, v) in self.surfaces.iter().zip(&self.views) {
-            if s.compute {
+            if !s.cleared {
                 continue;
             }
             let texels = super::region_texels(s.width, s.height);

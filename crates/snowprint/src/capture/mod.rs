@@ -167,9 +167,10 @@ pub fn footprint(p: &GpuPrimitive) -> [f32; 4] {
 /// Append to `work` an entry `[view, tile y << 16 | tile x]` for every 16 x 16 tile of the
 /// capture [`region`] of a `width` x `height` surface of half sides `half` that a footprint of
 /// `prims` reaches (a texel of margin around each, so that rounding never leaves out a texel the
-/// ray cast would hit), and then for every tile beside one of those (the update reads the capture
-/// one texel around the tiles the writes flag, and the compute path writes every texel of the
-/// tiles it takes, so that its regions need no clear); `seen` is scratch. The tiles are the
+/// ray cast would hit), and then, when they are few ([`SPARSE_TILES`]), every tile beside one of
+/// those: the update reads the capture one texel around the tiles the writes flag, and the compute
+/// path writes every texel of the tiles it takes, so that such a region needs no clear. Returns
+/// whether it took them (else the region is cleared). `seen` is scratch. The tiles are the
 /// region's (its first row and column are the apron), as the compute path's workgroups cover it.
 pub fn tiles_reached(
     prims: &[GpuPrimitive],
@@ -178,7 +179,7 @@ pub fn tiles_reached(
     view: u32,
     seen: &mut Vec<bool>,
     work: &mut Vec<[u32; 2]>,
-) {
+) -> bool {
     let tile = crate::pool::TILE_SIDE;
     let first = work.len();
     let (rw, rh) = region(width, height);
@@ -219,7 +220,8 @@ pub fn tiles_reached(
             }
         }
     }
-    for k in first..work.len() {
+    let reached = work.len();
+    for k in first..reached {
         let (c, r) = (work[k][1] & 0xffff, work[k][1] >> 16);
         for nr in r.saturating_sub(1)..=(r + 1).min(ty - 1) {
             for nc in c.saturating_sub(1)..=(c + 1).min(tx - 1) {
@@ -231,7 +233,17 @@ pub fn tiles_reached(
             }
         }
     }
+    let sparse = (work.len() - reached) as u64 * SPARSE_TILES < (tx * ty) as u64;
+    if !sparse {
+        work.truncate(reached);
+    }
+    sparse
 }
+
+/// A compute region takes the tiles beside its reached ones, instead of being cleared, while they
+/// are fewer than its tiles over this: on the H100 a workgroup over a tile costs about nine times
+/// a clear of the tile's bytes (`docs/PERFORMANCE.md`, "The capture cleared only where needed").
+pub const SPARSE_TILES: u64 = 9;
 
 /// `batch` of a surface record captured by the compute path (no pass over the atlas; anything but
 /// `NO_CAPTURE` tells the update that the capture holds its texels).

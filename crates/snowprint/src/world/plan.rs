@@ -574,12 +574,13 @@ impl FramePlan {
                 prims: job.prims.clone(),
                 draws: job.draws.clone(),
                 compute: job.compute,
+                cleared: true,
             });
             if job.compute {
                 let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
                 let view = c.views.len() as u32;
                 let size = (r.width, r.height);
-                capture::tiles_reached(
+                let sparse = capture::tiles_reached(
                     prims,
                     size,
                     job.half_size,
@@ -587,6 +588,9 @@ impl FramePlan {
                     &mut self.seen,
                     &mut c.work,
                 );
+                if let Some(s) = c.surfaces.last_mut() {
+                    s.cleared = !sparse;
+                }
             }
             c.views.push(CaptureView {
                 half_size: job.half_size.to_array(),
