@@ -145,6 +145,11 @@ pub struct CaptureView {
     pub ground: u32,
     /// Compute path: its primitives (first, count); count 0 on the raster path.
     pub prims: [u32; 2],
+    /// Compute path: 1 where its region is not cleared and each tile the work list takes is
+    /// written whole ([`tiles_reached`]); else 0.
+    pub whole: u32,
+    /// Padding to the WGSL struct's 8-byte alignment.
+    pub _pad: u32,
 }
 
 /// A primitive's footprint on its surface: the corners of its bounding rectangle, local `(x, z)`.

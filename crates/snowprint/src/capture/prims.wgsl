@@ -3,10 +3,10 @@
 // list), every invocation one texel. The workgroup first
 // gathers the primitives whose footprints reach its tile; each texel then ray-casts those whose
 // footprint holds its centre and keeps the lowest, as the raster path's fragments do
-// (`write.wgsl`, shared), and writes it once, 0 where nothing presses. The work list holds each
-// tile once, with the tiles beside every reached one (`capture::tiles_reached`), so every texel
-// the update may read of a compute path's region is written this frame, and that region is not
-// cleared before. Surfaces that meshes press, or with more
+// (`write.wgsl`, shared), and writes it once. The work list holds each tile once; for a region
+// whose reached tiles are few it holds the tiles beside them too (`capture::tiles_reached`), and
+// such a region (`whole`) is not cleared before: its workgroups write every texel, 0 where nothing
+// presses, so every texel the update may read of it is written this frame. Surfaces that meshes press, or with more
 // primitives than `COMPUTE_PRIMS_MAX`, take the raster path (`capture.wgsl`); their views have no
 // primitives here and no entry in the work list.
 //
@@ -48,6 +48,7 @@ fn view_at(k: u32) -> CaptureView {
         table[b + 10u],
         table[b + 11u],
         vec2<u32>(table[b + 12u], table[b + 13u]),
+        table[b + 14u],
     );
 }
 
@@ -116,12 +117,13 @@ fn capture_prims(
         }
         workgroupBarrier();
     }
-    // The workgroup is the only one of the frame on its tile: it writes every texel, 0 where
-    // nothing presses, so the capture buffer needs no clear over the compute path's regions.
-    if inside {
+    // The workgroup is the only one of the frame on its tile. Over a region that is not cleared
+    // (`whole`) it writes every texel, 0 where nothing presses; over a cleared one, only where
+    // something does.
+    if inside && (hit || v.whole != 0u) {
         atomicStore(&capture[texel_index_of(v, cell)], best);
-        if hit {
-            mark_tiles_of(v, cell);
-        }
+    }
+    if inside && hit {
+        mark_tiles_of(v, cell);
     }
 }

@@ -24,6 +24,7 @@ struct CaptureView {
     record: u32,            // the surface's record in the update, or NO_LIST
     ground: u32,            // first texel of the surface's ground field in `ground`, or NO_GROUND
     prims: vec2<u32>,       // compute path: its primitives (first, count); count 0 on the raster path
+    whole: u32,             // compute path: 1 where its region is not cleared (each tile written whole)
 }
 // Must match `CaptureView` in capture/mod.rs.
 

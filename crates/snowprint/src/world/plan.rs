@@ -576,6 +576,7 @@ impl FramePlan {
                 compute: job.compute,
                 cleared: true,
             });
+            let mut whole = 0;
             if job.compute {
                 let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
                 let view = c.views.len() as u32;
@@ -591,6 +592,7 @@ impl FramePlan {
                 if let Some(s) = c.surfaces.last_mut() {
                     s.cleared = !sparse;
                 }
+                whole = u32::from(sparse);
             }
             c.views.push(CaptureView {
                 half_size: job.half_size.to_array(),
@@ -607,6 +609,8 @@ impl FramePlan {
                 } else {
                     [0, 0]
                 },
+                whole,
+                _pad: 0,
             });
         }
         if self.jobs.is_empty() {
