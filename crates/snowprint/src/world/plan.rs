@@ -509,8 +509,9 @@ impl FramePlan {
         }
     }
 
-    /// Records, views, the accumulation's dispatch shape and the buffer sizes.
-    fn write_tables(&mut self, settings: &PlanSettings) {
+    /// The accumulation's dispatch shape: which records the refill streams, whether the fused
+    /// pass lists its tiles, what its grid covers, and whether every capture region is cleared.
+    fn accumulation_shape(&mut self, settings: &PlanSettings) {
         let dense = self
             .jobs
             .iter()
@@ -552,6 +553,12 @@ impl FramePlan {
         a.grid = if listed { tiled } else { self.jobs.len() } as u32;
         a.max_width = self.jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         a.max_height = self.jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
+    }
+
+    /// Records, views, the accumulation's dispatch shape and the buffer sizes.
+    fn write_tables(&mut self, settings: &PlanSettings) {
+        self.accumulation_shape(settings);
+        let a = &mut self.accumulate;
         let c = &mut self.capture;
         for (j, job) in self.jobs.iter().enumerate() {
             self.surfaces.push(job.surface);
@@ -602,7 +609,7 @@ impl FramePlan {
                 texels: [r.width as f32, r.height as f32],
                 tiles: r.tiles,
                 tiles_x: r.width.div_ceil(TILE_SIDE),
-                record: if listed { j as u32 } else { capture::NO_LIST },
+                record: if a.listed { j as u32 } else { capture::NO_LIST },
                 ground: job.ground_offset,
                 prims: if job.compute {
                     [job.prims.start, job.prims.len() as u32]
@@ -652,7 +659,7 @@ impl FramePlan {
             prims: std::mem::size_of_val(c.prims.as_slice()) as u64,
             draws: c.draws.len() as u64 * UNIFORM_STRIDE,
             // The blurred capture goes through memory only when blur and merge are separate.
-            scratch: if fused { 0 } else { texels },
+            scratch: if self.accumulate.fused { 0 } else { texels },
             capture: texels,
             winding: c.winding_texels() as u64 * 4,
             tiles: c.tile_flags.max(1) as u64 * 4,
