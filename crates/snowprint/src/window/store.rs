@@ -114,9 +114,7 @@ impl StripStore {
     }
 
     /// A store of saved pages (each checked by [`check_page`], no key twice).
-    pub(crate) fn from_pages(
-        pages: impl IntoIterator<Item = ((usize, i64, i64), Vec<u8>)>,
-    ) -> Self {
+    pub(crate) fn from_pages(pages: impl IntoIterator<Item = (PageKey, Vec<u8>)>) -> Self {
         let mut store = Self::default();
         for (key, compressed) in pages {
             store.bytes += compressed.len() as u64;

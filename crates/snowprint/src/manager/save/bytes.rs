@@ -69,6 +69,22 @@ impl<'a> Reader<'a> {
         Ok(n as usize)
     }
 
+    /// A counted run of 4-byte little-endian words (the count a u64, checked against the bytes
+    /// left), as the writers lay a count and then the words.
+    pub(super) fn words(&mut self, what: &str) -> std::result::Result<Vec<u32>, String> {
+        let n = self.count(4, what)?;
+        Ok(self
+            .take(n * 4, what)?
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect())
+    }
+
+    /// [`Reader::words`] read as `f32`s.
+    pub(super) fn floats(&mut self, what: &str) -> std::result::Result<Vec<f32>, String> {
+        Ok(self.words(what)?.into_iter().map(f32::from_bits).collect())
+    }
+
     pub(super) fn done(&self, what: &str) -> std::result::Result<(), String> {
         if self.at == self.bytes.len() {
             Ok(())

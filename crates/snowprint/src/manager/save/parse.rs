@@ -245,12 +245,7 @@ pub(super) fn read_surface(
     let width = r.u32("its width")?;
     let height = r.u32("its height")?;
     let carry = r.f64("its carry")?;
-    let n = r.count(4, "its words")?;
-    let words: Vec<u32> = r
-        .take(n * 4, "its words")?
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
+    let words = r.words("its words")?;
     r.done("a heightmap")?;
     let desc = plan
         .surfaces
@@ -291,12 +286,7 @@ pub(super) fn read_ground(
         full_degrees: r.f32("its slope rule")?,
         bare_degrees: r.f32("its slope rule")?,
     };
-    let n = r.count(4, "its heights")?;
-    let heights: Vec<f32> = r
-        .take(n * 4, "its heights")?
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
+    let heights = r.floats("its heights")?;
     r.done("a ground")?;
     let desc = &plan
         .surfaces
@@ -309,11 +299,15 @@ pub(super) fn read_ground(
         })?
         .desc;
     let layout = desc.layout();
-    if (width, height) != (layout.width, layout.height) || n as u64 != width as u64 * height as u64
+    if (width, height) != (layout.width, layout.height)
+        || heights.len() as u64 != width as u64 * height as u64
     {
         return Err(format!(
-            "surface {:?}'s ground is {width} x {height} texels with {n} heights, its heightmap {} x {}",
-            desc.name, layout.width, layout.height
+            "surface {:?}'s ground is {width} x {height} texels with {} heights, its heightmap {} x {}",
+            desc.name,
+            heights.len(),
+            layout.width,
+            layout.height
         ));
     }
     if heights.iter().any(|h| !h.is_finite()) {

@@ -160,12 +160,7 @@ pub(super) fn read_terrain(
     let head: SavedDesc = serde_json::from_slice(r.take(n, "its description")?)
         .map_err(|e| format!("its description does not read: {e}"))?;
     let name = head.name.clone();
-    let n = r.count(4, "its ground's heights")?;
-    let heights: Vec<f32> = r
-        .take(n * 4, "its ground's heights")?
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
+    let heights = r.floats("its ground's heights")?;
     let desc = description(head, heights)?;
     let format = config.format;
     crate::window::validate_for(&desc, format, config.atlas_side, config.pool_bytes)
@@ -182,12 +177,7 @@ pub(super) fn read_terrain(
         let origin = [r.i64("a level's origin")?, r.i64("a level's origin")?];
         let offset = r.u64("a level's slot")?;
         let carry = r.f64("a level's carry")?;
-        let n = r.count(4, "a level's words")?;
-        let words: Vec<u32> = r
-            .take(n * 4, "a level's words")?
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
+        let words = r.words("a level's words")?;
         let [w, h] = l.texels;
         let unit = format.precision.unit_texels() as i64;
         let far = origin
