@@ -80,6 +80,9 @@ pub struct CapturePlan {
     /// Clear the capture over every captured region (the separate passes blur every texel of
     /// them); else only over those marked `cleared`.
     pub clear_all: bool,
+    /// The capture buffer's ranges cleared before the capture, `(first texel, texels)`
+    /// ([`CapturePlan::plan_clears`]).
+    pub clears: Vec<(u32, u32)>,
     /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
     /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`; the
     /// codes are laid out as the capture regions, apron included):
@@ -102,27 +105,28 @@ impl CapturePlan {
         self.tile_flags = 0;
         self.ground_copies.clear();
         self.clear_all = false;
+        self.clears.clear();
     }
 
-    /// The capture buffer's ranges to clear before the capture, `(first texel, texels)`: the
-    /// regions of the surfaces marked `cleared` (all of them with `clear_all`), those that follow
-    /// one another merged.
-    pub fn clears(&self) -> Vec<(u32, u32)> {
+    /// Fill [`CapturePlan::clears`] once the surfaces and views are planned: the regions of the
+    /// surfaces marked `cleared` (all of them with `clear_all`), those that follow one another
+    /// merged.
+    pub fn plan_clears(&mut self) {
+        self.clears.clear();
         if self.clear_all {
-            return vec![(0, self.texels.max(1))];
+            self.clears.push((0, self.texels.max(1)));
+            return;
         }
-        let mut out: Vec<(u32, u32)> = Vec::new();
         for (s, v) in self.surfaces.iter().zip(&self.views) {
             if !s.cleared {
                 continue;
             }
             let texels = super::region_texels(s.width, s.height);
-            match out.last_mut() {
+            match self.clears.last_mut() {
                 Some((start, len)) if *start + *len == v.offset => *len += texels,
-                _ => out.push((v.offset, texels)),
+                _ => self.clears.push((v.offset, texels)),
             }
         }
-        out
     }
 
     /// Texels of the winding buffer: it counts only mesh solids, so a frame of analytic deformers
@@ -202,7 +206,7 @@ pub fn encode(
         )],
     );
     // Nothing captured yet: 0 is the code of "no deformer over this texel".
-    for (first, texels) in plan.clears() {
+    for &(first, texels) in &plan.clears {
         enc.clear_buffer(buffers.capture, first as u64 * 4, Some(texels as u64 * 4));
     }
     let winding = plan.winding_texels();

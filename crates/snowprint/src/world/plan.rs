@@ -302,7 +302,7 @@ impl FramePlan {
             capture_batches: self.capture.batches,
             primitives: self.capture.prims.len() as u32,
             mesh_draws: self.capture.draws.len() as u32,
-            cleared_capture_bytes: self.capture.clears().iter().map(|c| c.1 as u64 * 4).sum(),
+            cleared_capture_bytes: self.capture.clears.iter().map(|c| c.1 as u64 * 4).sum(),
             ..Default::default()
         }
     }
@@ -620,6 +620,7 @@ impl FramePlan {
                 _pad: 0,
             });
         }
+        c.plan_clears();
         if self.jobs.is_empty() {
             return;
         }

@@ -363,6 +363,8 @@ fn surfaces_that_refill_come_first_and_the_rest_are_listed() {
     let plan = FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes);
     assert!(!plan.accumulate.fused && !plan.accumulate.listed);
     assert_eq!(plan.accumulate.refill, 0, "the separate merge refills");
+    // Their blur reads every texel of every captured region: the whole capture is cleared.
+    assert_eq!(plan.capture.clears, vec![(0, plan.capture.texels)]);
     assert_eq!(plan.sizes.scratch, plan.sizes.capture);
 }
 
