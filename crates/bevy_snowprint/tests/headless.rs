@@ -184,7 +184,7 @@ fn a_device_short_of_the_limits_is_said_in_one_sentence() {
         Some(bevy_snowprint::SnowStatus::Unavailable(sentence)) => {
             eprintln!("{sentence}");
             assert!(
-                sentence.contains("max_storage_buffers_per_shader_stage to be at least 6")
+                sentence.contains("max_storage_buffers_per_shader_stage to be at least 8")
                     && sentence.contains("has 4")
                     && sentence.contains("WgpuSettings"),
                 "{sentence}"

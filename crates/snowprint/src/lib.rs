@@ -165,10 +165,10 @@ pub mod low_level {
     /// The capture pass: pipelines, primitives, atlas packing and `encode`.
     pub mod capture {
         pub use crate::capture::{
-            APRON, ATLAS_FORMAT, AtlasPlacement, CaptureBuffers, CaptureMesh, CapturePipelines,
-            CapturePlan, CaptureView, CaptureVolume, CapturedSurface, GpuPrimitive,
-            MAX_MESH_SUBSTEPS, MAX_SUBSTEPS, MESH_STEP, MeshDraw, NO_LIST, ONE_BITS, PRIM_BOX,
-            PRIM_CAPSULE, decode_depth, encode, encode_depth, mesh_substeps, pack_atlas,
+            APRON, ATLAS_FORMAT, AtlasPlacement, CAST, CAST_PRIMS_MAX, CaptureBuffers, CaptureMesh,
+            CapturePipelines, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
+            GpuPrimitive, MAX_MESH_SUBSTEPS, MAX_SUBSTEPS, MESH_STEP, MeshDraw, NO_LIST, ONE_BITS,
+            PRIM_BOX, PRIM_CAPSULE, decode_depth, encode, encode_depth, mesh_substeps, pack_atlas,
             pack_atlas_compact, push_mesh_draws, push_primitives, region, region_texels,
             strip_apron, substeps,
         };
@@ -187,8 +187,8 @@ pub mod low_level {
     /// The heightmap pool: slot allocator and the per-surface record the passes read.
     pub mod pool {
         pub use crate::pool::{
-            MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN, Slot,
-            SlotAllocator, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+            MODE_CAST, MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, SLOT_ALIGN,
+            Slot, SlotAllocator, SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
         };
     }
     /// The render graph: the pass table and its check.

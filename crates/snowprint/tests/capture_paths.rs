@@ -298,3 +298,135 @@ fn a_region_over_an_earlier_frames_capture_reads_none_of_it() {
         );
     }
 }
+
+/// The heightmaps of every surface after each frame of a random world run with `first` and then
+/// with `second`, the update on its list of tiles or on its grid, the snowfall streamed or not.
+fn heightmaps_of_two_paths(
+    paths: [CapturePath; 2],
+    (listed, streamed): (bool, bool),
+    spots: &[Spot],
+    per: u32,
+    seed: f32,
+) -> Vec<[Vec<u16>; 2]> {
+    let mut worlds = paths.map(|path| {
+        SnowWorld::new(
+            common::gpu(),
+            WorldConfig {
+                capture_path: path,
+                list_tiles_from: if listed { 0 } else { u32::MAX },
+                refill_stream_from: if streamed { 0 } else { u32::MAX },
+                ..WorldConfig::default()
+            },
+        )
+        .expect("world")
+    });
+    let descs: Vec<SurfaceDesc> = spots.iter().enumerate().map(|(i, s)| desc(i, s)).collect();
+    let mut ids: Vec<SurfaceId> = Vec::new();
+    for w in &mut worlds {
+        ids.clear();
+        for (d, s) in descs.iter().zip(spots) {
+            let id = w.add_surface(d.clone()).unwrap();
+            if s.hills {
+                w.set_ground(id, &hills(d), SlopeRule::default()).unwrap();
+            }
+            ids.push(id);
+        }
+    }
+    let mut maps = Vec::new();
+    for f in 0..5 {
+        let ds: Vec<Deformer> = (0..spots.len())
+            .flat_map(|i| (0..per).map(move |k| deformer(i, k, f, seed)))
+            .collect();
+        for w in &mut worlds {
+            w.step(1.0 / 30.0, &ds).unwrap();
+        }
+        for &id in &ids {
+            maps.push(worlds.each_ref().map(|w| {
+                let m = w.read_heightmap(id).unwrap();
+                m.depression.iter().chain(&m.displaced).copied().collect()
+            }));
+        }
+    }
+    maps
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4))]
+
+    /// The update's own ray cast (`CapturePath::Update`: no capture) leaves every heightmap, after
+    /// every frame, as the compute path's capture does, bit for bit: on hills and on flat ground,
+    /// yawed, with the update on its grid (the tiles test the footprints) and on its list (the plan
+    /// lists the tiles), snow refilling in the fused pass or streamed before it.
+    #[test]
+    fn the_updates_own_ray_cast_gives_the_compute_paths_heights(
+        spots in prop::collection::vec(
+            ((1.5f32..6.0, 1.5f32..6.0), -60.0f32..60.0, any::<bool>())
+                .prop_map(|(size, yaw, hills)| Spot { size, yaw, hills }),
+            1..4,
+        ),
+        per in 1u32..12,
+        seed in 0.0f32..1.0,
+        listed in any::<bool>(),
+        streamed in any::<bool>(),
+    ) {
+        let paths = [CapturePath::Compute, CapturePath::Update];
+        let maps = heightmaps_of_two_paths(paths, (listed, streamed), &spots, per, seed);
+        prop_assert!(maps.iter().any(|[a, _]| a.iter().any(|&v| v > 0)), "nothing pressed");
+        for (k, [a, b]) in maps.iter().enumerate() {
+            let diff = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            prop_assert_eq!(diff, 0, "frame {} surface {} differs", k / spots.len(), k % spots.len());
+        }
+    }
+}
+
+/// A surface the update ray-casts has no capture: no pass over the atlas, no bytes cleared, nothing
+/// to read back; one pressed by more primitives than the update casts is captured by the compute
+/// path, in the same frame.
+#[test]
+fn what_the_update_casts_is_not_captured() {
+    let mut w = world(CapturePath::Update, false);
+    let few = w
+        .add_surface(desc(
+            0,
+            &Spot {
+                size: (4.0, 3.0),
+                yaw: 20.0,
+                hills: false,
+            },
+        ))
+        .unwrap();
+    let many = w
+        .add_surface(desc(
+            1,
+            &Spot {
+                size: (4.0, 3.0),
+                yaw: 0.0,
+                hills: false,
+            },
+        ))
+        .unwrap();
+    let mut ds = vec![deformer(0, 0, 1, 0.5)];
+    // Resting spheres (one primitive each) over the second surface, more than the update casts.
+    let n = snowprint::low_level::capture::CAST_PRIMS_MAX + 1;
+    ds.extend((0..n).map(|k| {
+        Deformer::new(
+            Shape::Sphere { radius: 0.05 },
+            Pose::at([12.0 - 1.5 + 0.09 * k as f32, 1.02, 0.0]),
+        )
+    }));
+    let stats = w.step(1.0 / 30.0, &ds).unwrap();
+    assert_eq!((stats.captured, stats.capture_batches), (2, 0));
+    assert!(
+        w.read_last_capture(few).unwrap().is_none(),
+        "cast: nothing captured"
+    );
+    let captured = w
+        .read_last_capture(many)
+        .unwrap()
+        .expect("the compute path's capture");
+    assert!(captured.iter().any(|&d| d < 1.0));
+    for id in [few, many] {
+        let m = w.read_heightmap(id).unwrap();
+        assert!(m.depression.iter().any(|&d| d > 0), "pressed");
+    }
+}

@@ -65,6 +65,11 @@ pub struct AccumulateBuffers<'a> {
     pub tiles: &'a wgpu::Buffer,
     /// The capture's tile list with its indirect dispatch.
     pub tile_list: &'a wgpu::Buffer,
+    /// The capture's analytic primitives, which the fused pass ray-casts for the records marked
+    /// [`MODE_CAST`](crate::pool::MODE_CAST).
+    pub prims: &'a wgpu::Buffer,
+    /// The surfaces' ground fields (the capture's), read by that ray cast.
+    pub ground: &'a wgpu::Buffer,
 }
 
 /// Record a frame's accumulation: fused (or blur then merge), then normals when kept; each a
@@ -104,6 +109,8 @@ pub fn encode_update(
                 b.winding.as_entire_binding(),
                 b.tiles.as_entire_binding(),
                 b.tile_list.as_entire_binding(),
+                b.prims.as_entire_binding(),
+                b.ground.as_entire_binding(),
             ],
         );
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {

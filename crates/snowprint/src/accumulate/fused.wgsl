@@ -12,11 +12,15 @@
 // with nothing to deepen or refill leaves at once), and `fused_listed`, one workgroup per tile in
 // the capture's tile list for the records whose every tile the grid does not take (a record
 // refilled here and not by refill.wgsl), dispatched indirectly (seal.wgsl writes the arguments).
-// Reads: `records`, `tiles`, `tile_list`, `capture`, `winding`, each record's heights in `pool`.
+// A record marked MODE_CAST has no capture: its tiles ray-cast its primitives themselves
+// (cast.wgsl), on the grid where they reach the tile and in the list where the plan listed them.
+// Reads: `records`, `tiles`, `tile_list`, `capture`, `winding`, `prims`, `ground`, each record's
+// heights in `pool`.
 // Writes: the same heights regions.
-// CPU reference: accumulate::cpu::blur then merge_channels. Maths: maths.wgsl, capture_read.wgsl.
+// CPU reference: accumulate::cpu::blur then merge_channels. Maths: maths.wgsl, capture_read.wgsl,
+// cast.wgsl.
 
-// import maths, capture_read, texel_write
+// import maths, capture_read, texel_write, update_cast
 
 @group(0) @binding(0) var<storage, read> records: array<SurfaceRecord>;
 @group(0) @binding(1) var<storage, read> capture: array<u32>;
@@ -24,6 +28,8 @@
 @group(0) @binding(3) var<storage, read> winding: array<i32>;
 @group(0) @binding(4) var<storage, read> tiles: array<u32>;
 @group(0) @binding(5) var<storage, read> tile_list: array<u32>;
+@group(0) @binding(6) var<storage, read> prims: array<Primitive>;
+@group(0) @binding(7) var<storage, read> ground: array<vec2<f32>>;
 
 const SIDE: i32 = i32(TILE);
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
@@ -41,8 +47,9 @@ fn fused(
     if i32(wid.x) * SIDE >= i32(rec.width) || i32(wid.y) * SIDE >= i32(rec.height) {
         return;
     }
+    let casts = (rec.mode & MODE_CAST) != 0u;
     var has_capture = rec.batch != NO_CAPTURE;
-    if has_capture {
+    if has_capture && !casts {
         let tiles_x = (rec.width + u32(SIDE) - 1u) / u32(SIDE);
         has_capture = tiles[rec.tiles + wid.y * tiles_x + wid.x] != 0u;
     }
@@ -52,7 +59,15 @@ fn fused(
     if !has_capture && rep == 0u {
         return;
     }
-    update_tile(rec, wid.xy, has_capture, rep, lid, local.xy);
+    var mask = 0u;
+    if casts {
+        mask = cast_mask(rec, vec2<i32>(wid.xy) * SIDE - vec2<i32>(1), DEP, lid);
+        has_capture = mask != 0u;
+        if !has_capture && rep == 0u {
+            return;
+        }
+    }
+    update_tile(rec, wid.xy, has_capture, mask, rep, lid, local.xy);
 }
 
 @compute @workgroup_size(TILE, TILE, 1)
@@ -72,7 +87,16 @@ fn fused_listed(
         return;
     }
     let t = tile_list[5u + 2u * i];
-    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, 0u, lid, local.xy);
+    let tile = vec2<u32>(t & 0xffffu, t >> 16u);
+    var mask = 0u;
+    if (rec.mode & MODE_CAST) != 0u {
+        // The plan lists a cast record's tiles from the primitives' footprints, a margin around.
+        mask = cast_mask(rec, vec2<i32>(tile) * SIDE - vec2<i32>(1), DEP, lid);
+        if mask == 0u {
+            return;
+        }
+    }
+    update_tile(rec, tile, true, mask, 0u, lid, local.xy);
 }
 
 // Units this pass replenishes a record by: none where refill.wgsl refilled it.
@@ -80,9 +104,9 @@ fn replenished(rec: SurfaceRecord) -> u32 {
     return select(rec.replenish_units, 0u, (rec.mode & MODE_REFILLED) != 0u);
 }
 
-// Blur and merge one tile of a surface, replenished by `rep` units, in place. Called from uniform
-// control flow.
-fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, rep: u32, lid: u32, local: vec2<u32>) {
+// Blur and merge one tile of a surface, replenished by `rep` units, in place; a cast record's
+// depressions ray-cast from the primitives in `mask`. Called from uniform control flow.
+fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, mask: u32, rep: u32, lid: u32, local: vec2<u32>) {
     let tile = vec2<i32>(tile_id) * SIDE;
     // Unit lid of the tile: row lid / (SIDE / per), first texel column (lid % (SIDE / per)) * per.
     let per = unit_texels(PRECISION);
@@ -104,8 +128,15 @@ fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, rep: u
     }
     let dep_origin = tile - vec2<i32>(1);
     if has_capture {
+        let casts = (rec.mode & MODE_CAST) != 0u;
         for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
-            depressions[k] = depression(rec, dep_origin.x + k % DEP, dep_origin.y + k / DEP);
+            let x = dep_origin.x + k % DEP;
+            let y = dep_origin.y + k / DEP;
+            if casts {
+                depressions[k] = cast_depression(rec, mask, x, y);
+            } else {
+                depressions[k] = depression(rec, x, y);
+            }
         }
     }
     workgroupBarrier();

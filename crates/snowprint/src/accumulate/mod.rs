@@ -189,7 +189,13 @@ mod tests {
             "texel_z",
             "tiles",
             "wrap",
+            "half_x",
+            "half_z",
+            "prims",
+            "prim_count",
+            "ground",
         ];
+        assert_eq!(names.len(), expect.len());
         for (i, (name, offset)) in names.iter().enumerate() {
             assert_eq!(name, expect[i]);
             assert_eq!(*offset as usize, i * 4);

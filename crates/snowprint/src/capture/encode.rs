@@ -83,6 +83,11 @@ pub struct CapturePlan {
     /// The capture buffer's ranges cleared before the capture, `(first texel, texels)`
     /// ([`CapturePlan::plan_clears`]).
     pub clears: Vec<(u32, u32)>,
+    /// The update's tiles of the surfaces it ray-casts itself ([`super::CapturePath::Update`]),
+    /// listed by the plan when the update takes its tiles from the list: `[record, tile y << 16 |
+    /// tile x]`. They are uploaded as the list's first entries, with its header; the capture
+    /// appends its own after them.
+    pub listed: Vec<[u32; 2]>,
     /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
     /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`; the
     /// codes are laid out as the capture regions, apron included):
@@ -104,6 +109,7 @@ impl CapturePlan {
         self.texels = 0;
         self.tile_flags = 0;
         self.ground_copies.clear();
+        self.listed.clear();
         self.clear_all = false;
         self.clears.clear();
     }
@@ -223,7 +229,10 @@ pub fn encode(
         );
     }
     enc.clear_buffer(buffers.tiles, 0, Some(plan.tile_flags.max(1) as u64 * 4));
-    enc.clear_buffer(buffers.tile_list, 0, Some(TILE_LIST_HEADER * 4));
+    // A list that starts with the plan's entries was uploaded with its header.
+    if plan.listed.is_empty() {
+        enc.clear_buffer(buffers.tile_list, 0, Some(TILE_LIST_HEADER * 4));
+    }
     if !plan.work.is_empty() {
         encode_compute(device, enc, pipes, plan, buffers, queries);
     }

@@ -245,6 +245,65 @@ pub fn tiles_reached(
     sparse
 }
 
+/// Append to `list` an entry `[record, tile y << 16 | tile x]` for every 16 x 16 tile of the
+/// update of a `width` x `height` surface of half sides `half` whose blur may read a texel that a
+/// footprint of `prims` reaches: the footprint grown by two texels (the blur's one, and one of
+/// margin so that rounding never leaves out a texel the ray cast would hit), clamped to the
+/// surface. `seen` is scratch. The update ([`CapturePath::Update`]) tests each listed tile against
+/// the footprints again, so a tile listed in the margin costs a workgroup and changes nothing.
+pub fn update_tiles_reached(
+    prims: &[GpuPrimitive],
+    (width, height): (u32, u32),
+    half: glam::Vec2,
+    record: u32,
+    seen: &mut Vec<bool>,
+    list: &mut Vec<[u32; 2]>,
+) {
+    let tile = crate::pool::TILE_SIDE;
+    let (tx, ty) = (width.div_ceil(tile), height.div_ceil(tile));
+    seen.clear();
+    seen.resize((tx * ty) as usize, false);
+    let texel = half * 2.0 / glam::Vec2::new(width as f32, height as f32);
+    let margin = texel * (APRON as f32 + 1.0);
+    // The surface's texel of a local coordinate, clamped to the surface (left of its first texel
+    // the quotient is negative, which the clamp takes to column 0).
+    let to_texel = |v: f32, h: f32, t: f32, n: u32| {
+        let q = (v + h) / t;
+        if q < 0.0 {
+            0
+        } else {
+            (q as u64).min(n as u64 - 1) as u32
+        }
+    };
+    for p in prims {
+        let [x0, z0, x1, z1] = footprint(p);
+        let (lo, hi) = (
+            glam::Vec2::new(x0, z0) - margin,
+            glam::Vec2::new(x1, z1) + margin,
+        );
+        if hi.x < -half.x || hi.y < -half.y || lo.x > half.x || lo.y > half.y {
+            continue;
+        }
+        let (c0, c1) = (
+            to_texel(lo.x, half.x, texel.x, width) / tile,
+            to_texel(hi.x, half.x, texel.x, width) / tile,
+        );
+        let (r0, r1) = (
+            to_texel(lo.y, half.y, texel.y, height) / tile,
+            to_texel(hi.y, half.y, texel.y, height) / tile,
+        );
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                let i = (r * tx + c) as usize;
+                if !seen[i] {
+                    seen[i] = true;
+                    list.push([record, r << 16 | c]);
+                }
+            }
+        }
+    }
+}
+
 /// A compute region takes the tiles beside its reached ones, instead of being cleared, while they
 /// are fewer than its tiles over this: on the H100 a workgroup over a tile costs about nine times
 /// a clear of the tile's bytes (`docs/PERFORMANCE.md`, "The capture cleared only where needed").
@@ -253,6 +312,15 @@ pub const SPARSE_TILES: u64 = 9;
 /// `batch` of a surface record captured by the compute path (no pass over the atlas; anything but
 /// `NO_CAPTURE` tells the update that the capture holds its texels).
 pub const COMPUTED: u32 = 0xffff_fffe;
+
+/// `batch` of a surface record whose analytic primitives the update ray-casts itself
+/// ([`CapturePath::Update`], [`crate::pool::MODE_CAST`]): no capture holds its texels.
+pub const CAST: u32 = 0xffff_fffd;
+
+/// Most analytic primitives a surface may have and still be ray-cast by the update itself
+/// ([`CapturePath::Update`]): each texel its blur reads tests every one of them that reaches its
+/// tile, and a tile keeps them in a mask of one bit each.
+pub const CAST_PRIMS_MAX: u32 = crate::wgsl::consts::CAST_PRIMS_MAX;
 
 /// Most analytic primitives a surface may have and still be captured by the compute path (each
 /// texel of its reach tests every one of them; past this the raster path, which draws each
@@ -272,6 +340,12 @@ pub enum CapturePath {
     Compute,
     /// Every surface rendered in its viewport of the atlas, primitives as rectangles.
     Raster,
+    /// No capture for the surfaces that only analytic deformers press, up to
+    /// [`CAST_PRIMS_MAX`] primitives: the fused update ray-casts them itself at each texel its
+    /// blur reads, so they need no capture pass, no capture memory and no clear. The others take
+    /// [`CapturePath::Compute`], and every surface does in a world with separate passes
+    /// ([`crate::PassMode::Separate`]) or kicked-up snow, whose passes read the capture.
+    Update,
 }
 
 impl CapturePath {

@@ -22,11 +22,13 @@ pub fn required_features() -> wgpu::Features {
 pub fn required_limits() -> wgpu::Limits {
     let base = wgpu::Limits::downlevel_defaults();
     wgpu::Limits {
-        // The fused blur + merge dispatch (accumulate/fused.wgsl) binds six storage buffers in the
-        // compute stage: records, capture, pool, winding, tiles, tile list. The capture's fragment
-        // stage (capture/capture.wgsl) binds five: primitives, and the capture, winding, tile
-        // flags and tile list it writes with atomics. Downlevel devices promise four.
-        max_storage_buffers_per_shader_stage: 6,
+        // The fused blur + merge dispatch (accumulate/fused.wgsl) binds eight storage buffers in
+        // the compute stage: records, capture, pool, winding, tiles, tile list, and the primitives
+        // and ground fields of the surfaces it ray-casts itself (`CapturePath::Update`). The
+        // capture's fragment stage (capture/capture.wgsl) binds five: primitives, and the capture,
+        // winding, tile flags and tile list it writes with atomics. Downlevel devices promise
+        // four; WebGPU promises eight.
+        max_storage_buffers_per_shader_stage: 8,
         // Two at most (capture, tonemap, the snow passes: frame or view globals, then the pass's
         // own group).
         max_bind_groups: base.max_bind_groups.max(2),

@@ -246,7 +246,7 @@ pub struct SurfaceRecord {
     /// Capture atlas y of the surface's capture region.
     pub atlas_y: u32,
     /// Bit 0: mask capture (else depth); bit 1: [`MODE_MESHES`]; bit 2: [`MODE_GROUND`]; bit 3:
-    /// [`MODE_REFILLED`].
+    /// [`MODE_REFILLED`]; bit 4: [`MODE_CAST`].
     pub mode: u32,
     /// Depression units refilled this update.
     pub replenish_units: u32,
@@ -266,6 +266,17 @@ pub struct SurfaceRecord {
     pub tiles: u32,
     /// Toroidal storage offsets, `ox | oy << 16` ([`wrapped`]); 0 for an ordinary surface.
     pub wrap: u32,
+    /// With [`MODE_CAST`]: half the surface's side along x, metres (what the update's ray cast
+    /// reads instead of a capture view).
+    pub half_x: f32,
+    /// With [`MODE_CAST`]: half the surface's side along z, metres.
+    pub half_z: f32,
+    /// With [`MODE_CAST`]: its first primitive in the frame's list.
+    pub prims: u32,
+    /// With [`MODE_CAST`]: its primitives (at most [`crate::capture::CAST_PRIMS_MAX`]).
+    pub prim_count: u32,
+    /// With [`MODE_CAST`]: the first texel of its ground field, or [`crate::capture::NO_GROUND`].
+    pub ground: u32,
 }
 
 impl SurfaceRecord {
@@ -332,6 +343,11 @@ pub const MODE_GROUND: u32 = crate::wgsl::consts::MODE_GROUND;
 /// Bit of [`SurfaceRecord::mode`] set when the update's refill pass replenishes the surface over
 /// its whole heights region (accumulate/refill.wgsl): the fused pass then replenishes nothing.
 pub const MODE_REFILLED: u32 = crate::wgsl::consts::MODE_REFILLED;
+/// Bit of [`SurfaceRecord::mode`] set when the fused update ray-casts the surface's analytic
+/// primitives itself, where its blur reads them ([`crate::CapturePath::Update`]): nothing of the
+/// surface is in the capture's buffers, and its `half_x`, `half_z`, `prims`, `prim_count` and
+/// `ground` say what to cast.
+pub const MODE_CAST: u32 = crate::wgsl::consts::MODE_CAST;
 /// `normals` of a record in a pool that keeps no normals.
 pub const NO_NORMALS: u32 = crate::wgsl::consts::NO_NORMALS;
 
@@ -480,8 +496,8 @@ mod tests {
     }
 
     #[test]
-    fn record_is_68_bytes() {
-        assert_eq!(std::mem::size_of::<SurfaceRecord>(), 68);
+    fn record_is_88_bytes() {
+        assert_eq!(std::mem::size_of::<SurfaceRecord>(), 88);
     }
 
     #[test]

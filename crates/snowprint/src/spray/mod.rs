@@ -13,7 +13,7 @@
 //!    dropped and counted ([`SprayCounters`]), a defined answer rather than an overwrite of the
 //!    frame's own particles;
 //! 4. `place` (`simulate.wgsl`): this frame's spawns, written in their surface's frame, move to the
-//!    world (the spawn already binds WebGPU's least limit of six storage buffers); cost: the ring's
+//!    world (the spawn already binds six storage buffers); cost: the ring's
 //!    capacity.
 //!
 //! The spawn reads the heights before the accumulation overwrites them and writes nothing the

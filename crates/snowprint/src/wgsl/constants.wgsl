@@ -42,6 +42,11 @@ const MODE_GROUND: u32 = 4u;
 // Mode bit of a surface record: its snowfall is refilled by the streaming refill pass this update,
 // so the fused pass replenishes nothing and updates only the tiles the capture reached.
 const MODE_REFILLED: u32 = 8u;
+// Mode bit of a surface record: its analytic primitives are ray-cast by the fused update itself
+// where its blur reads them (accumulate/cast.wgsl); nothing of it is in the capture's buffers.
+const MODE_CAST: u32 = 16u;
+// Most primitives a surface the update ray-casts may have (a bit each of a tile's mask).
+const CAST_PRIMS_MAX: u32 = 32u;
 // Primitive kind of a capture primitive (`kind.x`): a capsule (a sphere is a capsule of zero length).
 const PRIM_CAPSULE: u32 = 0u;
 // Primitive kind of a capture primitive: an oriented box.

@@ -17,6 +17,8 @@ const WGSL_FILES: &[(&str, &str, bool)] = &[
     ("texel_write", "pool/texel_write.wgsl", false),
     ("maths", "accumulate/maths.wgsl", false),
     ("capture_read", "accumulate/capture_read.wgsl", false),
+    ("update_cast", "accumulate/cast.wgsl", false),
+    ("capture_cast", "capture/cast.wgsl", false),
     ("capture_write", "capture/write.wgsl", false),
     ("capture", "capture/capture.wgsl", true),
     ("capture_prims", "capture/prims.wgsl", true),

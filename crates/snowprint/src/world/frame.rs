@@ -15,7 +15,7 @@ use crate::error::{Result, SnowError};
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::gpu::timestamps::StageQueries;
 use crate::mesh::MeshId;
-use crate::pool::SurfaceRecord;
+use crate::pool::{SurfaceRecord, TILE_LIST_HEADER};
 use crate::relax::{self, RelaxBuffers};
 
 /// A frame recorded into a caller's command encoder by [`SnowWorld::encode_update`] or
@@ -518,6 +518,16 @@ impl SnowWorld {
         self.winding.ensure(device, sizes.winding);
         self.tiles.ensure(device, sizes.tiles);
         self.tile_list.ensure(device, sizes.tile_list);
+        if !c.listed.is_empty() {
+            // The list's header (its count, the dispatch arguments seal.wgsl writes) and the
+            // plan's entries; the capture appends after them.
+            let mut header = [0u32; TILE_LIST_HEADER as usize];
+            header[3] = c.listed.len() as u32;
+            blocks.clear();
+            blocks.extend_from_slice(bytemuck::cast_slice(&header));
+            blocks.extend_from_slice(bytemuck::cast_slice(&c.listed));
+            write(&self.tile_list.buffer, blocks);
+        }
     }
 
     /// Record the plan's capture and accumulation into `enc`, measuring their passes with
@@ -560,6 +570,8 @@ impl SnowWorld {
             pool: &self.pool,
             tiles: &self.tiles.buffer,
             tile_list: &self.tile_list.buffer,
+            prims: &self.prims.buffer,
+            ground: &self.grounds.buffer,
         };
         accumulate::encode_update(
             &self.device,

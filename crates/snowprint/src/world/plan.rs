@@ -23,8 +23,8 @@ use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::pool::{
-    MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord,
-    TILE_LIST_HEADER, TILE_SIDE,
+    MODE_CAST, MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat,
+    SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
@@ -49,6 +49,8 @@ pub struct PlanSettings {
     pub atlas_side: u32,
     /// Which path captures analytic deformers.
     pub capture_path: capture::CapturePath,
+    /// Whether kicked-up snow is spawned from the capture (then every surface is captured).
+    pub spray: bool,
 }
 
 impl PlanSettings {
@@ -62,6 +64,7 @@ impl PlanSettings {
             refill_stream_from: config.refill_stream_from,
             atlas_side: config.atlas_side,
             capture_path: config.capture_path,
+            spray: config.spray.is_some(),
         }
     }
 
@@ -210,8 +213,8 @@ struct Job {
     ground_codes: u32,
     prims: Range<u32>,
     draws: Range<u32>,
-    /// Whether the compute path captures it.
-    compute: bool,
+    /// How its analytic deformers reach the update.
+    way: Way,
     /// Relaxation steps this update (0: none), the material's repose angle (degrees) and the
     /// rectangle that relaxes.
     relax: (u32, f32, Rect),
@@ -298,7 +301,7 @@ impl FramePlan {
     pub fn stats(&self) -> FrameStats {
         FrameStats {
             updated: self.surfaces.len() as u32,
-            captured: self.capture.surfaces.len() as u32,
+            captured: self.surfaces.iter().filter(|s| s.captured).count() as u32,
             capture_batches: self.capture.batches,
             primitives: self.capture.prims.len() as u32,
             mesh_draws: self.capture.draws.len() as u32,
@@ -452,13 +455,19 @@ impl FramePlan {
                 texel_z: texel.y,
                 tiles: 0,
                 wrap: s.wrap,
+                // The update's ray cast, set when it takes the surface (`pack_atlas`).
+                half_x: 0.0,
+                half_z: 0.0,
+                prims: 0,
+                prim_count: 0,
+                ground: capture::NO_GROUND,
             },
             half_size,
             ground_offset: s.ground.map_or(capture::NO_GROUND, |g| g.offset),
             ground_codes: s.ground.map_or(0, |g| g.codes),
             prims: p0..p1,
             draws: d0..d1,
-            compute: computed(settings, p1 - p0, d1 > d0),
+            way: way(settings, p1 - p0, d1 > d0),
             relax: if relaxes && !rect.is_empty() {
                 (steps, material.repose_degrees.unwrap_or(90.0), rect)
             } else {
@@ -470,7 +479,7 @@ impl FramePlan {
     /// Place captured surfaces in the atlas (those the raster path captures), the capture buffer
     /// and the tile flags.
     fn pack_atlas(&mut self, settings: &PlanSettings) {
-        let rendered = |j: &Job| j.surface.captured && !j.compute;
+        let rendered = |j: &Job| j.surface.captured && j.way == Way::Raster;
         self.rects.extend(
             self.jobs
                 .iter()
@@ -487,7 +496,16 @@ impl FramePlan {
         let mut placed = placements.iter();
         for job in self.jobs.iter_mut().filter(|j| j.surface.captured) {
             let r = &mut job.record;
-            if job.compute {
+            if job.way == Way::Cast {
+                // Nothing of it in the capture: the update casts its primitives.
+                r.batch = capture::CAST;
+                r.mode |= MODE_CAST;
+                (r.half_x, r.half_z) = (job.half_size.x, job.half_size.y);
+                (r.prims, r.prim_count) = (job.prims.start, job.prims.len() as u32);
+                r.ground = job.ground_offset;
+                continue;
+            }
+            if job.way == Way::Compute {
                 r.batch = capture::COMPUTED;
             } else if let Some(p) = placed.next() {
                 r.atlas_x = p.x;
@@ -567,7 +585,18 @@ impl FramePlan {
                 record.mode |= MODE_REFILLED;
             }
             a.records.push(record);
-            if !job.surface.captured {
+            if job.way == Way::Cast && a.listed {
+                let r = &job.record;
+                capture::update_tiles_reached(
+                    &c.prims[job.prims.start as usize..job.prims.end as usize],
+                    (r.width, r.height),
+                    job.half_size,
+                    j as u32,
+                    &mut self.seen,
+                    &mut c.listed,
+                );
+            }
+            if !job.surface.captured || job.way == Way::Cast {
                 continue;
             }
             let r = &job.record;
@@ -580,11 +609,11 @@ impl FramePlan {
                 height: r.height,
                 prims: job.prims.clone(),
                 draws: job.draws.clone(),
-                compute: job.compute,
+                compute: job.way == Way::Compute,
                 cleared: true,
             });
             let mut whole = 0;
-            if job.compute {
+            if job.way == Way::Compute {
                 let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
                 let view = c.views.len() as u32;
                 let size = (r.width, r.height);
@@ -611,7 +640,7 @@ impl FramePlan {
                 tiles_x: r.width.div_ceil(TILE_SIDE),
                 record: if a.listed { j as u32 } else { capture::NO_LIST },
                 ground: job.ground_offset,
-                prims: if job.compute {
+                prims: if job.way == Way::Compute {
                     [job.prims.start, job.prims.len() as u32]
                 } else {
                     [0, 0]
@@ -664,7 +693,7 @@ impl FramePlan {
             capture: texels,
             winding: c.winding_texels() as u64 * 4,
             tiles: c.tile_flags.max(1) as u64 * 4,
-            tile_list: (TILE_LIST_HEADER + 2 * c.tile_flags as u64) * 4,
+            tile_list: (TILE_LIST_HEADER + 2 * (c.tile_flags as u64 + c.listed.len() as u64)) * 4,
             relax_records: std::mem::size_of_val(self.relax.records.as_slice()) as u64,
             relax_scratch: self.relax.scratch_words as u64 * 4,
             relax_tiles: self.relax.tile_words as u64 * 4,
@@ -715,14 +744,38 @@ fn refused(d: &Deformer, meshes: &impl PlanMeshes) -> bool {
         || matches!(d.shape, Shape::Mesh(id) if meshes.radius(id).is_none())
 }
 
-/// Whether the compute path captures a surface with `prims` primitives (and mesh draws when
-/// `meshes`): not when meshes press it, when it has no primitives or too many, or when the world
-/// asks for the raster path.
-fn computed(settings: &PlanSettings, prims: u32, meshes: bool) -> bool {
-    settings.capture_path != capture::CapturePath::Raster
-        && !meshes
-        && prims > 0
-        && prims <= capture::COMPUTE_PRIMS_MAX
+/// How a surface's analytic deformers reach the update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Way {
+    /// Rendered in its viewport of the atlas (and so are its meshes).
+    Raster,
+    /// Ray-cast into the capture by the compute path.
+    Compute,
+    /// Ray-cast by the fused update itself ([`capture::CapturePath::Update`]).
+    Cast,
+}
+
+/// How a surface with `prims` primitives (and mesh draws when `meshes`) is captured: rendered when
+/// meshes press it, when it has no primitives or more than the compute path takes, or when the
+/// world asks for the raster path; cast by the update when the world asks for that, the update is
+/// fused, no spray reads the capture and it has few enough; else the compute path.
+fn way(settings: &PlanSettings, prims: u32, meshes: bool) -> Way {
+    use capture::CapturePath;
+    if settings.capture_path == CapturePath::Raster
+        || meshes
+        || prims == 0
+        || prims > capture::COMPUTE_PRIMS_MAX
+    {
+        return Way::Raster;
+    }
+    if settings.capture_path == CapturePath::Update
+        && settings.fused()
+        && !settings.spray
+        && prims <= capture::CAST_PRIMS_MAX
+    {
+        return Way::Cast;
+    }
+    Way::Compute
 }
 
 /// Add a surface's replenishment over `elapsed` seconds to its carry: `(new carry, whole units
