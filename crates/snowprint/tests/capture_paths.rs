@@ -430,3 +430,77 @@ fn what_the_update_casts_is_not_captured() {
         assert!(m.depression.iter().any(|&d| d > 0), "pressed");
     }
 }
+
+/// One frame's deformers for `mixed_frames`: a moving sphere over surfaces 0 and 2 (cast by the
+/// update), more resting spheres than it casts over surfaces 1 and 3 (captured), none over 4.
+fn mixed_deformers(f: u32) -> Vec<Deformer> {
+    let mut ds = vec![deformer(0, 0, f, 0.3), deformer(2, 1, f, 0.6)];
+    for i in [1usize, 3] {
+        let n = snowprint::low_level::capture::CAST_PRIMS_MAX + 3;
+        ds.extend((0..n).map(|k| {
+            let x = i as f32 * 12.0 - 1.5 + 0.09 * k as f32;
+            Deformer::new(
+                Shape::Sphere { radius: 0.05 },
+                Pose::at([x, 1.02 - 0.002 * f as f32, 0.1 * (k % 3) as f32]),
+            )
+        }));
+    }
+    ds
+}
+
+/// Surfaces the update casts and surfaces the capture holds in one frame, some refilling snow and
+/// some not (surfaces 0, 3 and 4 refill), on the fused pass's grid and on its list, the snowfall
+/// streamed or not: every heightmap after every frame is the compute path's, bit for bit. (The
+/// grid then starts after the cast records that refill, which the list's header names.)
+#[test]
+fn cast_and_captured_surfaces_in_one_frame_update_as_the_compute_path() {
+    let spot = Spot {
+        size: (3.0, 2.5),
+        yaw: 15.0,
+        hills: false,
+    };
+    for (listed, streamed) in [(false, false), (true, false), (false, true), (true, true)] {
+        let mut worlds = [CapturePath::Compute, CapturePath::Update].map(|path| {
+            let config = WorldConfig {
+                capture_path: path,
+                list_tiles_from: if listed { 0 } else { u32::MAX },
+                refill_stream_from: if streamed { 0 } else { u32::MAX },
+                ..WorldConfig::default()
+            };
+            SnowWorld::new(common::gpu(), config).expect("world")
+        });
+        let mut ids = Vec::new();
+        for w in &mut worlds {
+            ids = (0..5)
+                .map(|i| {
+                    let mut d = desc(i, &spot);
+                    d.replenish_rate = if [0, 3, 4].contains(&i) { 0.05 } else { 0.0 };
+                    w.add_surface(d).unwrap()
+                })
+                .collect();
+        }
+        let mut pressed = 0;
+        for f in 0..4 {
+            let ds = mixed_deformers(f);
+            let stats = worlds.each_mut().map(|w| w.step(1.0 / 30.0, &ds).unwrap());
+            assert_eq!(stats[0].captured, 4);
+            assert_eq!(stats[1].captured, 4);
+            for &id in &ids {
+                let [a, b] = worlds.each_ref().map(|w| {
+                    let m = w.read_heightmap(id).unwrap();
+                    let v: Vec<u16> = m.depression.iter().chain(&m.displaced).copied().collect();
+                    v
+                });
+                pressed += a.iter().filter(|&&v| v > 0).count();
+                let diff = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+                assert_eq!(
+                    diff, 0,
+                    "frame {f} {id:?}: listed {listed}, streamed {streamed}"
+                );
+            }
+        }
+        assert!(pressed > 0);
+        assert!(worlds[1].read_last_capture(ids[0]).unwrap().is_none());
+        assert!(worlds[1].read_last_capture(ids[1]).unwrap().is_some());
+    }
+}

@@ -28,16 +28,12 @@ fn cast_cell(rec: SurfaceRecord, x: i32, y: i32) -> vec2<u32> {
     return vec2<u32>(clamp(vec2<i32>(x + a, y + a), vec2<i32>(0), last));
 }
 
-// Whether primitive `p`'s footprint, clipped to the region as the capture draws it, holds the
-// local point `x`.
-fn cast_covers(v: CaptureView, p: Primitive, x: vec2<f32>) -> bool {
-    let f = prim_footprint(p);
-    let reach = region_half_of(v);
-    return all(x >= max(f.xy, -reach)) && all(x <= min(f.zw, reach));
-}
-
 var<workgroup> cast_bits: atomic<u32>;
 var<workgroup> cast_mask_shared: u32;
+// The record's primitives and their footprints clipped to the region (`cast_covers`), by their
+// index in the record, kept for the workgroup's ray casts by `cast_mask`.
+var<workgroup> cast_prims: array<Primitive, CAST_PRIMS_MAX>;
+var<workgroup> cast_rects: array<vec4<f32>, CAST_PRIMS_MAX>;
 
 // The record's primitives whose footprints reach the texel centres of the staging rectangle
 // [first, first + side) (logical texels, clamped to the region), a bit each. Every invocation
@@ -52,12 +48,15 @@ fn cast_mask(rec: SurfaceRecord, first: vec2<i32>, side: i32, lid: u32) -> u32 {
         let lo = texel_center_of(v, vec2<f32>(cast_cell(rec, first.x, first.y)) + vec2<f32>(0.5));
         let end = first + vec2<i32>(side - 1);
         let hi = texel_center_of(v, vec2<f32>(cast_cell(rec, end.x, end.y)) + vec2<f32>(0.5));
-        let f = prim_footprint(prims[rec.prims + lid]);
+        let p = prims[rec.prims + lid];
+        let f = prim_footprint(p);
         let reach = region_half_of(v);
         let f_lo = max(f.xy, -reach);
         let f_hi = min(f.zw, reach);
         if all(f_lo <= hi) && all(f_hi >= lo) {
             atomicOr(&cast_bits, 1u << lid);
+            cast_prims[lid] = p;
+            cast_rects[lid] = vec4<f32>(f_lo, f_hi);
         }
     }
     workgroupBarrier();
@@ -79,11 +78,11 @@ fn cast_depression(rec: SurfaceRecord, mask: u32, x: i32, y: i32) -> f32 {
     while bits != 0u {
         let k = firstTrailingBit(bits);
         bits &= bits - 1u;
-        let p = prims[rec.prims + k];
-        if !cast_covers(v, p, centre) {
+        let f = cast_rects[k];
+        if any(centre < f.xy) || any(centre > f.zw) {
             continue;
         }
-        let code = prim_code(v, p, cell, c);
+        let code = prim_code(v, cast_prims[k], cell, c);
         if code != NO_HIT {
             best = max(best, code);
         }

@@ -25,8 +25,12 @@ pub struct AccumulatePlan {
     /// listed (a seal dispatch, then an indirect one).
     pub listed: bool,
     /// Records the fused pass's grid covers: all of them when not `listed`, else those it refills
-    /// (none when the refill pass streams).
+    /// (none when the refill pass streams). The records it ray-casts itself
+    /// ([`MODE_CAST`](crate::pool::MODE_CAST)) are not its.
     pub grid: u32,
+    /// Entries at the head of the tile list that the plan wrote, the tiles of the records the
+    /// fused pass ray-casts itself: one workgroup each of its dispatch over them.
+    pub cast_tiles: u32,
     /// Widest record, texels.
     pub max_width: u32,
     /// Tallest record, texels.
@@ -43,6 +47,7 @@ impl AccumulatePlan {
         self.refill_words = 0;
         self.listed = false;
         self.grid = 0;
+        self.cast_tiles = 0;
         self.max_width = 0;
         self.max_height = 0;
     }
@@ -138,6 +143,11 @@ pub fn encode_update(
                 max_h.div_ceil(FUSED_WORKGROUP),
                 plan.grid,
             );
+        }
+        if plan.cast_tiles > 0 {
+            let n = plan.cast_tiles;
+            pass.set_pipeline(&pipes.fused_cast);
+            pass.dispatch_workgroups(n.min(u16::MAX as u32), n.div_ceil(u16::MAX as u32), 1);
         }
         if plan.listed {
             let seal_bg = bind_group(

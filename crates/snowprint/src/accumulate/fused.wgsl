@@ -12,8 +12,8 @@
 // with nothing to deepen or refill leaves at once), and `fused_listed`, one workgroup per tile in
 // the capture's tile list for the records whose every tile the grid does not take (a record
 // refilled here and not by refill.wgsl), dispatched indirectly (seal.wgsl writes the arguments).
-// A record marked MODE_CAST has no capture: its tiles ray-cast its primitives themselves
-// (cast.wgsl), on the grid where they reach the tile and in the list where the plan listed them.
+// A record marked MODE_CAST has no capture: `fused_cast` takes its tiles from the plan's entries at
+// the head of the tile list, and ray-casts its primitives itself (cast.wgsl).
 // Reads: `records`, `tiles`, `tile_list`, `capture`, `winding`, `prims`, `ground`, each record's
 // heights in `pool`.
 // Writes: the same heights regions.
@@ -42,14 +42,16 @@ fn fused(
     @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
 ) {
-    let rec = records[wid.z];
+    // The grid covers the records from the one the list's header names (before it: cast records
+    // that refill snow, whose tiles are `fused_cast`'s, as those of every cast record).
+    let rec = records[tile_list[TILE_LIST_GRID_FIRST] + wid.z];
     // Whole workgroups past the surface leave together, before any barrier.
-    if i32(wid.x) * SIDE >= i32(rec.width) || i32(wid.y) * SIDE >= i32(rec.height) {
+    let past = i32(wid.x) * SIDE >= i32(rec.width) || i32(wid.y) * SIDE >= i32(rec.height);
+    if past || (rec.mode & MODE_CAST) != 0u {
         return;
     }
-    let casts = (rec.mode & MODE_CAST) != 0u;
     var has_capture = rec.batch != NO_CAPTURE;
-    if has_capture && !casts {
+    if has_capture {
         let tiles_x = (rec.width + u32(SIDE) - 1u) / u32(SIDE);
         has_capture = tiles[rec.tiles + wid.y * tiles_x + wid.x] != 0u;
     }
@@ -59,15 +61,7 @@ fn fused(
     if !has_capture && rep == 0u {
         return;
     }
-    var mask = 0u;
-    if casts {
-        mask = cast_mask(rec, vec2<i32>(wid.xy) * SIDE - vec2<i32>(1), DEP, lid);
-        has_capture = mask != 0u;
-        if !has_capture && rep == 0u {
-            return;
-        }
-    }
-    update_tile(rec, wid.xy, has_capture, mask, rep, lid, local.xy);
+    update_tile(rec, wid.xy, has_capture, false, 0u, rep, lid, local.xy);
 }
 
 @compute @workgroup_size(TILE, TILE, 1)
@@ -80,23 +74,43 @@ fn fused_listed(
     if i >= tile_list[3] {
         return;
     }
-    let rec = records[tile_list[4u + 2u * i]];
-    // A record refilled here has all its tiles updated by `fused`.
+    let rec = records[tile_list[TILE_LIST_HEADER + 2u * i]];
+    // A record refilled here has all its tiles updated by `fused`; a cast record's listed tiles
+    // are `fused_cast`'s.
     let rep = replenished(rec);
-    if rep != 0u {
+    if rep != 0u || (rec.mode & MODE_CAST) != 0u {
         return;
     }
-    let t = tile_list[5u + 2u * i];
-    let tile = vec2<u32>(t & 0xffffu, t >> 16u);
-    var mask = 0u;
-    if (rec.mode & MODE_CAST) != 0u {
-        // The plan lists a cast record's tiles from the primitives' footprints, a margin around.
-        mask = cast_mask(rec, vec2<i32>(tile) * SIDE - vec2<i32>(1), DEP, lid);
-        if mask == 0u {
-            return;
-        }
+    let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
+    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, false, 0u, 0u, lid, local.xy);
+}
+
+// The tiles of the cast records, which the plan lists first in `tile_list` (all of a record's
+// tiles where this pass refills it, else those its primitives' footprints reach, a margin
+// around), one workgroup an entry; dispatched over those entries alone, so an entry past them
+// (the capture's, of a record that is not cast) leaves at once.
+@compute @workgroup_size(TILE, TILE, 1)
+fn fused_cast(
+    @builtin(local_invocation_index) lid: u32,
+    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(workgroup_id) wid: vec3<u32>,
+) {
+    let i = wid.x + wid.y * 65535u;
+    if i >= tile_list[3] {
+        return;
     }
-    update_tile(rec, tile, true, mask, 0u, lid, local.xy);
+    let rec = records[tile_list[TILE_LIST_HEADER + 2u * i]];
+    if (rec.mode & MODE_CAST) == 0u {
+        return;
+    }
+    let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
+    let tile = vec2<u32>(t & 0xffffu, t >> 16u);
+    let rep = replenished(rec);
+    let mask = cast_mask(rec, vec2<i32>(tile) * SIDE - vec2<i32>(1), DEP, lid);
+    if mask == 0u && rep == 0u {
+        return;
+    }
+    update_tile(rec, tile, mask != 0u, true, mask, rep, lid, local.xy);
 }
 
 // Units this pass replenishes a record by: none where refill.wgsl refilled it.
@@ -104,9 +118,13 @@ fn replenished(rec: SurfaceRecord) -> u32 {
     return select(rec.replenish_units, 0u, (rec.mode & MODE_REFILLED) != 0u);
 }
 
-// Blur and merge one tile of a surface, replenished by `rep` units, in place; a cast record's
-// depressions ray-cast from the primitives in `mask`. Called from uniform control flow.
-fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, mask: u32, rep: u32, lid: u32, local: vec2<u32>) {
+// Blur and merge one tile of a surface, replenished by `rep` units, in place; the depressions of
+// a cast record (`casts`, a constant of each entry point, so that the others compile without the
+// ray cast) from its primitives in `mask`. Called from uniform control flow.
+fn update_tile(
+    rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, casts: bool, mask: u32, rep: u32,
+    lid: u32, local: vec2<u32>,
+) {
     let tile = vec2<i32>(tile_id) * SIDE;
     // Unit lid of the tile: row lid / (SIDE / per), first texel column (lid % (SIDE / per)) * per.
     let per = unit_texels(PRECISION);
@@ -128,7 +146,6 @@ fn update_tile(rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, mask: 
     }
     let dep_origin = tile - vec2<i32>(1);
     if has_capture {
-        let casts = (rec.mode & MODE_CAST) != 0u;
         for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
             let x = dep_origin.x + k % DEP;
             let y = dep_origin.y + k / DEP;

@@ -53,6 +53,9 @@ pub struct AccumulatePipelines {
     pub fused: wgpu::ComputePipeline,
     /// Blur and merge fused, over the capture's listed tiles of the records the grid leaves.
     pub fused_listed: wgpu::ComputePipeline,
+    /// The fused pass over the tiles of the records it ray-casts itself (`MODE_CAST`), which the
+    /// plan lists at the head of the tile list.
+    pub fused_cast: wgpu::ComputePipeline,
     /// Writes the listed pass's indirect dispatch.
     pub seal: wgpu::ComputePipeline,
     /// Layout of the seal's group 0: the tile list.
@@ -75,7 +78,7 @@ impl AccumulatePipelines {
         use crate::wgsl::{BLUR, FUSED, MERGE, NORMALS, REFILL, SEAL};
         let blur_layout = BLUR.bind_group_layout(device, "blur", 0);
         let merge_layout = MERGE.bind_group_layout(device, "merge", 0);
-        // One layout for both fused entry points: the module's group 0 covers what either reads.
+        // One layout for the three fused entry points: the module's group 0 covers what either reads.
         let fused_layout = FUSED.bind_group_layout(device, "fused", 0);
         let seal_layout = SEAL.bind_group_layout(device, "seal", 0);
         let refill_layout = REFILL.bind_group_layout(device, "refill", 0);
@@ -111,6 +114,7 @@ impl AccumulatePipelines {
             refill: make("refill", &REFILL, &refill_layout),
             fused: make("fused", &FUSED, &fused_layout),
             fused_listed: make("fused_listed", &FUSED, &fused_layout),
+            fused_cast: make("fused_cast", &FUSED, &fused_layout),
             seal: make("seal_tiles", &SEAL, &seal_layout),
             seal_layout,
             refill_layout,

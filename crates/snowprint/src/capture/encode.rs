@@ -88,6 +88,9 @@ pub struct CapturePlan {
     /// tile x]`. They are uploaded as the list's first entries, with its header; the capture
     /// appends its own after them.
     pub listed: Vec<[u32; 2]>,
+    /// The first record of the fused pass's grid, in the list's header
+    /// (`TILE_LIST_GRID_FIRST`): the records before it are cast by the update and refill snow.
+    pub grid_first: u32,
     /// Ground codes copied into the winding buffer before the capture, for the surfaces on ground
     /// that is not flat that meshes press (the second half of their regions, `MODE_GROUND`; the
     /// codes are laid out as the capture regions, apron included):
@@ -110,6 +113,7 @@ impl CapturePlan {
         self.tile_flags = 0;
         self.ground_copies.clear();
         self.listed.clear();
+        self.grid_first = 0;
         self.clear_all = false;
         self.clears.clear();
     }
@@ -133,6 +137,12 @@ impl CapturePlan {
                 _ => self.clears.push((v.offset, texels)),
             }
         }
+    }
+
+    /// Whether the plan uploads the tile list's header (with its own entries, or a grid that does
+    /// not start at record 0); else the capture clears it.
+    pub fn uploads_list_header(&self) -> bool {
+        !self.listed.is_empty() || self.grid_first != 0
     }
 
     /// Texels of the winding buffer: it counts only mesh solids, so a frame of analytic deformers
@@ -230,7 +240,7 @@ pub fn encode(
     }
     enc.clear_buffer(buffers.tiles, 0, Some(plan.tile_flags.max(1) as u64 * 4));
     // A list that starts with the plan's entries was uploaded with its header.
-    if plan.listed.is_empty() {
+    if !plan.uploads_list_header() {
         enc.clear_buffer(buffers.tile_list, 0, Some(TILE_LIST_HEADER * 4));
     }
     if !plan.work.is_empty() {

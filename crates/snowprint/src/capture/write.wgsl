@@ -29,8 +29,8 @@ fn mark_tiles_of(v: CaptureView, cell_u: vec2<u32>) {
             // Most texels find their tiles flagged already: only the first lists a tile.
             if atomicLoad(&tiles[i]) == 0u && atomicExchange(&tiles[i], 1u) == 0u {
                 let n = atomicAdd(&tile_list[3], 1u);
-                atomicStore(&tile_list[4u + 2u * n], v.record);
-                atomicStore(&tile_list[5u + 2u * n], (ty << 16u) | tx);
+                atomicStore(&tile_list[TILE_LIST_HEADER + 2u * n], v.record);
+                atomicStore(&tile_list[TILE_LIST_HEADER + 1u + 2u * n], (ty << 16u) | tx);
             }
         }
     }

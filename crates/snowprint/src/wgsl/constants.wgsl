@@ -18,8 +18,12 @@ const REFILL_GROUP: u32 = 256u;
 // 16-byte vectors of a heights region each invocation of the refill takes, all loaded before any
 // is stored.
 const REFILL_VECTORS: u32 = 4u;
-// Words before the entries of the capture's tile list: the dispatch arguments and the count.
-const TILE_LIST_HEADER: u32 = 4u;
+// Words before the entries of the capture's tile list: the dispatch arguments (0-2), the count
+// (3), the first record of the fused pass's grid (TILE_LIST_GRID_FIRST), and three unused.
+const TILE_LIST_HEADER: u32 = 8u;
+// Word of the tile list's header holding the first record of the fused pass's grid (0 unless the
+// plan uploads the header: the records before it are cast by the update and refill snow).
+const TILE_LIST_GRID_FIRST: u32 = 4u;
 // What a primitive leaves at a texel it does not press (capture/write.wgsl's `prim_code`): above
 // every code of a depth in [0, 1].
 const NO_HIT: u32 = 0xffffffffu;

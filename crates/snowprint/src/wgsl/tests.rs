@@ -156,7 +156,7 @@ fn shared_constants() {
     assert_eq!(consts::ONE_BITS, 1.0f32.to_bits());
     assert_eq!(consts::TILE, 16);
     assert_eq!(consts::WORKGROUP, 8);
-    assert_eq!(consts::TILE_LIST_HEADER, 4);
+    assert_eq!(consts::TILE_LIST_HEADER, 8);
     assert_eq!(consts::NO_LIST, u32::MAX);
     assert_eq!(consts::NO_CAPTURE, u32::MAX);
     assert_eq!(consts::NO_NORMALS, u32::MAX);

@@ -17,6 +17,7 @@ use crate::gpu::timestamps::StageQueries;
 use crate::mesh::MeshId;
 use crate::pool::{SurfaceRecord, TILE_LIST_HEADER};
 use crate::relax::{self, RelaxBuffers};
+use crate::wgsl::consts::TILE_LIST_GRID_FIRST;
 
 /// A frame recorded into a caller's command encoder by [`SnowWorld::encode_update`] or
 /// [`SnowWorld::encode_step`], waiting for the caller's `queue.submit`. Give it back with
@@ -518,11 +519,12 @@ impl SnowWorld {
         self.winding.ensure(device, sizes.winding);
         self.tiles.ensure(device, sizes.tiles);
         self.tile_list.ensure(device, sizes.tile_list);
-        if !c.listed.is_empty() {
-            // The list's header (its count, the dispatch arguments seal.wgsl writes) and the
-            // plan's entries; the capture appends after them.
+        if c.uploads_list_header() {
+            // The list's header (its count, the dispatch arguments seal.wgsl writes, the grid's
+            // first record) and the plan's entries; the capture appends after them.
             let mut header = [0u32; TILE_LIST_HEADER as usize];
             header[3] = c.listed.len() as u32;
+            header[TILE_LIST_GRID_FIRST as usize] = c.grid_first;
             blocks.clear();
             blocks.extend_from_slice(bytemuck::cast_slice(&header));
             blocks.extend_from_slice(bytemuck::cast_slice(&c.listed));

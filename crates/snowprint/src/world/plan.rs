@@ -285,9 +285,17 @@ impl FramePlan {
         for s in surfaces {
             self.plan_surface(settings, &s, &meshes);
         }
-        // Surfaces that refill snow first: the fused grid covers records 0..dense; the others are
-        // updated only where the capture listed a tile.
-        self.jobs.sort_by_key(|j| j.record.replenish_units == 0);
+        // Surfaces that refill snow first (the refill pass streams records 0..dense), those the
+        // update casts first among them and last among the others, so that the fused grid covers
+        // a run of records that it captures (`accumulation_shape`).
+        self.jobs.sort_by_key(
+            |j| match (j.record.replenish_units > 0, j.way == Way::Cast) {
+                (true, true) => 0,
+                (true, false) => 1,
+                (false, false) => 2,
+                (false, true) => 3,
+            },
+        );
         self.pack_atlas(settings);
         self.write_tables(settings);
     }
@@ -544,11 +552,22 @@ impl FramePlan {
         };
         let refill_words: u64 = self.jobs[..dense].iter().map(words).sum();
         // Snowfall over many words is refilled by the streaming pass (the records so marked);
-        // over few, by the fused pass's grid over every tile of the refilling records.
+        // over few, by the fused pass: its grid over every tile of the refilling records it
+        // captures, and the plan's list of every tile of those it casts.
         let stream = fused && dense > 0 && refill_words >= settings.refill_stream_from as u64;
-        let tiled = if stream { 0 } else { dense };
-        // The fused pass visits the other records' tiles only where the capture reached.
-        let flagged: u64 = self.jobs[tiled..]
+        let cast_first = self.jobs[..dense]
+            .iter()
+            .take_while(|j| j.way == Way::Cast)
+            .count();
+        let captured_end = dense
+            + self.jobs[dense..]
+                .iter()
+                .take_while(|j| j.way != Way::Cast)
+                .count();
+        let tiled = if stream { cast_first } else { dense };
+        // The fused pass visits the other records' tiles only where the capture reached (those it
+        // casts, where the plan lists them).
+        let flagged: u64 = self.jobs[tiled..captured_end]
             .iter()
             .filter(|j| j.surface.captured)
             .map(|j| j.record.tile_count() as u64)
@@ -566,9 +585,10 @@ impl FramePlan {
             .max()
             .unwrap_or(0);
         a.listed = listed;
-        // Without the list, the grid covers every record; with it, the records whose every tile
-        // it refills.
-        a.grid = if listed { tiled } else { self.jobs.len() } as u32;
+        // Without the list, the grid covers every record it captures; with it, the records whose
+        // every tile it refills. It starts after the cast records that refill snow.
+        self.capture.grid_first = cast_first as u32;
+        a.grid = if listed { tiled } else { captured_end }.saturating_sub(cast_first) as u32;
         a.max_width = self.jobs.iter().map(|j| j.record.width).max().unwrap_or(1);
         a.max_height = self.jobs.iter().map(|j| j.record.height).max().unwrap_or(1);
     }
@@ -585,16 +605,24 @@ impl FramePlan {
                 record.mode |= MODE_REFILLED;
             }
             a.records.push(record);
-            if job.way == Way::Cast && a.listed {
+            if job.way == Way::Cast {
                 let r = &job.record;
-                capture::update_tiles_reached(
-                    &c.prims[job.prims.start as usize..job.prims.end as usize],
-                    (r.width, r.height),
-                    job.half_size,
-                    j as u32,
-                    &mut self.seen,
-                    &mut c.listed,
-                );
+                if r.replenish_units > 0 && record.mode & MODE_REFILLED == 0 {
+                    // The fused pass refills it: every tile.
+                    let tiles_x = r.width.div_ceil(TILE_SIDE);
+                    c.listed.extend(
+                        (0..r.tile_count()).map(|t| [j as u32, (t / tiles_x) << 16 | t % tiles_x]),
+                    );
+                } else {
+                    capture::update_tiles_reached(
+                        &c.prims[job.prims.start as usize..job.prims.end as usize],
+                        (r.width, r.height),
+                        job.half_size,
+                        j as u32,
+                        &mut self.seen,
+                        &mut c.listed,
+                    );
+                }
             }
             if !job.surface.captured || job.way == Way::Cast {
                 continue;
@@ -649,6 +677,7 @@ impl FramePlan {
                 _pad: 0,
             });
         }
+        a.cast_tiles = c.listed.len() as u32;
         c.plan_clears();
         if self.jobs.is_empty() {
             return;
