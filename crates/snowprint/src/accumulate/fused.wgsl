@@ -61,7 +61,7 @@ fn fused(
     if !has_capture && rep == 0u {
         return;
     }
-    update_tile(rec, wid.xy, has_capture, false, 0u, rep, lid, local.xy);
+    update_tile(rec, wid.xy, has_capture, false, rep, lid, local.xy);
 }
 
 @compute @workgroup_size(TILE, TILE, 1)
@@ -82,7 +82,7 @@ fn fused_listed(
         return;
     }
     let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
-    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, false, 0u, 0u, lid, local.xy);
+    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, false, 0u, lid, local.xy);
 }
 
 // The tiles of the cast records, which the plan lists first in `tile_list` (all of a record's
@@ -105,12 +105,8 @@ fn fused_cast(
     }
     let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
     let tile = vec2<u32>(t & 0xffffu, t >> 16u);
-    let rep = replenished(rec);
-    let mask = cast_mask(rec, vec2<i32>(tile) * SIDE - vec2<i32>(1), DEP, lid);
-    if mask == 0u && rep == 0u {
-        return;
-    }
-    update_tile(rec, tile, mask != 0u, true, mask, rep, lid, local.xy);
+    // Whether anything presses the tile is known once its old texels are being loaded.
+    update_tile(rec, tile, true, true, replenished(rec), lid, local.xy);
 }
 
 // Units this pass replenishes a record by: none where refill.wgsl refilled it.
@@ -118,12 +114,13 @@ fn replenished(rec: SurfaceRecord) -> u32 {
     return select(rec.replenish_units, 0u, (rec.mode & MODE_REFILLED) != 0u);
 }
 
-// Blur and merge one tile of a surface, replenished by `rep` units, in place; the depressions of
-// a cast record (`casts`, a constant of each entry point, so that the others compile without the
-// ray cast) from its primitives in `mask`. Called from uniform control flow.
+// Blur and merge one tile of a surface, replenished by `rep` units, in place. A cast record's
+// (`casts`, a constant of each entry point, so that the others compile without the ray cast)
+// depressions are ray-cast from its primitives that reach the tile, and it has a capture where
+// one does. Called from uniform control flow.
 fn update_tile(
-    rec: SurfaceRecord, tile_id: vec2<u32>, has_capture: bool, casts: bool, mask: u32, rep: u32,
-    lid: u32, local: vec2<u32>,
+    rec: SurfaceRecord, tile_id: vec2<u32>, captured: bool, casts: bool, rep: u32, lid: u32,
+    local: vec2<u32>,
 ) {
     let tile = vec2<i32>(tile_id) * SIDE;
     // Unit lid of the tile: row lid / (SIDE / per), first texel column (lid % (SIDE / per)) * per.
@@ -145,6 +142,15 @@ fn update_tile(
         }
     }
     let dep_origin = tile - vec2<i32>(1);
+    var has_capture = captured;
+    var mask = 0u;
+    if casts {
+        mask = cast_mask(rec, dep_origin, DEP, lid);
+        has_capture = mask != 0u;
+        if !has_capture && rep == 0u {
+            return;
+        }
+    }
     if has_capture {
         for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
             let x = dep_origin.x + k % DEP;
