@@ -68,7 +68,7 @@ fn downlevel_defaults_are_refused_naming_the_limit() {
             available,
         } => {
             assert_eq!(limit, "max_storage_buffers_per_shader_stage");
-            assert_eq!((required, available), (6, 4));
+            assert_eq!((required, available), (8, 4));
             let sentence = SnowError::DeviceLimit {
                 limit,
                 required,

@@ -41,6 +41,11 @@ pub(super) fn configs(quick: bool) -> Vec<Config> {
         snowing(cfg("talk_budget", 2, 512, 10, separate)),
         snowing(at(Precision::Bits8, cfg("talk_budget", 2, 512, 10, fused))),
         snowing(at(Precision::Bits32, cfg("talk_budget", 2, 512, 10, fused))),
+        // The snowing frame with the spheres in the capture's compute path, for comparison.
+        Config {
+            capture: CapturePath::Compute,
+            ..snowing(cfg("talk_budget", 2, 512, 10, fused))
+        },
     ];
     let (counts, resolutions, deformers): (&[u32], &[u32], &[u32]) = if quick {
         (&[1, 4, 16], &[64, 128, 256], &[1, 10, 100])
@@ -69,17 +74,18 @@ pub(super) fn configs(quick: bool) -> Vec<Config> {
             .iter()
             .map(|&n| raster(snowing(cfg("raster_surf", n, 128, 10, auto)))),
     );
-    // Again with the spheres ray-cast by the update itself (`CapturePath::Update`): no capture
-    // pass, no capture memory, no clear.
-    let cast = |c: Config| Config {
-        capture: CapturePath::Update,
+    // Again with the spheres ray-cast into the capture by its compute path (`Auto` on a GPU
+    // leaves them to the update, which ray-casts them itself): the capture pass, its memory and
+    // its clear against none of them, in the same run.
+    let computed = |c: Config| Config {
+        capture: CapturePath::Compute,
         ..c
     };
-    let cast_counts: &[u32] = if quick { &[16] } else { &[256, 1024, 4096] };
+    let computed_counts: &[u32] = if quick { &[16] } else { &[256, 1024, 4096] };
     configs.extend(
-        cast_counts
+        computed_counts
             .iter()
-            .map(|&n| cast(snowing(cfg("update_surf", n, 128, 10, auto)))),
+            .map(|&n| computed(snowing(cfg("compute_surf", n, 128, 10, auto)))),
     );
     configs.extend(
         resolutions
@@ -100,7 +106,7 @@ pub(super) fn configs(quick: bool) -> Vec<Config> {
             Precision::Bits8,
             cfg("many_512", 1024, 512, 1, fused),
         )));
-        configs.push(cast(snowing(cfg("many_512", 1024, 512, 1, fused))));
+        configs.push(computed(snowing(cfg("many_512", 1024, 512, 1, fused))));
         // The same with every texel pressed: every word changes and is written every frame.
         let pressed = |c: Config| Config { pressed: true, ..c };
         configs.push(pressed(snowing(cfg("many_512", 1024, 512, 1, fused))));

@@ -48,8 +48,10 @@ pub struct Row {
     pub resolution: u32,
     /// Deformers over each surface.
     pub deformers_per_surface: u32,
-    /// The capture's path for the spheres: what `Auto` takes on this adapter (`compute` on a GPU)
-    /// or `raster` (the sweep `raster_surf`, the same surfaces rendered in viewports).
+    /// The capture's path for the spheres: what `Auto` takes on this adapter (`update` on a GPU:
+    /// the update ray-casts them itself, with no capture), or `compute` (the sweep `compute_surf`
+    /// and the rows so marked: the capture's compute path) or `raster` (the sweep `raster_surf`,
+    /// the same surfaces rendered in viewports).
     pub capture_path: &'static str,
     /// Blur and merge fused in one pass (else separate passes).
     pub fused: bool,
@@ -412,9 +414,10 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         }
     );
     println!(
-        "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7} {:>9} {:>11}",
+        "{:<12} {:>5} {:>7} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7} {:>9} {:>11}",
         "sweep",
         "mode",
+        "capture",
         "bits",
         "snow",
         "surfaces",
@@ -438,9 +441,10 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<12} {:>5} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2} {:>9.1} {:>11.2}",
+            "{:<12} {:>5} {:>7} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2} {:>9.1} {:>11.2}",
             r.sweep,
             if r.fused { "fused" } else { "split" },
+            r.capture_path,
             r.precision_bits,
             match (r.snowing, r.pressed) {
                 (false, _) => "no",

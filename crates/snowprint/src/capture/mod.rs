@@ -327,11 +327,12 @@ pub const CAST_PRIMS_MAX: u32 = crate::wgsl::consts::CAST_PRIMS_MAX;
 /// primitive's rectangle alone, does less work).
 pub const COMPUTE_PRIMS_MAX: u32 = 256;
 
-/// Which path captures analytic deformers. Both write the same bits (`tests/capture_paths.rs`).
+/// Which path captures analytic deformers. All give the same bits (`tests/capture_paths.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum CapturePath {
-    /// [`CapturePath::Compute`] on a GPU, [`CapturePath::Raster`] on a software adapter (where
-    /// llvmpipe ran the compute path up to three times slower: `docs/PERFORMANCE.md`).
+    /// [`CapturePath::Update`] on a GPU (where it costs the least: `docs/PERFORMANCE.md`, "The
+    /// update's own ray cast"), [`CapturePath::Raster`] on a software adapter (where llvmpipe ran
+    /// the compute path up to three times slower).
     #[default]
     Auto,
     /// Compute, one dispatch for every surface that only analytic deformers press (up to
@@ -353,7 +354,7 @@ impl CapturePath {
     pub fn resolved(self, device_type: wgpu::DeviceType) -> Self {
         match (self, device_type) {
             (Self::Auto, wgpu::DeviceType::Cpu) => Self::Raster,
-            (Self::Auto, _) => Self::Compute,
+            (Self::Auto, _) => Self::Update,
             (path, _) => path,
         }
     }

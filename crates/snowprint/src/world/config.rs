@@ -40,10 +40,11 @@ pub struct WorldConfig {
     pub refill_stream_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
-    /// Which path captures analytic deformers: `Compute` ray-casts them in one dispatch for every
-    /// surface that meshes do not press, `Raster` renders every surface in its viewport, and
-    /// [`CapturePath::Auto`] (the default) takes `Compute` on a GPU and `Raster` on a software
-    /// adapter. Both write the same bits.
+    /// Which path captures analytic deformers: `Update` leaves them to the fused update, which
+    /// ray-casts them itself where its blur reads them, `Compute` ray-casts them into the capture
+    /// in one dispatch for every surface that meshes do not press, `Raster` renders every surface
+    /// in its viewport, and [`CapturePath::Auto`] (the default) takes `Update` on a GPU and
+    /// `Raster` on a software adapter. All give the same heights.
     pub capture_path: CapturePath,
     /// Kicked-up snow: particles spawned where an update deepens a print fast (`spray/`). `None`
     /// (the default): no spray pass, the update exactly as without it.
