@@ -4,7 +4,7 @@ use glam::{Quat, Vec2};
 use proptest::prelude::*;
 
 use super::*;
-use crate::deformer::Pose;
+use crate::deformer::{Pose, Shape};
 use crate::pool::Precision;
 
 fn settings() -> PlanSettings {
