@@ -109,6 +109,8 @@ pub struct StageTimesUs {
     pub normals: f64,
     /// Fused blur + merge.
     pub fused: f64,
+    /// The snowfall streamed over whole regions before the fused pass (0 where it does not run).
+    pub refill: f64,
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -209,6 +211,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
     let timestamps = world.has_timestamps();
     let (mut total, mut cpu, mut cap, mut blur, mut merge, mut normals, mut fused) =
         (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+    let mut refill = vec![];
     let (mut gpu_times, mut measured_from, mut cleared) = (Vec::new(), u64::MAX, 0);
     for f in 0..args.warmup + args.frames {
         // Each surface is given the deformers over it, as a manager's spatial lookup would.
@@ -264,6 +267,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             merge_ms,
             normals_ms,
             fused_ms,
+            refill_ms,
             // The bench's surfaces are the talk's snow, which never relaxes.
             relax_ms: _,
             // Nor has spray.
@@ -274,6 +278,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
         merge.push(merge_ms * 1e3);
         normals.push(normals_ms * 1e3);
         fused.push(fused_ms * 1e3);
+        refill.push(refill_ms * 1e3);
         total.push(t.total_ms() * 1e3);
     }
     let bytes = c.surfaces as u64 * format.heights_bytes(c.resolution, c.resolution);
@@ -317,6 +322,7 @@ fn measure(gpu: &GpuContext, c: &Config, args: &Args) -> Result<Row, String> {
             merge: median(&mut merge),
             normals: median(&mut normals),
             fused: median(&mut fused),
+            refill: median(&mut refill),
         }),
         cpu_encode_us: median(&mut cpu),
         heightmap_bytes: bytes,
@@ -414,7 +420,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         }
     );
     println!(
-        "{:<12} {:>5} {:>7} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7} {:>9} {:>11}",
+        "{:<12} {:>5} {:>7} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7} {:>9} {:>7} {:>9} {:>11}",
         "sweep",
         "mode",
         "capture",
@@ -429,6 +435,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         "merge",
         "normals",
         "fused",
+        "refill",
         "cpu_us",
         "copy_us",
         "x_copy",
@@ -441,7 +448,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
         let s = r.stages_us;
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
         println!(
-            "{:<12} {:>5} {:>7} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2} {:>9.1} {:>11.2}",
+            "{:<12} {:>5} {:>7} {:>4} {:>4} {:>8} {:>5} {:>5} {:>10.1} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8.1} {:>9.1} {:>7.2} {:>9.1} {:>7.2} {:>9.1} {:>11.2}",
             r.sweep,
             if r.fused { "fused" } else { "split" },
             r.capture_path,
@@ -460,6 +467,7 @@ fn print_rows(gpu: &GpuContext, rows: &[Row]) {
             f(s.map(|s| s.merge)),
             f(s.map(|s| s.normals)),
             f(s.map(|s| s.fused)),
+            f(s.map(|s| s.refill)),
             r.cpu_encode_us,
             r.copy_us,
             r.ratio_to_copy,

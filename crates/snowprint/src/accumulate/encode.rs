@@ -118,11 +118,8 @@ pub fn encode_update(
                 b.ground.as_entire_binding(),
             ],
         );
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("fused"),
-            timestamp_writes: queries.compute("fused"),
-        });
-        // The snow that fell, over whole regions; then the captures, over the tiles they reached.
+        // The snow that fell, over whole regions, in a pass of its own (timed apart); then the
+        // captures, over the tiles they reached.
         if plan.refill > 0 {
             let refill_bg = bind_group(
                 device,
@@ -130,11 +127,19 @@ pub fn encode_update(
                 &pipes.refill_layout,
                 &[b.records.as_entire_binding(), b.pool.as_entire_binding()],
             );
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("refill"),
+                timestamp_writes: queries.compute("refill"),
+            });
             let (x, y) = refill_groups(plan.refill_words);
             pass.set_pipeline(&pipes.refill);
             pass.set_bind_group(0, &refill_bg, &[]);
             pass.dispatch_workgroups(x, y, plan.refill);
         }
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("fused"),
+            timestamp_writes: queries.compute("fused"),
+        });
         pass.set_bind_group(0, &fused_bg, &[]);
         if plan.grid > 0 {
             pass.set_pipeline(&pipes.fused);

@@ -96,6 +96,9 @@ pub struct StageTimes {
     pub normals_ms: f64,
     /// The fused blur + merge dispatch (when [`PassMode::Fused`]).
     pub fused_ms: f64,
+    /// The snowfall streamed over whole heights regions before the fused pass (see
+    /// [`WorldConfig::refill_stream_from`]), when it runs.
+    pub refill_ms: f64,
     /// The relaxation of slumping materials (see [`crate::Material`]).
     pub relax_ms: f64,
     /// The kicked-up snow's pass (simulate, spawn, fold, place), with [`WorldConfig::spray`].
@@ -110,6 +113,7 @@ impl StageTimes {
             + self.merge_ms
             + self.normals_ms
             + self.fused_ms
+            + self.refill_ms
             + self.relax_ms
             + self.spray_ms
     }

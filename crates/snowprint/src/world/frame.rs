@@ -661,6 +661,7 @@ fn stage_times(times: &[(&'static str, f64)]) -> StageTimes {
             "normals" => t.normals_ms += ms,
             "relax" => t.relax_ms += ms,
             "spray" => t.spray_ms += ms,
+            "refill" => t.refill_ms += ms,
             _ => t.fused_ms += ms,
         }
     }
