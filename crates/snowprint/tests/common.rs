@@ -40,8 +40,30 @@ pub fn target(
     })
 }
 
-/// Bytes of a save with these sections, every length and checksum right (stored raw).
+/// Bytes of the settle state that ends a version 4 `SURF` section (updates and a rectangle).
+pub const SURF_SETTLE_BYTES: usize = 20;
+
+/// Bytes of a save with these sections, every length and checksum right (stored raw). The
+/// sections are this build's (version 4): for an older `version`, each `SURF` loses its settle
+/// state, as older builds wrote it.
 pub fn assemble_save(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
+    let older: Vec<([u8; 4], Vec<u8>)>;
+    let sections = if version < 4 {
+        older = sections
+            .iter()
+            .map(|(tag, data)| {
+                let keep = if tag == b"SURF" {
+                    data.len().saturating_sub(SURF_SETTLE_BYTES)
+                } else {
+                    data.len()
+                };
+                (*tag, data[..keep].to_vec())
+            })
+            .collect();
+        &older
+    } else {
+        sections
+    };
     let mut out = b"SNOWSAVE".to_vec();
     out.extend_from_slice(&version.to_le_bytes());
     out.extend_from_slice(&(sections.len() as u32).to_le_bytes());

@@ -1623,3 +1623,35 @@ fn a_step_that_captures_nothing_clears_the_last_capture() {
     w.step(1.0 / 60.0, &[]).unwrap();
     assert_eq!(w.read_last_capture(id).unwrap(), None);
 }
+
+/// Under the default passes (`PassMode::Auto`, fused on every adapter) nothing writes the blurred
+/// scratch, so there is no stage 1 output to read: `read_last_blurred` answers `None`, as under
+/// `PassMode::Fused`, rather than whatever the scratch buffer held; with separate passes it
+/// answers.
+#[test]
+fn the_blurred_capture_is_read_only_where_a_pass_wrote_it() {
+    for (passes, written) in [
+        (PassMode::Auto, false),
+        (PassMode::Fused, false),
+        (PassMode::Separate, true),
+    ] {
+        let mut w = SnowWorld::new(
+            common::gpu(),
+            WorldConfig {
+                passes,
+                ..WorldConfig::default()
+            },
+        )
+        .unwrap();
+        let id = w
+            .add_surface(SurfaceDesc::new("s", [0.0, 0.0, 0.0], [2.0, 2.0], 0.3))
+            .unwrap();
+        let ball = Deformer::new(Shape::Sphere { radius: 0.3 }, Pose::at([0.0, 0.25, 0.0]));
+        w.step(1.0 / 30.0, &[ball]).unwrap();
+        assert_eq!(
+            w.read_last_blurred(id).unwrap().is_some(),
+            written,
+            "{passes:?}"
+        );
+    }
+}

@@ -258,7 +258,7 @@ fn saves_keep_the_ground_and_refuse_a_wrong_one() {
     m.flush().unwrap();
     let bytes = m.to_save_bytes().unwrap();
     let file = SaveFile::parse(&bytes).unwrap();
-    assert_eq!(file.version, 3);
+    assert_eq!(file.version, 4);
     assert_eq!(file.grounds.len(), 2, "two surfaces lie on ground");
     let mut loaded = SnowManager::from_save(common::gpu(), file).unwrap();
     for &id in &ids {

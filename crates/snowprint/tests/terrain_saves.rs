@@ -186,7 +186,7 @@ fn a_saved_walk_goes_on_alike_and_brings_back_the_trail_paged_out() {
     }
     let bytes = m.to_save_bytes().expect("save");
     let file = SaveFile::parse(&bytes).expect("parse");
-    assert_eq!(file.version, 3);
+    assert_eq!(file.version, 4);
     assert_eq!(file.terrains.len(), 1);
     let saved = &file.terrains[0];
     assert_eq!((saved.index, saved.desc.clone()), (1, valley()));

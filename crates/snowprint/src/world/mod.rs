@@ -476,6 +476,20 @@ impl SnowWorld {
             })
     }
 
+    /// How long and where a surface of a slumping material still relaxes (a save keeps it).
+    pub(crate) fn settle_of(&self, id: SurfaceId) -> Result<crate::relax::Settle> {
+        Ok(self.state(id)?.settle)
+    }
+
+    /// Set a surface's settle state (a save's, checked against the surface by the save's reader).
+    pub(crate) fn set_settle(&mut self, id: SurfaceId, settle: crate::relax::Settle) -> Result<()> {
+        self.state(id)?;
+        if let Some(s) = self.surfaces[id.0 as usize].as_mut() {
+            s.settle = settle;
+        }
+        Ok(())
+    }
+
     /// Bytes of GPU memory held.
     pub fn memory(&self) -> MemoryReport {
         MemoryReport {

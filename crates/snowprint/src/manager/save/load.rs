@@ -134,6 +134,7 @@ impl SnowManager {
                         )));
                     }
                     let w = m.world.restore_surface(&s.snapshot, Some(offset))?;
+                    m.world.set_settle(w, s.settle)?;
                     m.world_ids[i] = Some(w);
                 }
                 None => {

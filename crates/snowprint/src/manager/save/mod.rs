@@ -10,13 +10,15 @@
 //! (the planner's state: every surface's description, zone, queue, clocks and slot; JSON), `MESH`
 //! (the manager's meshes and the world meshes queued imprints name; binary), then one `SURF` per
 //! surface that holds a heightmap, resident or paged (binary: the slot's words and the
-//! replenishment carry), then (from version 2) one `GRND` per surface on ground that is not flat
+//! replenishment carry, and from version 4 how long and where a slumping material still relaxes),
+//! then (from version 2) one `GRND` per surface on ground that is not flat
 //! (binary: its ground height at every texel and its slope rule; the field is rebuilt from them
 //! as [`crate::GroundField::build`] built it), then (from version 3) one `TERR` per terrain
 //! window the manager runs (binary, `terrain.rs`: its description, each level's window origin,
 //! slot, carry and words, its scroll statistics and the pages of its store; the terrain is built
 //! again from them exactly, under the same [`ManagedTerrainId`](super::ManagedTerrainId)).
-//! Version 1 files, which have no `GRND`, and version 2 files, which have no `TERR`, still read.
+//! Version 1 files, which have no `GRND`, version 2 files, which have no `TERR`, and version 3
+//! files, whose surfaces count as settled, still read.
 //! Reading checks everything before anything is built: a corrupt, truncated, foreign or newer
 //! file is one [`SnowError::SaveFile`](crate::SnowError::SaveFile) sentence.
 
@@ -35,7 +37,7 @@ mod write;
 /// The first eight bytes of every save.
 pub(crate) const MAGIC: [u8; 8] = *b"SNOWSAVE";
 /// The format version this build writes and the newest it reads.
-pub(crate) const VERSION: u32 = 3;
+pub(crate) const VERSION: u32 = 4;
 /// Most sections a save may have (a section per surface and per terrain, plus three).
 pub(crate) const MAX_SECTIONS: u32 = 1 << 20;
 /// Most bytes a section may expand to (a 512^2 surface at 32 bits with normals is 3 MiB; the
@@ -125,6 +127,9 @@ pub struct SavedSurface {
     pub slot_offset: Option<u64>,
     /// The heightmap and its replenishment carry.
     pub snapshot: SurfaceSnapshot,
+    /// How long and where a slumping material still relaxes (from version 4; settled before,
+    /// and always for a surface paged out).
+    pub(crate) settle: crate::relax::Settle,
 }
 
 /// The meshes of a save: the manager's (handle order) and every world mesh a queue names.

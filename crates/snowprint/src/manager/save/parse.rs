@@ -9,6 +9,7 @@ use super::{
 };
 use crate::manager::ManagerConfig;
 use crate::manager::planner::PlannerState;
+use crate::relax::{Rect, Settle};
 use crate::world::SurfaceSnapshot;
 
 impl SaveFile {
@@ -116,7 +117,7 @@ impl SaveFile {
         let mut surfaces = Vec::new();
         for s in &sections[3..heightmaps] {
             surfaces.push(
-                read_surface(&s.data, &config, &plan)
+                read_surface(&s.data, &config, &plan, version)
                     .map_err(|e| format!("a heightmap (SURF): {e}"))?,
             );
         }
@@ -238,6 +239,7 @@ pub(super) fn read_surface(
     data: &[u8],
     config: &ManagerConfig,
     plan: &PlannerState,
+    version: u32,
 ) -> std::result::Result<SavedSurface, String> {
     let mut r = Reader::new(data);
     let index = r.u32("its surface index")?;
@@ -246,6 +248,17 @@ pub(super) fn read_surface(
     let height = r.u32("its height")?;
     let carry = r.f64("its carry")?;
     let words = r.words("its words")?;
+    // From version 4: how long and where a slumping material still relaxes.
+    let mut settle = Settle::default();
+    if version >= 4 {
+        settle.updates = r.u32("its settle updates")?;
+        let mut v = [0; 4];
+        for x in &mut v {
+            *x = r.u32("its settle rectangle")?;
+        }
+        let [x0, y0, x1, y1] = v;
+        settle.rect = Rect { x0, y0, x1, y1 };
+    }
     r.done("a heightmap")?;
     let desc = plan
         .surfaces
@@ -258,6 +271,7 @@ pub(super) fn read_surface(
         })?
         .desc
         .clone();
+    check_settle(&settle, &desc, (width, height), offset == u64::MAX)?;
     Ok(SavedSurface {
         index,
         slot_offset: (offset != u64::MAX).then_some(offset),
@@ -269,7 +283,36 @@ pub(super) fn read_surface(
             carry,
             words,
         },
+        settle,
     })
+}
+
+/// A saved settle state fits its surface: a rectangle within its texels, no more updates than its
+/// material settles for, and none on a surface paged out (which has settled).
+fn check_settle(
+    s: &Settle,
+    desc: &crate::SurfaceDesc,
+    (width, height): (u32, u32),
+    paged: bool,
+) -> std::result::Result<(), String> {
+    let r = s.rect;
+    let max = desc.material.settle_updates;
+    if s.updates > max || (paged && s.updates > 0) {
+        return Err(format!(
+            "surface {:?} still settles for {} updates, its material for at most {}{}",
+            desc.name,
+            s.updates,
+            if paged { 0 } else { max },
+            if paged { " once paged out" } else { "" }
+        ));
+    }
+    if r.x0 > r.x1 || r.y0 > r.y1 || r.x1 > width || r.y1 > height {
+        return Err(format!(
+            "surface {:?}'s settling rectangle ({}, {}) to ({}, {}) is not within its {width} x {height} texels",
+            desc.name, r.x0, r.y0, r.x1, r.y1
+        ));
+    }
+    Ok(())
 }
 
 /// A `GRND` section: checked against its surface's heightmap size, its heights finite, its rule
@@ -335,4 +378,34 @@ pub(super) fn one_line(s: &str) -> String {
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A settle state that does not fit its surface is refused in one sentence naming it: a
+    /// rectangle past its texels or turned inside out, more updates than its material settles for,
+    /// a paged-out surface still settling; one that fits reads.
+    #[test]
+    fn a_settle_state_must_fit_its_surface() {
+        let mut desc = crate::SurfaceDesc::new("dune", [0.0; 3], [2.0, 2.0], 0.2);
+        desc.material = crate::Material::sand();
+        let settle = |updates, [x0, y0, x1, y1]: [u32; 4]| Settle {
+            updates,
+            rect: Rect { x0, y0, x1, y1 },
+        };
+        let size = (50, 40);
+        assert!(check_settle(&settle(120, [0, 0, 50, 40]), &desc, size, false).is_ok());
+        assert!(check_settle(&Settle::default(), &desc, size, true).is_ok());
+        for (s, paged, says) in [
+            (settle(3, [0, 0, 51, 40]), false, "settling rectangle"),
+            (settle(3, [10, 0, 5, 40]), false, "settling rectangle"),
+            (settle(121, [0, 0, 1, 1]), false, "at most 120"),
+            (settle(1, [0, 0, 1, 1]), true, "once paged out"),
+        ] {
+            let e = check_settle(&s, &desc, size, paged).unwrap_err();
+            assert!(e.contains(says) && e.contains("\"dune\""), "{e}");
+        }
+    }
 }

@@ -9,6 +9,7 @@ use super::{MAGIC, VERSION};
 use crate::error::{Result, SnowError};
 use crate::manager::SnowManager;
 use crate::mesh::Mesh;
+use crate::relax::Settle;
 use crate::world::SurfaceSnapshot;
 
 impl SnowManager {
@@ -54,22 +55,21 @@ impl SnowManager {
         )?;
         let level_snaps = snaps.split_off(resident.len());
         let terrains = self.terrain_sections(&levels, &level_snaps)?;
-        let mut surfaces: Vec<(u32, Option<u64>, SurfaceSnapshot)> = resident
-            .iter()
-            .zip(snaps)
-            .map(|(&(i, _), s)| {
-                let offset = self
-                    .planner
-                    .slot(crate::manager::ManagedId(i))
-                    .map(|s| s.offset);
-                (i, offset, s)
-            })
-            .collect();
+        // A surface paged out (or on its way in) has settled.
+        let settled = Settle::default();
+        let mut surfaces: Vec<(u32, Option<u64>, SurfaceSnapshot, Settle)> = Vec::new();
+        for (&(i, w), s) in resident.iter().zip(snaps) {
+            let offset = self
+                .planner
+                .slot(crate::manager::ManagedId(i))
+                .map(|s| s.offset);
+            surfaces.push((i, offset, s, self.world.settle_of(w)?));
+        }
         for (i, page) in self.pages.iter() {
-            surfaces.push((i, None, page.decompress()?));
+            surfaces.push((i, None, page.decompress()?, settled));
         }
         for (id, snap) in self.arriving_snapshots()? {
-            surfaces.push((id.0, None, snap));
+            surfaces.push((id.0, None, snap, settled));
         }
         surfaces.sort_by_key(|s| s.0);
         let mut out = Vec::new();
@@ -90,8 +90,8 @@ impl SnowManager {
         section(&mut out, b"CONF", &conf);
         section(&mut out, b"PLAN", &plan);
         section(&mut out, b"MESH", &meshes);
-        for (i, offset, s) in &surfaces {
-            let mut b = Vec::with_capacity(48 + s.words.len() * 4);
+        for (i, offset, s, settle) in &surfaces {
+            let mut b = Vec::with_capacity(68 + s.words.len() * 4);
             put_u32(&mut b, *i);
             put_u64(&mut b, offset.unwrap_or(u64::MAX));
             put_u32(&mut b, s.width);
@@ -99,6 +99,10 @@ impl SnowManager {
             b.extend_from_slice(&s.carry.to_bits().to_le_bytes());
             put_u64(&mut b, s.words.len() as u64);
             b.extend_from_slice(bytemuck::cast_slice(&s.words));
+            let r = settle.rect;
+            for v in [settle.updates, r.x0, r.y0, r.x1, r.y1] {
+                put_u32(&mut b, v);
+            }
             section(&mut out, b"SURF", &b);
         }
         for (i, g) in grounds {
