@@ -1,7 +1,7 @@
 // cast.wgsl (module `update_cast`): the fused update's own ray cast, for the records marked
 // MODE_CAST (`CapturePath::Update`): no capture pass runs for them and no capture buffer holds
 // them; a tile's workgroup finds the record's primitives that reach the texels its blur reads
-// (`cast_mask`), and each texel staged for the blur ray-casts those (`cast_depression`) with the
+// and keeps them in workgroup memory (`cast_mask`), and each texel staged for the blur ray-casts those (`cast_depression`) with the
 // capture's own functions (capture/cast.wgsl) at the same region texel centres, keeping the
 // lowest code as the capture's atomic max does. So the depressions, and everything after them, are
 // the bits the capture's paths give (tests/capture_paths.rs).

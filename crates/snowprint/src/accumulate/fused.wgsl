@@ -8,8 +8,9 @@
 // before this pass, so here it replenishes nothing and changes only where the capture reached
 // (deepening a refilled texel equals merging with the refill: accumulate::cpu::refill_word);
 // any other record that refills snow has every tile refilled here.
-// Two entry points share that work: `fused`, a grid over every tile of the first records (a tile
-// with nothing to deepen or refill leaves at once), and `fused_listed`, one workgroup per tile in
+// Three entry points share that work: `fused`, a grid over every tile of a run of records, from
+// the one the tile list's header names (a tile with nothing to deepen or refill leaves at
+// once), and `fused_listed`, one workgroup per tile in
 // the capture's tile list for the records whose every tile the grid does not take (a record
 // refilled here and not by refill.wgsl), dispatched indirectly (seal.wgsl writes the arguments).
 // A record marked MODE_CAST has no capture: `fused_cast` takes its tiles from the plan's entries at
