@@ -71,19 +71,18 @@ fn fused_listed(
     @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
 ) {
-    let i = wid.x + wid.y * 65535u;
-    if i >= tile_list[3] {
+    let e = list_entry(wid);
+    if !e.listed {
         return;
     }
-    let rec = records[tile_list[TILE_LIST_HEADER + 2u * i]];
+    let rec = records[e.record];
     // A record refilled here has all its tiles updated by `fused`; a cast record's listed tiles
     // are `fused_cast`'s.
     let rep = replenished(rec);
     if rep != 0u || (rec.mode & MODE_CAST) != 0u {
         return;
     }
-    let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
-    update_tile(rec, vec2<u32>(t & 0xffffu, t >> 16u), true, false, 0u, lid, local.xy);
+    update_tile(rec, e.tile, true, false, 0u, lid, local.xy);
 }
 
 // The tiles of the cast records, which the plan lists first in `tile_list` (all of a record's
@@ -96,18 +95,34 @@ fn fused_cast(
     @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
 ) {
-    let i = wid.x + wid.y * 65535u;
-    if i >= tile_list[3] {
+    let e = list_entry(wid);
+    if !e.listed {
         return;
     }
-    let rec = records[tile_list[TILE_LIST_HEADER + 2u * i]];
+    let rec = records[e.record];
     if (rec.mode & MODE_CAST) == 0u {
         return;
     }
-    let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
-    let tile = vec2<u32>(t & 0xffffu, t >> 16u);
     // Whether anything presses the tile is known once its old texels are being loaded.
-    update_tile(rec, tile, true, true, replenished(rec), lid, local.xy);
+    update_tile(rec, e.tile, true, true, replenished(rec), lid, local.xy);
+}
+
+// An entry of the tile list: its record and tile, where the workgroup's index is within the
+// list's count.
+struct Entry {
+    listed: bool,
+    record: u32,
+    tile: vec2<u32>,
+}
+
+// The entry of workgroup `wid` of a dispatch over the list (x + y * 65535).
+fn list_entry(wid: vec3<u32>) -> Entry {
+    let i = wid.x + wid.y * 65535u;
+    if i >= tile_list[3] {
+        return Entry(false, 0u, vec2<u32>(0u));
+    }
+    let t = tile_list[TILE_LIST_HEADER + 1u + 2u * i];
+    return Entry(true, tile_list[TILE_LIST_HEADER + 2u * i], vec2<u32>(t & 0xffffu, t >> 16u));
 }
 
 // Units this pass replenishes a record by: none where refill.wgsl refilled it.
