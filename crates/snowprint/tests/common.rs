@@ -40,12 +40,14 @@ pub fn target(
     })
 }
 
-/// Bytes of the settle state that ends a version 4 `SURF` section (updates and a rectangle).
-pub const SURF_SETTLE_BYTES: usize = 20;
+/// Bytes of the settle state that follows a heightmap's words from version 4 (a `SURF` section's
+/// last, and each level's of a `TERR`): updates and a rectangle.
+pub const SETTLE_BYTES: usize = 20;
 
 /// Bytes of a save with these sections, every length and checksum right (stored raw). The
 /// sections are this build's (version 4): for an older `version`, each `SURF` loses its settle
-/// state, as older builds wrote it.
+/// state, as older builds wrote it (a `TERR` is left as it is: files older than version 3 have
+/// none).
 pub fn assemble_save(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
     let older: Vec<([u8; 4], Vec<u8>)>;
     let sections = if version < 4 {
@@ -53,7 +55,7 @@ pub fn assemble_save(version: u32, sections: &[([u8; 4], Vec<u8>)]) -> Vec<u8> {
             .iter()
             .map(|(tag, data)| {
                 let keep = if tag == b"SURF" {
-                    data.len().saturating_sub(SURF_SETTLE_BYTES)
+                    data.len().saturating_sub(SETTLE_BYTES)
                 } else {
                     data.len()
                 };

@@ -299,13 +299,14 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
     let terr = &secs[k].1;
     let at = level0(terr);
     let words = u64::from_le_bytes(terr[at + 32..at + 40].try_into().unwrap()) as usize;
-    let pages = at
-        + 40
-        + 4 * words
+    // A level: origin, slot, carry and word count (40 bytes), its words, its settle state.
+    let settle0 = at + 40 + 4 * words;
+    let pages = settle0
+        + common::SETTLE_BYTES
         + {
-            let l1 = at + 40 + 4 * words;
+            let l1 = settle0 + common::SETTLE_BYTES;
             let n = u64::from_le_bytes(terr[l1 + 32..l1 + 40].try_into().unwrap()) as usize;
-            40 + 4 * n
+            40 + 4 * n + common::SETTLE_BYTES
         }
         + 7 * 8;
     assert!(
@@ -333,6 +334,12 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
         (edit(at + 32, &(words as u64 - 1).to_le_bytes()), "words"),
         (edit(at + 16, &8u64.to_le_bytes()), "overlaps"),
         (edit(pages + 8, &9u32.to_le_bytes()), "page of level 9"),
+        // Level 0's settle rectangle reaching past its 48 columns.
+        (
+            edit(settle0 + 12, &49u32.to_le_bytes()),
+            "settling rectangle",
+        ),
+        (edit(settle0, &5000u32.to_le_bytes()), "at most"),
         // The last byte of the first page's LZ4: a literal, the top byte of a channel.
         (edit(page0_end - 1, &[1]), "above the pool's 65535"),
         (edit(13, b"}"), "description does not read"),
@@ -340,7 +347,7 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
         (cut(pages + 4), "ends inside its pages"),
     ];
     for (s, says) in cases {
-        let Err(e) = SaveFile::parse(&common::assemble_save(3, &s)) else {
+        let Err(e) = SaveFile::parse(&common::assemble_save(4, &s)) else {
             panic!("{says}: the damaged section was read");
         };
         assert!(
@@ -351,7 +358,7 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
     }
     // Any cut of the section is refused.
     for len in (0..terr.len()).step_by(61) {
-        assert!(SaveFile::parse(&common::assemble_save(3, &cut(len))).is_err());
+        assert!(SaveFile::parse(&common::assemble_save(4, &cut(len))).is_err());
     }
     // Through `load`: the file's name and the sentence, and no manager.
     let dir = std::env::temp_dir().join(format!("snowprint-terrain-saves-{}", std::process::id()));
@@ -359,7 +366,7 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
     let path = dir.join("carry.snow");
     std::fs::write(
         &path,
-        common::assemble_save(3, &edit(at + 24, &2.0f64.to_le_bytes())),
+        common::assemble_save(4, &edit(at + 24, &2.0f64.to_le_bytes())),
     )
     .unwrap();
     let e = SnowManager::load(common::gpu(), &path).unwrap_err();
@@ -382,4 +389,59 @@ fn a_damaged_terrain_section_is_one_sentence_and_version_2_still_loads() {
     let loaded = SnowManager::from_save(common::gpu(), file).expect("load");
     assert_eq!(roof_maps(&loaded), roof_maps(&m));
     assert_eq!(loaded.terrain_ids().count(), 0);
+}
+
+/// A sand terrain saved in the update a box pressed a steep-walled pit into its level, while the
+/// pit still slumps, and loaded into a fresh manager: with a pebble pressing the level's far
+/// side after (so that the level is updated), the two levels are the same texel for texel, and
+/// the pit's walls moved after the save (a level that loaded as settled would relax only around
+/// the pebble).
+#[test]
+fn a_terrain_level_saved_while_it_slumps_slumps_on_after_a_load() {
+    let dunes = TerrainDesc {
+        name: "dunes".into(),
+        material: Material::sand(),
+        replenish_rate: 0.0,
+        levels: vec![LevelDesc {
+            texels: [48, 48],
+            texel_size: 0.05,
+        }],
+        ..valley()
+    };
+    let mut m = SnowManager::new(common::gpu(), config()).expect("manager");
+    let t = m.add_terrain(dunes, Vec3::ZERO).expect("terrain");
+    let pit = ManagedDeformer::player(Deformer::new(
+        Shape::Box {
+            half_extents: Vec3::new(0.3, 0.3, 0.3),
+        },
+        Pose::at([-0.5, 0.3, 0.0]),
+    ));
+    let pebble = |f: u32| {
+        ManagedDeformer::new(Deformer::new(
+            Shape::Sphere { radius: 0.05 },
+            Pose::at([0.9, 0.22 - 0.001 * f as f32, 0.9]),
+        ))
+    };
+    m.follow_terrain(t, Vec3::ZERO).expect("follow");
+    m.tick(DT, None, &[pit]).expect("tick");
+    let bytes = m.to_save_bytes().expect("save");
+    let mut loaded = SnowManager::from_save(common::gpu(), SaveFile::parse(&bytes).expect("parse"))
+        .expect("load");
+    let lt = loaded.terrain_named("dunes").expect("the terrain");
+    let at_save = levels(&mut m, t);
+    assert!(levels(&mut loaded, lt) == at_save);
+    for f in 0..4 {
+        for (mm, tt) in [(&mut m, t), (&mut loaded, lt)] {
+            mm.follow_terrain(tt, Vec3::ZERO).expect("follow");
+            mm.tick(DT, None, &[pebble(f)]).expect("tick");
+        }
+        let same = levels(&mut loaded, lt) == levels(&mut m, t);
+        assert!(same, "update {f} after the load differs");
+    }
+    // The pit's half of the level (x < 0, depression channel) moved after the save.
+    let now = levels(&mut m, t);
+    let moved = (0..48 * 48)
+        .filter(|&i| i % 48 < 24 && now[0][i] != at_save[0][i])
+        .count();
+    assert!(moved > 0, "the pit slumped on after the save");
 }

@@ -215,6 +215,9 @@ impl SnowManager {
                 (t.stats, t.last_written),
                 t.pages,
             )?;
+            for (id, l) in terrain.surfaces().into_iter().zip(&t.levels) {
+                self.world.set_settle(id, l.settle)?;
+            }
             self.put_restored_terrain(t.index, terrain)?;
         }
         Ok(())

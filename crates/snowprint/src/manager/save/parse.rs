@@ -127,7 +127,7 @@ impl SaveFile {
         }
         let mut terrains = Vec::new();
         for (k, s) in sections.iter().enumerate().skip(ground_end) {
-            terrains.push(read_terrain(&s.data, &config).map_err(|e| {
+            terrains.push(read_terrain(&s.data, &config, version).map_err(|e| {
                 format!("section {k}, a terrain window (TERR): {e}; the save is damaged or was altered: load an earlier one")
             })?);
         }
@@ -249,16 +249,11 @@ pub(super) fn read_surface(
     let carry = r.f64("its carry")?;
     let words = r.words("its words")?;
     // From version 4: how long and where a slumping material still relaxes.
-    let mut settle = Settle::default();
-    if version >= 4 {
-        settle.updates = r.u32("its settle updates")?;
-        let mut v = [0; 4];
-        for x in &mut v {
-            *x = r.u32("its settle rectangle")?;
-        }
-        let [x0, y0, x1, y1] = v;
-        settle.rect = Rect { x0, y0, x1, y1 };
-    }
+    let settle = if version >= 4 {
+        read_settle(&mut r)?
+    } else {
+        Settle::default()
+    };
     r.done("a heightmap")?;
     let desc = plan
         .surfaces
@@ -271,7 +266,15 @@ pub(super) fn read_surface(
         })?
         .desc
         .clone();
-    check_settle(&settle, &desc, (width, height), offset == u64::MAX)?;
+    let paged = offset == u64::MAX;
+    let max = desc.material.settle_updates;
+    check_settle(
+        &settle,
+        &format!("surface {:?}", desc.name),
+        max,
+        (width, height),
+        paged,
+    )?;
     Ok(SavedSurface {
         index,
         slot_offset: (offset != u64::MAX).then_some(offset),
@@ -287,20 +290,20 @@ pub(super) fn read_surface(
     })
 }
 
-/// A saved settle state fits its surface: a rectangle within its texels, no more updates than its
-/// material settles for, and none on a surface paged out (which has settled).
-fn check_settle(
+/// A saved settle state (of `what`: a surface or a terrain's level, named) fits: a rectangle within
+/// its texels, no more updates than its material settles for (`max`), and none on a surface paged
+/// out (which has settled).
+pub(super) fn check_settle(
     s: &Settle,
-    desc: &crate::SurfaceDesc,
+    what: &str,
+    max: u32,
     (width, height): (u32, u32),
     paged: bool,
 ) -> std::result::Result<(), String> {
     let r = s.rect;
-    let max = desc.material.settle_updates;
     if s.updates > max || (paged && s.updates > 0) {
         return Err(format!(
-            "surface {:?} still settles for {} updates, its material for at most {}{}",
-            desc.name,
+            "{what} still settles for {} updates, its material for at most {}{}",
             s.updates,
             if paged { 0 } else { max },
             if paged { " once paged out" } else { "" }
@@ -308,11 +311,26 @@ fn check_settle(
     }
     if r.x0 > r.x1 || r.y0 > r.y1 || r.x1 > width || r.y1 > height {
         return Err(format!(
-            "surface {:?}'s settling rectangle ({}, {}) to ({}, {}) is not within its {width} x {height} texels",
-            desc.name, r.x0, r.y0, r.x1, r.y1
+            "{what}'s settling rectangle ({}, {}) to ({}, {}) is not within its {width} x {height} texels",
+            r.x0, r.y0, r.x1, r.y1
         ));
     }
     Ok(())
+}
+
+/// A settle state as written after a heightmap's words (from version 4): updates, then the
+/// rectangle's first column, first row, and one past its last column and row.
+pub(super) fn read_settle(r: &mut Reader<'_>) -> std::result::Result<Settle, String> {
+    let updates = r.u32("its settle updates")?;
+    let mut v = [0; 4];
+    for x in &mut v {
+        *x = r.u32("its settle rectangle")?;
+    }
+    let [x0, y0, x1, y1] = v;
+    Ok(Settle {
+        updates,
+        rect: Rect { x0, y0, x1, y1 },
+    })
 }
 
 /// A `GRND` section: checked against its surface's heightmap size, its heights finite, its rule
@@ -396,15 +414,17 @@ mod tests {
             rect: Rect { x0, y0, x1, y1 },
         };
         let size = (50, 40);
-        assert!(check_settle(&settle(120, [0, 0, 50, 40]), &desc, size, false).is_ok());
-        assert!(check_settle(&Settle::default(), &desc, size, true).is_ok());
+        let what = format!("surface {:?}", desc.name);
+        let max = desc.material.settle_updates;
+        assert!(check_settle(&settle(120, [0, 0, 50, 40]), &what, max, size, false).is_ok());
+        assert!(check_settle(&Settle::default(), &what, max, size, true).is_ok());
         for (s, paged, says) in [
             (settle(3, [0, 0, 51, 40]), false, "settling rectangle"),
             (settle(3, [10, 0, 5, 40]), false, "settling rectangle"),
             (settle(121, [0, 0, 1, 1]), false, "at most 120"),
             (settle(1, [0, 0, 1, 1]), true, "once paged out"),
         ] {
-            let e = check_settle(&s, &desc, size, paged).unwrap_err();
+            let e = check_settle(&s, &what, max, size, paged).unwrap_err();
             assert!(e.contains(says) && e.contains("\"dune\""), "{e}");
         }
     }

@@ -1,5 +1,5 @@
-//! The `TERR` section (version 3): one terrain window of the manager's, written and read back,
-//! every value checked before anything is built.
+//! The `TERR` section (version 3; version 4 adds each level's settle state): one terrain window of
+//! the manager's, written and read back, every value checked before anything is built.
 //!
 //! ```text
 //! index u32 (its ManagedTerrainId)
@@ -7,7 +7,8 @@
 //!                levels, and the ground's columns, rows, origin, size and slope rule
 //! ground heights count u64 | f32 each (row after row; 0 of them on flat ground)
 //! levels         count u32 | per level: origin x i64, origin z i64, slot offset u64, carry f64,
-//!                word count u64, the slot's words in logical order (heights, then normals)
+//!                word count u64, the slot's words in logical order (heights, then normals),
+//!                from version 4 its settle state (updates u32, rectangle 4 x u32)
 //! statistics     scrolls, texels out, texels in, bytes written, texels paged in, bytes folded,
 //!                bytes of the last scroll (7 x u64)
 //! pages          count u64 | per page: level u32, chunk column i64, chunk row i64, byte count
@@ -40,6 +41,7 @@ pub(crate) struct SavedLevel {
     pub(crate) offset: u64,
     pub(crate) carry: f64,
     pub(crate) words: Vec<u32>,
+    pub(crate) settle: crate::relax::Settle,
 }
 
 /// The description as saved (a stable mirror of [`TerrainDesc`] without the ground's heights,
@@ -70,7 +72,7 @@ struct SavedGroundDesc {
 pub(super) fn put_terrain(
     index: u32,
     terrain: &Terrain,
-    levels: &[(u64, f64, &[u32])],
+    levels: &[(u64, f64, &[u32], crate::relax::Settle)],
 ) -> crate::error::Result<Vec<u8>> {
     if index >= MAX_HANDLES {
         return Err(crate::error::SnowError::SaveContent(format!(
@@ -110,7 +112,7 @@ pub(super) fn put_terrain(
     put_u64(&mut b, heights.len() as u64);
     b.extend_from_slice(bytemuck::cast_slice(heights));
     put_u32(&mut b, levels.len() as u32);
-    for (origin, &(offset, carry, words)) in origins.iter().zip(levels) {
+    for (origin, &(offset, carry, words, settle)) in origins.iter().zip(levels) {
         for v in origin {
             b.extend_from_slice(&v.to_le_bytes());
         }
@@ -118,6 +120,10 @@ pub(super) fn put_terrain(
         b.extend_from_slice(&carry.to_bits().to_le_bytes());
         put_u64(&mut b, words.len() as u64);
         b.extend_from_slice(bytemuck::cast_slice(words));
+        let r = settle.rect;
+        for v in [settle.updates, r.x0, r.y0, r.x1, r.y1] {
+            put_u32(&mut b, v);
+        }
     }
     for v in [
         stats.scrolls,
@@ -148,6 +154,7 @@ pub(super) fn put_terrain(
 pub(super) fn read_terrain(
     data: &[u8],
     config: &ManagerConfig,
+    version: u32,
 ) -> std::result::Result<SavedTerrain, String> {
     let mut r = Reader::new(data);
     let index = r.u32("its handle")?;
@@ -178,7 +185,14 @@ pub(super) fn read_terrain(
         let offset = r.u64("a level's slot")?;
         let carry = r.f64("a level's carry")?;
         let words = r.words("a level's words")?;
+        let settle = if version >= 4 {
+            super::parse::read_settle(&mut r)?
+        } else {
+            crate::relax::Settle::default()
+        };
         let [w, h] = l.texels;
+        let what = format!("terrain {name:?} level {i}");
+        super::parse::check_settle(&settle, &what, desc.material.settle_updates, (w, h), false)?;
         let unit = format.precision.unit_texels() as i64;
         let far = origin
             .iter()
@@ -213,6 +227,7 @@ pub(super) fn read_terrain(
             offset,
             carry,
             words,
+            settle,
         });
     }
     let mut s = [0u64; 7];

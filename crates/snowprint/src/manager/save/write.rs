@@ -137,7 +137,13 @@ impl SnowManager {
             at += n;
             let mut parts = Vec::with_capacity(n);
             for (&id, s) in ids.iter().zip(snaps) {
-                parts.push((self.world.slot_of(id)?.offset, s.carry, s.words.as_slice()));
+                let settle = self.world.settle_of(id)?;
+                parts.push((
+                    self.world.slot_of(id)?.offset,
+                    s.carry,
+                    s.words.as_slice(),
+                    settle,
+                ));
             }
             out.push(super::terrain::put_terrain(index, t, &parts)?);
         }
