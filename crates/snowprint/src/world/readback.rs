@@ -91,8 +91,10 @@ impl SnowWorld {
     }
 
     /// Debug readback of the last step: the capture of a surface (depth per texel, 1 = nothing,
-    /// `width x height` of them), when it was captured in that step; `None` otherwise. The apron
-    /// the capture also covers is left out ([`SnowWorld::read_last_capture_region`] keeps it).
+    /// `width x height` of them), when it was captured in that step; `None` otherwise, and for a
+    /// surface whose deformers the update ray-cast itself ([`crate::CapturePath::Update`]: no
+    /// capture holds it). The apron the capture also covers is left out
+    /// ([`SnowWorld::read_last_capture_region`] keeps it).
     pub fn read_last_capture(&self, id: SurfaceId) -> Result<Option<Vec<f32>>> {
         let layout = self.state(id)?.layout;
         Ok(self
