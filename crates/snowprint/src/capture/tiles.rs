@@ -2,6 +2,8 @@
 //! path's work ([`tiles_reached`], tiles of the capture region) and the update's own ray cast
 //! ([`update_tiles_reached`], tiles of the update).
 
+use std::ops::RangeInclusive;
+
 use super::{APRON, GpuPrimitive, footprint, region};
 
 /// Append to `work` an entry `[view, tile y << 16 | tile x]` for every 16 x 16 tile of the
@@ -50,28 +52,17 @@ pub fn tiles_reached(
             to_cell(z0 - texel.y, half.y, texel.y, rh),
             to_cell(z1 + texel.y, half.y, texel.y, rh),
         );
-        for r in r0 / tile..=r1 / tile {
-            for c in c0 / tile..=c1 / tile {
-                let i = (r * tx + c) as usize;
-                if !seen[i] {
-                    seen[i] = true;
-                    work.push([view, r << 16 | c]);
-                }
-            }
-        }
+        let tiles = (c0 / tile..=c1 / tile, r0 / tile..=r1 / tile);
+        push_unseen(view, tiles, tx, seen, work);
     }
     let reached = work.len();
     for k in first..reached {
         let (c, r) = (work[k][1] & 0xffff, work[k][1] >> 16);
-        for nr in r.saturating_sub(1)..=(r + 1).min(ty - 1) {
-            for nc in c.saturating_sub(1)..=(c + 1).min(tx - 1) {
-                let i = (nr * tx + nc) as usize;
-                if !seen[i] {
-                    seen[i] = true;
-                    work.push([view, nr << 16 | nc]);
-                }
-            }
-        }
+        let beside = (
+            c.saturating_sub(1)..=(c + 1).min(tx - 1),
+            r.saturating_sub(1)..=(r + 1).min(ty - 1),
+        );
+        push_unseen(view, beside, tx, seen, work);
     }
     let sparse = (work.len() - reached) as u64 * SPARSE_TILES < (tx * ty) as u64;
     if !sparse {
@@ -119,21 +110,31 @@ pub fn update_tiles_reached(
         if hi.x < -half.x || hi.y < -half.y || lo.x > half.x || lo.y > half.y {
             continue;
         }
-        let (c0, c1) = (
-            to_texel(lo.x, half.x, texel.x, width) / tile,
-            to_texel(hi.x, half.x, texel.x, width) / tile,
+        let tiles = (
+            to_texel(lo.x, half.x, texel.x, width) / tile
+                ..=to_texel(hi.x, half.x, texel.x, width) / tile,
+            to_texel(lo.y, half.y, texel.y, height) / tile
+                ..=to_texel(hi.y, half.y, texel.y, height) / tile,
         );
-        let (r0, r1) = (
-            to_texel(lo.y, half.y, texel.y, height) / tile,
-            to_texel(hi.y, half.y, texel.y, height) / tile,
-        );
-        for r in r0..=r1 {
-            for c in c0..=c1 {
-                let i = (r * tx + c) as usize;
-                if !seen[i] {
-                    seen[i] = true;
-                    list.push([record, r << 16 | c]);
-                }
+        push_unseen(record, tiles, tx, seen, list);
+    }
+}
+
+/// Append `[id, tile y << 16 | tile x]` for each tile of the `(columns, rows)` ranges of a grid
+/// `tx` tiles wide that `seen` does not hold yet, marking it.
+fn push_unseen(
+    id: u32,
+    (columns, rows): (RangeInclusive<u32>, RangeInclusive<u32>),
+    tx: u32,
+    seen: &mut [bool],
+    out: &mut Vec<[u32; 2]>,
+) {
+    for r in rows {
+        for c in columns.clone() {
+            let i = (r * tx + c) as usize;
+            if !seen[i] {
+                seen[i] = true;
+                out.push([id, (r << 16) | c]);
             }
         }
     }

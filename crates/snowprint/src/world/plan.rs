@@ -610,8 +610,8 @@ impl FramePlan {
             }
             a.records.push(record);
             if job.way == Way::Cast {
-                let r = &job.record;
-                if r.replenish_units > 0 && record.mode & MODE_REFILLED == 0 {
+                let r = &record;
+                if r.replenish_units > 0 && r.mode & MODE_REFILLED == 0 {
                     // The fused pass refills it: every tile.
                     let tiles_x = r.width.div_ceil(TILE_SIDE);
                     c.listed.extend(
