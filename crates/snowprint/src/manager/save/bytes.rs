@@ -2,6 +2,7 @@
 
 use super::{CODEC_LZ4, CODEC_RAW};
 use crate::mesh::Mesh;
+use crate::relax::{Rect, Settle};
 
 /// A little-endian reader over a byte slice that never reads past its end.
 pub(super) struct Reader<'a> {
@@ -134,6 +135,29 @@ pub(super) fn read_mesh(r: &mut Reader<'_>) -> std::result::Result<Mesh, String>
         indices.push(r.u32("an index")?);
     }
     Ok(Mesh { positions, indices })
+}
+
+/// A settle state after a heightmap's words (from version 4): updates, then the rectangle's first
+/// column, first row, and one past its last column and row ([`read_settle`] reads it).
+pub(super) fn put_settle(out: &mut Vec<u8>, s: &Settle) {
+    let r = s.rect;
+    for v in [s.updates, r.x0, r.y0, r.x1, r.y1] {
+        put_u32(out, v);
+    }
+}
+
+/// A settle state as [`put_settle`] writes it.
+pub(super) fn read_settle(r: &mut Reader<'_>) -> std::result::Result<Settle, String> {
+    let updates = r.u32("its settle updates")?;
+    let mut v = [0; 4];
+    for x in &mut v {
+        *x = r.u32("its settle rectangle")?;
+    }
+    let [x0, y0, x1, y1] = v;
+    Ok(Settle {
+        updates,
+        rect: Rect { x0, y0, x1, y1 },
+    })
 }
 
 pub(super) fn put_string(out: &mut Vec<u8>, s: &str) {

@@ -9,7 +9,7 @@ use super::{
 };
 use crate::manager::ManagerConfig;
 use crate::manager::planner::PlannerState;
-use crate::relax::{Rect, Settle};
+use crate::relax::Settle;
 use crate::world::SurfaceSnapshot;
 
 impl SaveFile {
@@ -250,7 +250,7 @@ pub(super) fn read_surface(
     let words = r.words("its words")?;
     // From version 4: how long and where a slumping material still relaxes.
     let settle = if version >= 4 {
-        read_settle(&mut r)?
+        super::bytes::read_settle(&mut r)?
     } else {
         Settle::default()
     };
@@ -316,21 +316,6 @@ pub(super) fn check_settle(
         ));
     }
     Ok(())
-}
-
-/// A settle state as written after a heightmap's words (from version 4): updates, then the
-/// rectangle's first column, first row, and one past its last column and row.
-pub(super) fn read_settle(r: &mut Reader<'_>) -> std::result::Result<Settle, String> {
-    let updates = r.u32("its settle updates")?;
-    let mut v = [0; 4];
-    for x in &mut v {
-        *x = r.u32("its settle rectangle")?;
-    }
-    let [x0, y0, x1, y1] = v;
-    Ok(Settle {
-        updates,
-        rect: Rect { x0, y0, x1, y1 },
-    })
 }
 
 /// A `GRND` section: checked against its surface's heightmap size, its heights finite, its rule
@@ -401,6 +386,7 @@ pub(super) fn one_line(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::relax::Rect;
 
     /// A settle state that does not fit its surface is refused in one sentence naming it: a
     /// rectangle past its texels or turned inside out, more updates than its material settles for,

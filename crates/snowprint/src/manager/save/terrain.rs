@@ -16,7 +16,7 @@
 //! ```
 
 use super::SavedTerrain;
-use super::bytes::{Reader, put_u32, put_u64};
+use super::bytes::{Reader, put_settle, put_u32, put_u64};
 use crate::ground::{HeightGrid, SlopeRule};
 use crate::manager::ManagerConfig;
 use crate::manager::planner::PlannerState;
@@ -120,10 +120,7 @@ pub(super) fn put_terrain(
         b.extend_from_slice(&carry.to_bits().to_le_bytes());
         put_u64(&mut b, words.len() as u64);
         b.extend_from_slice(bytemuck::cast_slice(words));
-        let r = settle.rect;
-        for v in [settle.updates, r.x0, r.y0, r.x1, r.y1] {
-            put_u32(&mut b, v);
-        }
+        put_settle(&mut b, &settle);
     }
     for v in [
         stats.scrolls,
@@ -186,7 +183,7 @@ pub(super) fn read_terrain(
         let carry = r.f64("a level's carry")?;
         let words = r.words("a level's words")?;
         let settle = if version >= 4 {
-            super::parse::read_settle(&mut r)?
+            super::bytes::read_settle(&mut r)?
         } else {
             crate::relax::Settle::default()
         };

@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::bytes::{put_mesh, put_string, put_u32, put_u64, section};
+use super::bytes::{put_mesh, put_settle, put_string, put_u32, put_u64, section};
 use super::config::SavedConfig;
 use super::{MAGIC, VERSION};
 use crate::error::{Result, SnowError};
@@ -99,10 +99,7 @@ impl SnowManager {
             b.extend_from_slice(&s.carry.to_bits().to_le_bytes());
             put_u64(&mut b, s.words.len() as u64);
             b.extend_from_slice(bytemuck::cast_slice(&s.words));
-            let r = settle.rect;
-            for v in [settle.updates, r.x0, r.y0, r.x1, r.y1] {
-                put_u32(&mut b, v);
-            }
+            put_settle(&mut b, settle);
             section(&mut out, b"SURF", &b);
         }
         for (i, g) in grounds {
