@@ -30,8 +30,8 @@ fn cast_cell(rec: SurfaceRecord, x: i32, y: i32) -> vec2<u32> {
 
 var<workgroup> cast_bits: atomic<u32>;
 var<workgroup> cast_mask_shared: u32;
-// The record's primitives and their footprints clipped to the region (`cast_covers`), by their
-// index in the record, kept for the workgroup's ray casts by `cast_mask`.
+// The record's primitives and their footprints clipped to the region as the capture draws them,
+// by their index in the record, kept for the workgroup's ray casts by `cast_mask`.
 var<workgroup> cast_prims: array<Primitive, CAST_PRIMS_MAX>;
 var<workgroup> cast_rects: array<vec4<f32>, CAST_PRIMS_MAX>;
 
