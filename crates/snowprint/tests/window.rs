@@ -397,7 +397,9 @@ fn bad_terrains_and_foci_are_refused_in_one_sentence() {
 
 mod render {
     use super::*;
-    use snowprint::render::{Environment, RenderConfig, RenderFrame, Renderer, Tier};
+    use snowprint::render::{
+        Environment, RenderConfig, RenderFrame, Renderer, SearchSettings, Tier,
+    };
     use snowprint::{Camera, GroundMaterial, SurfaceId};
 
     fn shoot(
@@ -418,9 +420,22 @@ mod render {
         camera: Camera,
         size: (u32, u32),
     ) -> (Renderer, Vec<u8>) {
+        shot_searching(w, ids, tier, camera, size, None)
+    }
+
+    /// [`shot`] with the relief search's settings (`None`: the tier's).
+    fn shot_searching(
+        w: &SnowWorld,
+        ids: &[SurfaceId],
+        tier: Tier,
+        camera: Camera,
+        size: (u32, u32),
+        search: Option<SearchSettings>,
+    ) -> (Renderer, Vec<u8>) {
         let mut c = RenderConfig::new(size.0, size.1, tier);
         c.shadow_map_size = 256;
         c.snowflakes = 0;
+        c.search = search;
         let surfaces: Vec<_> = ids.iter().map(|&i| (i, GroundMaterial::Concrete)).collect();
         let mut r = Renderer::new(common::gpu(), c).unwrap();
         let f = RenderFrame {
@@ -774,6 +789,110 @@ mod render {
                 assert!(differ.is_empty(), "a seam at {differ:?}");
             }
         }
+        up_close(&a, &b, &[level, roof], one, camera, line, desc.center.z);
+    }
+
+    /// The trodden line of [`a_window_and_a_surface_beside_it_meet_without_a_seam`] at 960x640,
+    /// where a ridge between two prints crosses it a few pixels wide.
+    ///
+    /// Relief: each box spends its own linear taps over its own span, so where the taps step over
+    /// a ridge the two boxes and the one wider box can miss it differently (with the tier's 12
+    /// taps, 8 pixels of the ridge's outline differ). With a search fine enough to resolve the
+    /// ridge, the two draw the one surface's pixels within 2 of 255: the line itself adds nothing.
+    ///
+    /// Tessellated: the two meshes are diced apart and the one mesh across the line, so their
+    /// vertices differ everywhere on the trail and so do a few pixels along every texel line
+    /// across it. The meeting line must be no worse than the others: no more pixels differing by
+    /// more than 2 of 255 within 1.5 pixels of it and the two texel lines either side than along
+    /// any other five texel lines over the trail. (With the sides left unlinked, 831 pixels differ
+    /// around the line against at most 133 elsewhere.)
+    fn up_close(
+        a: &SnowWorld,
+        b: &SnowWorld,
+        two_ids: &[SurfaceId],
+        one: SurfaceId,
+        camera: Camera,
+        line: f32,
+        z: f32,
+    ) {
+        let size = (960, 640);
+        let dense = SearchSettings {
+            taps_per_texel: 4.0,
+            min_taps: 4,
+            max_taps: 256,
+            refine_taps: 10,
+            shadow_taps: 0,
+        };
+        let two = shot_searching(a, two_ids, Tier::Relief, camera, size, Some(dense)).1;
+        let reference = shot_searching(b, &[one], Tier::Relief, camera, size, Some(dense)).1;
+        save("beside_close_Relief.png", &two, size);
+        let differ = seam_pixels(&two, &reference, size);
+        println!(
+            "Relief, 960x640, a search of 4 taps a texel: {} pixels differ from the one surface by more than 2 of 255",
+            differ.len()
+        );
+        assert!(differ.is_empty(), "a seam up close at {differ:?}");
+
+        let two = shoot(a, two_ids, Tier::Tessellated, camera, size);
+        let reference = shoot(b, &[one], Tier::Tessellated, camera, size);
+        save("beside_close_Tessellated.png", &two, size);
+        let project = |p: Vec3| {
+            let clip = camera.projection(size.0 as f32 / size.1 as f32, 0.05, 100.0)
+                * camera.view()
+                * p.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            glam::Vec2::new(
+                (ndc.x * 0.5 + 0.5) * size.0 as f32,
+                (0.5 - ndc.y * 0.5) * size.1 as f32,
+            )
+        };
+        // Pixels that differ within 1.5 pixels of the texel line `k` texels past the meeting
+        // line, over the trail (its prints lie within 25 cm of z).
+        let differing_along = |k: i32| {
+            let x = line + k as f32 * 0.04;
+            let (p, q) = (
+                project(Vec3::new(x, 1.0 + DEPTH, z - 0.25)),
+                project(Vec3::new(x, 1.0 + DEPTH, z + 0.25)),
+            );
+            let d = q - p;
+            let mut n = 0;
+            for y in 0..size.1 {
+                for xp in 0..size.0 {
+                    let c = glam::Vec2::new(xp as f32, y as f32) - p;
+                    let s = c.dot(d) / d.length_squared();
+                    let off = (c - d * s).length();
+                    let i = 4 * (y * size.0 + xp) as usize;
+                    if (0.0..=1.0).contains(&s)
+                        && off <= 1.5
+                        && (0..3).any(|ch| two[i + ch].abs_diff(reference[i + ch]) > 2)
+                    {
+                        n += 1;
+                    }
+                }
+            }
+            n
+        };
+        // A seam (the sides left unlinked, say) spreads over the two texels either side of the
+        // line, so the five texel lines around it are weighed against every other five.
+        let along: Vec<u32> = (-30..=30).map(differing_along).collect();
+        let around = |k: i32| {
+            (k - 2..=k + 2)
+                .map(|j| along[(j + 30) as usize])
+                .sum::<u32>()
+        };
+        let at_line = around(0);
+        let worst = (-28..=28)
+            .filter(|k: &i32| k.abs() >= 5)
+            .map(around)
+            .max()
+            .unwrap_or(0);
+        println!(
+            "Tessellated, 960x640: {at_line} pixels differ along the five texel lines around the meeting line, at most {worst} along any other five over the trail"
+        );
+        assert!(
+            at_line <= worst,
+            "the meeting line differs in {at_line} pixels, more than anywhere else on the trail ({worst})"
+        );
     }
 
     /// The largest difference of the level's and the roof's fields (`l`, 64 columns, and `r`, 32)
