@@ -14,6 +14,8 @@ pub enum GroundMaterial {
     RoofTiles,
     /// Concrete (streets, flat roofs).
     Concrete,
+    /// Bare rock (terrain: the cliffs and outcrops too steep to hold snow show it).
+    Rock,
 }
 
 /// A perspective camera.

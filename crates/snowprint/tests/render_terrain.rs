@@ -170,12 +170,13 @@ fn scene_with(on_ground: bool, pressed: bool, slope: SlopeRule) -> Scene {
 }
 
 fn render(scene: &mut Scene, tier: Tier) -> RenderOutput {
+    render_on(scene, tier, GroundMaterial::Concrete)
+}
+
+/// [`render`] with the surfaces' ground drawn as `ground`.
+fn render_on(scene: &mut Scene, tier: Tier, ground: GroundMaterial) -> RenderOutput {
     scene.renderer.set_tier(tier);
-    let surfaces: Vec<_> = scene
-        .surfaces
-        .iter()
-        .map(|&id| (id, GroundMaterial::Concrete))
-        .collect();
+    let surfaces: Vec<_> = scene.surfaces.iter().map(|&id| (id, ground)).collect();
     let frame = RenderFrame {
         camera: Camera {
             eye: Vec3::new(0.0, 2.3, 3.0),
@@ -309,9 +310,10 @@ fn slope_patch(out: &RenderOutput) -> (f32, f32) {
     (sum / n as f32, jumps as f32 / n as f32)
 }
 
-/// Where a slope is too steep to hold snow its rock shows: the 30-degree plane under a rule that
-/// bares it (none held from 20 degrees) draws darker than under one that keeps all its snow, and
-/// without the speckle a division by the little snow held would make.
+/// Where a slope is too steep to hold snow its ground shows: the 30-degree plane under a rule
+/// that bares it (none held from 20 degrees) draws darker than under one that keeps all its snow,
+/// and without the speckle a division by the little snow held would make, as concrete and as
+/// rock (whose relief image is a golden).
 #[test]
 fn a_bare_slope_shows_its_rock() {
     let bare = SlopeRule {
@@ -323,18 +325,24 @@ fn a_bare_slope_shows_its_rock() {
             &mut scene_with(true, false, SlopeRule::NEVER_BARE),
             tier,
         ));
-        let out = render(&mut scene_with(true, false, bare), tier);
-        keep(&format!("bare_{tier:?}"), &out);
-        let (rock, speckle) = slope_patch(&out);
-        eprintln!("{tier:?}: snow {snowy:.1}, bare {rock:.1}, speckle {speckle:.4}");
-        assert!(
-            rock < 0.7 * snowy,
-            "{tier:?}: the bare slope reads {rock}, its snow {snowy}"
-        );
-        assert!(
-            speckle < 0.02,
-            "{tier:?}: {speckle} of the bare slope's pixels jump"
-        );
+        for ground in [GroundMaterial::Concrete, GroundMaterial::Rock] {
+            let out = render_on(&mut scene_with(true, false, bare), tier, ground);
+            keep(&format!("bare_{tier:?}_{ground:?}"), &out);
+            if (tier, ground) == (Tier::Relief, GroundMaterial::Rock) {
+                // The rock's own look (mottled, cracked, no joints), held by a golden.
+                check("terrain_bare_rock", &out);
+            }
+            let (rock, speckle) = slope_patch(&out);
+            eprintln!("{tier:?} {ground:?}: snow {snowy:.1}, bare {rock:.1}, speckle {speckle:.4}");
+            assert!(
+                rock < 0.7 * snowy,
+                "{tier:?} {ground:?}: the bare slope reads {rock}, its snow {snowy}"
+            );
+            assert!(
+                speckle < 0.02,
+                "{tier:?} {ground:?}: {speckle} of the bare slope's pixels jump"
+            );
+        }
     }
 }
 

@@ -266,7 +266,7 @@ pub(crate) struct Shading {
     pub search: crate::render::SearchSettings,
     /// The material's look and switches.
     pub look: crate::render::SnowLook,
-    /// `SNOW_GROUND_TILES` or `SNOW_GROUND_CONCRETE`.
+    /// `SNOW_GROUND_TILES`, `SNOW_GROUND_CONCRETE` or `SNOW_GROUND_ROCK`.
     pub ground: u32,
     /// The surface's slot in the renderer's per-surface tables.
     pub index: u32,

@@ -72,7 +72,7 @@ pub fn lay(
     let mut out: Vec<(SurfaceId, GroundMaterial)> = valley
         .surfaces()
         .into_iter()
-        .map(|id| (id, GroundMaterial::Concrete))
+        .map(|id| (id, GroundMaterial::Rock))
         .collect();
     let (roof, ridge) = terrain::roof_triangles();
     let (c, half, _, _) = CABIN;

@@ -173,6 +173,7 @@ impl SnowPass {
                 ground: match surface.ground {
                     GroundMaterial::RoofTiles => 0,
                     GroundMaterial::Concrete => 1,
+                    GroundMaterial::Rock => 2,
                 },
                 index: s as u32,
                 macro_waves: surface.geometry.macro_waves,

@@ -55,7 +55,7 @@ struct SnowSurface {
     snow_depth: f32,        // metres of fresh snow over the ground
     texel: f32,             // heightmap texel side, metres
     grid: vec2<f32>,        // heightmap width and height, texels
-    ground: u32,            // SNOW_GROUND_TILES or SNOW_GROUND_CONCRETE
+    ground: u32,            // SNOW_GROUND_TILES, SNOW_GROUND_CONCRETE or SNOW_GROUND_ROCK
     index: u32,             // the surface's slot in the renderer's per-surface tables
     search: vec4<f32>,      // x: linear taps per texel crossed, y: min taps, z: max taps, w: binary refinement taps
     look: vec4<f32>,        // x: depression where the ground starts to show, y: where it shows fully, z: AO strength, w: POM self-shadow taps
@@ -90,6 +90,7 @@ fn snow_in_hole(s: SnowSurface, xz: vec2<f32>) -> bool {
 
 const SNOW_GROUND_TILES: u32 = 0u;
 const SNOW_GROUND_CONCRETE: u32 = 1u;
+const SNOW_GROUND_ROCK: u32 = 2u;
 const SNOW_TIER_RELIEF: u32 = 0u;
 const SNOW_TIER_POM: u32 = 1u;
 // `terrain` of a surface on flat ground. Must match NO_GROUND in wgsl/constants.wgsl.
@@ -543,9 +544,35 @@ fn snow_concrete(p: vec2<f32>, pixel: f32) -> SnowLayer {
     return layer;
 }
 
+// Bare rock (a terrain's cliffs and outcrops): weathered grey stone, blotched over metres, mottled
+// over centimetres, and cut by a few irregular cracks where a noise crosses its middle. Nothing in
+// it is straight or periodic, so the planar mapping's stretch down a steep face reads as streaks
+// of weathering, not as the lines that concrete's joints drew there.
+fn snow_rock(p: vec2<f32>, pixel: f32) -> SnowLayer {
+    let blotch = snow_fbm(p, 0.45, pixel);
+    let mottle = snow_fbm(p + vec2<f32>(5.3, 1.7), 6.0, pixel);
+    let grain = snow_fbm(p, 30.0, pixel);
+    let vein = snow_fbm(p + vec2<f32>(11.0, 3.0), 1.3, pixel);
+    // A crack: a line about a centimetre wide where the vein noise is 0.5, broken up by the
+    // blotches (so it runs for a while and stops) and faded once it is narrower than a pixel.
+    let width = 0.012 * length(vein.yz) + 1e-4;
+    let runs = smoothstep(0.45, 0.6, blotch.x);
+    let crack = (1.0 - smoothstep(0.0, width, abs(vein.x - 0.5))) * runs * (1.0 - smoothstep(0.01, 0.04, pixel));
+    var layer: SnowLayer;
+    let tone = (0.65 + 0.7 * blotch.x) * (0.8 + 0.4 * mottle.x) * (0.92 + 0.16 * grain.x);
+    layer.albedo = vec3<f32>(0.33, 0.31, 0.28) * tone * (1.0 - 0.4 * crack);
+    layer.roughness = 0.9 - 0.1 * mottle.x;
+    layer.normal = snow_normal_from_gradient(mottle.yz * 0.004 + grain.yz * 0.0015 + vein.yz * 0.02 * crack);
+    layer.f0 = 0.04;
+    return layer;
+}
+
 fn snow_ground_layer(s: SnowSurface, p: vec2<f32>, pixel: f32) -> SnowLayer {
     if s.ground == SNOW_GROUND_CONCRETE {
         return snow_concrete(p, pixel);
+    }
+    if s.ground == SNOW_GROUND_ROCK {
+        return snow_rock(p, pixel);
     }
     return snow_roof_tiles(p, pixel);
 }
