@@ -20,14 +20,16 @@ pub fn build(
     let mut v = Vec::new();
     // The floor: under the snow and snow-covered beyond it, out to the ridges. Under the snow it
     // lies a little more than the snow's depth down (where prints reach the ground it is the
-    // surfaces' own ground that shows), so that its shadow never falls on the snow it carries.
+    // surfaces' own ground that shows). It casts the valley's shadows (the outcrop's across the
+    // slope below it) into the shadow map, which the relief tier's snow is not drawn into; lying
+    // under the snow's top, it does not shade the snow over it.
     let floor = renderer
-        .add_mesh(&terrain::floor_mesh(150.0, 2.0, 0.35))
+        .add_mesh(&terrain::floor_mesh(150.0, 1.0, 0.35))
         .map_err(rerr)?;
     let mut ground = Instance::new(floor, Mat4::IDENTITY, [0.78, 0.8, 0.86]);
     ground.roughness = 0.85;
     ground.snow_cover = 1.0;
-    v.push(ground.with_shadow(false));
+    v.push(ground);
     v.extend(trees(renderer, clear)?);
     v.extend(rocks(renderer)?);
     v.extend(cabin(renderer)?);
