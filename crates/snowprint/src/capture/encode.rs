@@ -47,7 +47,7 @@ pub struct CapturedSurface {
     /// Whether the compute path captures it (its view's `prims` and `rect`; no viewport).
     pub compute: bool,
     /// Whether its region is cleared before the capture: always on the raster path; on the compute
-    /// path unless its work list took the tiles beside the reached ones ([`super::tiles_reached`]).
+    /// path unless its work list took the tiles beside the reached ones (`capture::tiles_reached`).
     pub cleared: bool,
 }
 
@@ -161,7 +161,7 @@ impl CapturePlan {
 #[derive(Clone, Copy, Debug)]
 pub struct CaptureBuffers<'a> {
     /// [`CaptureView`]s, one uniform block (256 bytes) each, then (when the compute path has
-    /// work) [`CapturePlan::work`] and its first word and length ([`work_table`]).
+    /// work) [`CapturePlan::work`] and its first word and length (`work_table`).
     pub views: &'a wgpu::Buffer,
     /// [`GpuPrimitive`]s.
     pub prims: &'a wgpu::Buffer,

@@ -148,7 +148,7 @@ pub struct CaptureView {
     /// Compute path: its primitives (first, count); count 0 on the raster path.
     pub prims: [u32; 2],
     /// Compute path: 1 where its region is not cleared and each tile the work list takes is
-    /// written whole ([`tiles_reached`]); else 0.
+    /// written whole (`tiles_reached`); else 0.
     pub whole: u32,
     /// Padding to the WGSL struct's 8-byte alignment.
     pub _pad: u32,
@@ -198,7 +198,7 @@ pub enum CapturePath {
     #[default]
     Auto,
     /// Compute, one dispatch for every surface that only analytic deformers press (up to
-    /// [`COMPUTE_PRIMS_MAX`] primitives): no viewport and no draw per surface, a workgroup per tile
+    /// `COMPUTE_PRIMS_MAX` primitives): no viewport and no draw per surface, a workgroup per tile
     /// the primitives reach. Surfaces that meshes press are rendered.
     Compute,
     /// Every surface rendered in its viewport of the atlas, primitives as rectangles.

@@ -27,7 +27,7 @@ pub fn height_over(t: &[Vec3; 3], x: f32, z: f32) -> Option<f32> {
     Some(wa * a.y + wb * b.y + wc * c.y)
 }
 
-/// Reference of [`super::GroundRaster::rasterise`]: world-space `triangles` over the texel centres
+/// Reference of [`super::raster::GroundRaster::rasterise`]: world-space `triangles` over the texel centres
 /// of a surface (`world_to_local`, sides `size`, `layout`), the highest face at each, row-major.
 pub fn rasterise(
     triangles: &[[Vec3; 3]],

@@ -300,7 +300,7 @@ impl GroundField {
     }
 
     /// The columns of the surface's capture region, the apron's extrapolated
-    /// ([`region_columns`]).
+    /// (`region_columns`).
     pub fn region_columns(&self) -> Vec<[f32; 2]> {
         region_columns(&self.columns, self.width, self.height)
     }

@@ -308,7 +308,7 @@ impl SnowManager {
     }
 
     /// Register a mesh deformer shape (see [`SnowWorld::add_mesh`]). The handle is the manager's:
-    /// use it in [`Shape::Mesh`] of the deformers given to [`SnowManager::tick`].
+    /// use it in [`crate::Shape::Mesh`] of the deformers given to [`SnowManager::tick`].
     pub fn add_mesh(&mut self, name: &str, mesh: &Mesh) -> Result<MeshId> {
         let world = self.world.add_mesh(name, mesh)?;
         self.planner

@@ -264,7 +264,7 @@ pub struct SurfaceRecord {
     pub texel_z: f32,
     /// First of the surface's tile flags written by the capture (see `capture.wgsl`).
     pub tiles: u32,
-    /// Toroidal storage offsets, `ox | oy << 16` ([`wrapped`]); 0 for an ordinary surface.
+    /// Toroidal storage offsets, `ox | oy << 16` (`pool::wrapped`); 0 for an ordinary surface.
     pub wrap: u32,
     /// With [`MODE_CAST`]: half the surface's side along x, metres (what the update's ray cast
     /// reads instead of a capture view).

@@ -36,13 +36,13 @@ pub struct RelaxRecord {
     pub threshold_x: u32,
     /// The same between z neighbours.
     pub threshold_z: u32,
-    /// The rectangle that relaxes ([`Rect`]): first column, first row, columns, rows.
+    /// The rectangle that relaxes (`relax::Rect`): first column, first row, columns, rows.
     pub rect: [u32; 4],
     /// Steps each relaxing dispatch takes ([`RelaxPlan::schedule`]).
     pub dispatch_steps: u32,
     /// First word of the surface's tile flags ([`RelaxPlan::tile_words`]).
     pub tiles: u32,
-    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    /// Toroidal storage offsets (`pool::wrapped`).
     pub wrap: u32,
 }
 
@@ -174,7 +174,7 @@ impl RelaxPlan {
         self.records.push(record);
     }
 
-    /// Split the plan's steps into dispatches ([`split_steps`]) and tell every record (call once
+    /// Split the plan's steps into dispatches (`split_steps`) and tell every record (call once
     /// every surface is listed).
     pub fn schedule(&mut self) {
         let (n, k) = split_steps(self.steps, crate::wgsl::consts::RELAX_HALO);

@@ -295,7 +295,7 @@ pub struct ClassifyRecord {
     /// flat (the basic one draws a flat top), or with a hole (the basic one cannot meet the step
     /// at its edge, `surface.wgsl`'s `through_hole`), else 0.
     pub always_deformable: u32,
-    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    /// Toroidal storage offsets (`pool::wrapped`).
     pub wrap: u32,
     /// The texels the bank passes run over: along x in the low 16 bits, along z in the high.
     pub banks: u32,
@@ -329,7 +329,7 @@ pub struct HeightfieldParams {
     /// First texel of the surface's ground field ([`crate::FrameView::ground_buffer`]), or
     /// [`crate::low_level::ground::NO_GROUND`] on flat ground.
     pub ground: u32,
-    /// Toroidal storage offsets ([`crate::pool::wrapped`]).
+    /// Toroidal storage offsets (`pool::wrapped`).
     pub wrap: u32,
     /// Padding (three members, as in WGSL).
     pub _pad: [u32; 3],

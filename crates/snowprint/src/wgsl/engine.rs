@@ -30,7 +30,7 @@ const POOL_DECLARATION: &str =
     "@group(0) @binding(0) var<storage, read> snowprint_pool: array<u32>;";
 
 /// The engine module with the pool at `options`' group and binding: WGSL to put into a shader
-/// module (declarations may come in any order). See the [module docs](self) for the contract.
+/// module (declarations may come in any order). The contract is in the module's documentation (`wgsl/engine.rs`).
 pub fn engine_module(options: &ImportOptions) -> String {
     rebind(super::libraries::ENGINE, options)
 }

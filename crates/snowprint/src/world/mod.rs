@@ -552,7 +552,7 @@ impl SnowWorld {
         ))
     }
 
-    /// A surface's toroidal storage offsets, `ox | oy << 16` ([`crate::pool::wrapped`]): 0 for
+    /// A surface's toroidal storage offsets, `ox | oy << 16` (`pool::wrapped`): 0 for
     /// every surface but a terrain window's levels (`crate::Terrain`).
     pub fn wrap(&self, id: SurfaceId) -> Result<u32> {
         Ok(self.state(id)?.wrap)

@@ -112,7 +112,7 @@ pub struct PlanSurface<'a> {
     pub heights_word: u32,
     /// Word offset of its normals, when the pool keeps them.
     pub normals_word: Option<u32>,
-    /// Its toroidal storage offsets ([`crate::pool::wrapped`]; 0 for an ordinary surface).
+    /// Its toroidal storage offsets (`pool::wrapped`; 0 for an ordinary surface).
     pub wrap: u32,
     /// Replenishment carried from earlier updates, units (a fraction in `[0, 1)`).
     pub carry: f64,

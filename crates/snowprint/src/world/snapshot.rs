@@ -23,7 +23,7 @@ pub struct SurfaceSnapshot {
     /// Replenishment not yet applied, units at the format's precision (a fraction in `[0, 1)`).
     pub carry: f64,
     /// The slot's words: the heights region, then the normals when the format keeps them, in
-    /// logical order (a terrain level stored wrapped is unwrapped: [`crate::pool::wrapped`]).
+    /// logical order (a terrain level stored wrapped is unwrapped: `pool::wrapped`).
     pub words: Vec<u32>,
 }
 
