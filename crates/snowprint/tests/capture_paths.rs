@@ -210,7 +210,11 @@ proptest! {
         listed in any::<bool>(),
     ) {
         let c = compare(listed, &spots, per, seed);
-        prop_assert!(c.both > 0, "nothing was captured");
+        // A surface under 2 m across with one deformer lies off that deformer's path (it runs
+        // 1.2 m out along z): neither path may capture anything there, and the case compares
+        // nothing, so another is drawn.
+        prop_assert!(c.both > 0 || c.edges == 0, "only one path captured");
+        prop_assume!(c.both > 0);
         prop_assert_eq!(c.unequal, 0, "codes differ where both captured");
         prop_assert!(c.edges * 1000 <= c.both, "{} edge texels of {}", c.edges, c.both);
         prop_assert_eq!(c.compute_wrong, 0, "the compute path misses the reference");
@@ -371,11 +375,14 @@ proptest! {
     ) {
         let paths = [CapturePath::Compute, CapturePath::Update];
         let maps = heightmaps_of_two_paths(paths, (listed, streamed), &spots, per, seed);
-        prop_assert!(maps.iter().any(|[a, _]| a.iter().any(|&v| v > 0)), "nothing pressed");
         for (k, [a, b]) in maps.iter().enumerate() {
             let diff = a.iter().zip(b).filter(|(x, y)| x != y).count();
             prop_assert_eq!(diff, 0, "frame {} surface {} differs", k / spots.len(), k % spots.len());
         }
+        // A surface under 2 m across with one deformer lies off that deformer's path (it runs
+        // 1.2 m out along z): both paths leave it untouched (above), and the case counts only
+        // where something was pressed.
+        prop_assume!(maps.iter().any(|[a, _]| a.iter().any(|&v| v > 0)));
     }
 }
 
