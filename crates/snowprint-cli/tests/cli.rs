@@ -383,9 +383,12 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
     // files in it caught the writing itself only when the test ran alone: in a full clean-clone
     // run every dump finished unseen. With two frames the run also outran the signal in a clean
     // clone (twenty times in a row): forty frames keep it staging long after the folder appears.
+    // Forty frames still outran the poll twenty times in a row in one clean clone (the run takes
+    // under a second alone): four hundred keep it staging ten times as long, and it is killed as
+    // soon as the folder appears, so the test takes no longer.
     let mut interrupted = false;
     for _attempt in 0..20 {
-        let mut child = run("40");
+        let mut child = run("400");
         let staging = dump.join(format!(".snowprint-dump-partial-{}", child.id()));
         let start = std::time::Instant::now();
         let mut writing = false;
@@ -420,7 +423,7 @@ fn sigint_during_a_dump_leaves_the_old_set_or_the_new_one() {
                     1,
                     "the interrupted run's staging"
                 ),
-                40 => {}
+                400 => {}
                 other => panic!("frames {other}"),
             }
             break;
