@@ -4,11 +4,12 @@
 //! of them (`encode_step`, every surface offered every deformer) and a list per surface
 //! (`encode_update`, what `snowprint bench` does).
 //!
-//! Surfaces are captured by the compute path, as on a GPU (`CapturePath::Auto` would take the
-//! raster path on a software adapter, which plans less on the CPU).
+//! Surfaces are captured by the compute path unless `--path update` (`CapturePath::Auto` would take
+//! the raster path on a software adapter, which plans less on the CPU).
 //!
 //! `cargo bench -p snowprint --bench encode` (add `-- --quick` for a software adapter), with
-//! `--surfaces 256,1024,4096` to choose the counts and `--texels 64` for smaller surfaces (a
+//! `--surfaces 256,1024,4096` to choose the counts, `--path update` for the update's own ray cast
+//! (what `snowprint bench` measures on a GPU), and `--texels 64` for smaller surfaces (a
 //! software adapter binds at most 128 MiB, and the capture buffer holds 4 bytes a texel of every
 //! captured surface: 2048 of 128^2 at most); `--frames N` and `--only shared|each` for a profile.
 //! Results: `docs/PERFORMANCE.md`, "CPU encode".
@@ -27,7 +28,12 @@ fn median(v: &mut [f64]) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
-fn world(gpu: &GpuContext, surfaces: u32, texels: u32) -> (SnowWorld, Vec<(SurfaceId, [f32; 3])>) {
+fn world(
+    gpu: &GpuContext,
+    surfaces: u32,
+    texels: u32,
+    path: CapturePath,
+) -> (SnowWorld, Vec<(SurfaceId, [f32; 3])>) {
     // Texels of 4 cm, as `snowprint bench` has them, at 8 bits (the smallest pool).
     let metres = texels as f32 * 0.04;
     let format = PoolFormat::new(Precision::Bits8);
@@ -36,7 +42,7 @@ fn world(gpu: &GpuContext, surfaces: u32, texels: u32) -> (SnowWorld, Vec<(Surfa
         WorldConfig {
             pool_bytes: format.slot_bytes(texels, texels) * surfaces as u64,
             max_resolution: texels,
-            capture_path: CapturePath::Compute,
+            capture_path: path,
             format,
             atlas_side: 8192.min(gpu.caps.max_texture_side),
             ..Default::default()
@@ -79,8 +85,13 @@ type Cases = (bool, bool);
 
 /// Median milliseconds to encode a frame: (shared list, a list per surface), NaN for a case not
 /// measured.
-fn run(gpu: &GpuContext, (surfaces, texels): (u32, u32), frames: u32, cases: Cases) -> (f64, f64) {
-    let (mut world, ids) = world(gpu, surfaces, texels);
+fn run(
+    gpu: &GpuContext,
+    (surfaces, texels, path): (u32, u32, CapturePath),
+    frames: u32,
+    cases: Cases,
+) -> (f64, f64) {
+    let (mut world, ids) = world(gpu, surfaces, texels, path);
     let (mut shared, mut each) = (Vec::new(), Vec::new());
     for f in 0..frames {
         let t = f as f32 / 60.0;
@@ -157,13 +168,20 @@ fn main() {
         _ => (true, true),
     };
     let texels: u32 = value("--texels").map_or(128, |t| t.parse().expect("--texels takes a side"));
-    println!("encode on {}, surfaces of {texels}^2", gpu.info.name);
+    // `--path update`: the update's own ray cast (what `CapturePath::Auto` takes on a GPU, and
+    // `snowprint bench` measures), no capture planned.
+    let path = match value("--path") {
+        Some("update") => CapturePath::Update,
+        Some("compute") | None => CapturePath::Compute,
+        Some(other) => panic!("--path takes update or compute, not {other}"),
+    };
+    println!("encode on {}, surfaces of {texels}^2, {path:?}", gpu.info.name);
     println!(
         "{:<10} {:>16} {:>16}",
         "surfaces", "shared_list_ms", "per_surface_ms"
     );
     for n in counts {
-        let (shared, each) = run(&gpu, (n, texels), frames, cases);
+        let (shared, each) = run(&gpu, (n, texels, path), frames, cases);
         println!("{n:<10} {shared:>16.3} {each:>16.3}");
     }
 }
