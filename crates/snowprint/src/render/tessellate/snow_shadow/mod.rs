@@ -12,7 +12,7 @@ use crate::render::frame::FrameSurface;
 use crate::render::gpu::SurfaceUniform;
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::pipeline;
-use crate::render::readback::Timestamps;
+use crate::render::readback::{Timestamps, compute_pass};
 use crate::render::shadow::ShadowPass;
 
 pub(in crate::render) struct TessSurface {
@@ -161,6 +161,14 @@ impl TessSurface {
         shadow: &ShadowPass,
         dice: &DicePass,
     ) {
+        if !dice.any() {
+            // Nothing diced (the relief and POM tiers): no render pass into the cascades, which
+            // would only load and store them; an empty compute pass keeps the pass's timestamps.
+            if ts.is_some() {
+                drop(compute_pass(encoder, ts, slot));
+            }
+            return;
+        }
         for cascade in 0..2 {
             let label = if cascade == 0 {
                 "snow shadow (near cascade)"
@@ -168,11 +176,9 @@ impl TessSurface {
                 "snow shadow (far cascade)"
             };
             let mut p = shadow.cascade_pass(encoder, ts, slot, cascade, label, false);
-            if dice.any() {
-                p.set_pipeline(&self.shadow[cascade]);
-                p.set_bind_group(0, shadow_frame, &[]);
-                dice.draw(&mut p, &self.bind_groups);
-            }
+            p.set_pipeline(&self.shadow[cascade]);
+            p.set_bind_group(0, shadow_frame, &[]);
+            dice.draw(&mut p, &self.bind_groups);
         }
     }
 
