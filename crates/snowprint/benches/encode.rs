@@ -175,7 +175,10 @@ fn main() {
         Some("compute") | None => CapturePath::Compute,
         Some(other) => panic!("--path takes update or compute, not {other}"),
     };
-    println!("encode on {}, surfaces of {texels}^2, {path:?}", gpu.info.name);
+    println!(
+        "encode on {}, surfaces of {texels}^2, {path:?}",
+        gpu.info.name
+    );
     println!(
         "{:<10} {:>16} {:>16}",
         "surfaces", "shared_list_ms", "per_surface_ms"

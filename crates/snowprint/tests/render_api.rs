@@ -453,3 +453,51 @@ fn the_shadow_map_can_be_resized_on_a_running_renderer() {
     assert_eq!(resized.config().shadow_map_size, 1024);
     assert!(shoot(&mut resized) == built);
 }
+
+/// The renderer keeps its bind groups from frame to frame and makes one again when what it binds
+/// is replaced: a renderer that drew two surfaces, then twelve (every per-surface buffer grows
+/// past its first eight slots, under the groups of the first two), then the twelve in reverse
+/// order (each slot binds another surface's textures), renders each frame bit for bit as a fresh
+/// renderer does, in the relief and the tessellated tier.
+#[test]
+fn kept_bind_groups_follow_grown_buffers_and_reordered_surfaces() {
+    let gpu = common::gpu();
+    let mut world = world();
+    let centres: Vec<[f32; 3]> = (0..12)
+        .map(|i| [(i % 4) as f32 * 1.2 - 1.8, 0.0, (i / 4) as f32 * 1.2 - 1.2])
+        .collect();
+    let ids: Vec<_> = centres
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let desc = SurfaceDesc::new(&format!("s{i}"), c, [1.0, 1.0], 0.2);
+            world.add_surface(desc).unwrap()
+        })
+        .collect();
+    // Every surface pressed, so that each runs the heightfield (and, diced, the bank) passes.
+    let presses: Vec<Deformer> = centres
+        .iter()
+        .map(|&[x, _, z]| Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at([x, 0.1, z])))
+        .collect();
+    world.step(1.0 / 30.0, &presses).unwrap();
+    let all: Vec<_> = ids
+        .iter()
+        .map(|&id| (id, GroundMaterial::Concrete))
+        .collect();
+    let reversed: Vec<_> = all.iter().rev().copied().collect();
+    let shoot = |r: &mut Renderer, surfaces: &[(snowprint::SurfaceId, GroundMaterial)]| {
+        r.render(&world, &frame(surfaces, &[])).unwrap().rgba8
+    };
+    for tier in [Tier::Relief, Tier::Tessellated] {
+        let mut kept = Renderer::new(gpu, small(tier)).unwrap();
+        shoot(&mut kept, &all[..2]);
+        for (name, surfaces) in [("twelve", &all), ("reversed", &reversed)] {
+            let fresh = shoot(&mut Renderer::new(gpu, small(tier)).unwrap(), surfaces);
+            let again = shoot(&mut kept, surfaces);
+            assert!(
+                again == fresh,
+                "{tier:?}, {name}: the running renderer differs"
+            );
+        }
+    }
+}

@@ -84,6 +84,89 @@ pub(crate) fn bind_group(
     })
 }
 
+/// One binding of a kept bind group, as [`KeptGroups`] compares it: wgpu's handles compare by the
+/// resource they name, so a buffer re-created (grown) or another texture's view differs.
+#[derive(Clone, PartialEq)]
+enum Bound {
+    Buffer(wgpu::Buffer, u64, Option<std::num::NonZeroU64>),
+    View(wgpu::TextureView),
+    Sampler(wgpu::Sampler),
+}
+
+impl Bound {
+    /// The binding of `resource`; `None` for the kinds never kept (arrays, acceleration
+    /// structures): a group with one is made every time.
+    fn of(resource: &wgpu::BindingResource<'_>) -> Option<Self> {
+        match resource {
+            wgpu::BindingResource::Buffer(b) => {
+                Some(Self::Buffer(b.buffer.clone(), b.offset, b.size))
+            }
+            wgpu::BindingResource::TextureView(v) => Some(Self::View((*v).clone())),
+            wgpu::BindingResource::Sampler(s) => Some(Self::Sampler((*s).clone())),
+            _ => None,
+        }
+    }
+
+    /// Whether this is the binding of `resource`.
+    fn binds(&self, resource: &wgpu::BindingResource<'_>) -> bool {
+        match (self, resource) {
+            (Self::Buffer(buffer, offset, size), wgpu::BindingResource::Buffer(b)) => {
+                buffer == b.buffer && *offset == b.offset && *size == b.size
+            }
+            (Self::View(view), wgpu::BindingResource::TextureView(v)) => view == *v,
+            (Self::Sampler(sampler), wgpu::BindingResource::Sampler(s)) => sampler == *s,
+            _ => false,
+        }
+    }
+}
+
+/// A kept bind group: its layout, what it binds and the group.
+type Kept = (wgpu::BindGroupLayout, Vec<Bound>, wgpu::BindGroup);
+
+/// Bind groups kept from frame to frame, one per slot (a surface's place in the frame's list,
+/// say). Making a bind group each frame costs the CPU twice, once to make it and again in
+/// `CommandEncoder::finish`; most frames bind what the last bound. A slot's group is made again
+/// when its layout or anything it binds differs from the last time (a buffer re-created as it
+/// grew, another surface's textures, another block of a uniform buffer), never reused stale.
+#[derive(Default)]
+pub(crate) struct KeptGroups {
+    slots: Vec<Option<Kept>>,
+}
+
+impl KeptGroups {
+    /// Slot `slot`'s group of `resources` at bindings 0, 1, 2, ... in order (as [`bind_group`]):
+    /// the kept one where it binds the same, else a new one, kept.
+    pub(crate) fn get(
+        &mut self,
+        device: &wgpu::Device,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        slot: usize,
+        resources: &[wgpu::BindingResource<'_>],
+    ) -> wgpu::BindGroup {
+        if self.slots.len() <= slot {
+            self.slots.resize_with(slot + 1, || None);
+        }
+        if let Some((kept_layout, bound, group)) = &self.slots[slot] {
+            let same = kept_layout == layout
+                && bound.len() == resources.len()
+                && bound.iter().zip(resources).all(|(b, r)| b.binds(r));
+            if same {
+                return group.clone();
+            }
+        }
+        let group = bind_group(device, label, layout, resources);
+        let bound: Option<Vec<Bound>> = resources.iter().map(Bound::of).collect();
+        self.slots[slot] = bound.map(|bound| (layout.clone(), bound, group.clone()));
+        group
+    }
+
+    /// Let go of the groups of slots `slots` and after (the frame has fewer), and what they bind.
+    pub(crate) fn truncate(&mut self, slots: usize) {
+        self.slots.truncate(slots);
+    }
+}
+
 /// Record a write of `bytes` into `target` at `offset` in `enc`, through a staging buffer made for
 /// it: unlike `queue.write_buffer`, which lands before every command buffer of the next
 /// submission, this lands in the encoder's order (after what `enc` recorded before it).

@@ -7,7 +7,7 @@ use super::frame::FrameSurface;
 use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
 use super::pipeline;
 use super::readback::{Timestamps, compute_pass};
-use crate::gpu::resources::{Growable, bind_group};
+use crate::gpu::resources::{Growable, KeptGroups};
 
 /// A domain's size, x in the low 16 bits and z in the high.
 fn packed_size([x0, z0, x1, z1]: [i32; 4]) -> u32 {
@@ -23,6 +23,8 @@ pub(super) struct ClassifyPass {
     /// passes.
     pub state: Growable,
     bind_group: Option<wgpu::BindGroup>,
+    /// The group, kept while the pool and the two buffers stay.
+    kept: KeptGroups,
     surfaces: u32,
 }
 
@@ -48,6 +50,7 @@ impl ClassifyPass {
             layout,
             pipeline,
             bind_group: None,
+            kept: KeptGroups::default(),
             surfaces: 0,
         }
     }
@@ -87,10 +90,11 @@ impl ClassifyPass {
         self.state.ensure(device, n.max(1) as u64 * STATE_WORDS * 4);
         self.surfaces = n as u32;
         self.bind_group = (n > 0).then(|| {
-            bind_group(
+            self.kept.get(
                 device,
                 "classify",
                 &self.layout,
+                0,
                 &[
                     pool.as_entire_binding(),
                     self.records.buffer.as_entire_binding(),

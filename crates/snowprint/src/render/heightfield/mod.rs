@@ -16,7 +16,7 @@ use super::pipeline;
 use super::readback::{Timestamps, compute_pass, f16_to_f32, map_staging};
 use super::targets::HEIGHTFIELD_FORMAT;
 use super::tessellate::SurfaceFields;
-use crate::gpu::resources::{Growable, bind_group, uniform_block};
+use crate::gpu::resources::{Growable, KeptGroups, uniform_block};
 use crate::surface::SurfaceId;
 
 mod sides;
@@ -134,6 +134,8 @@ pub(super) struct HeightfieldPass {
     textures: HashMap<SurfaceId, HeightfieldTexture>,
     /// This frame's bind groups, in surface order, and whether each surface is linked.
     bind_groups: Vec<(wgpu::BindGroup, bool)>,
+    /// The groups by surface slot, kept while what they bind stays.
+    kept: KeptGroups,
 }
 
 impl HeightfieldPass {
@@ -152,6 +154,7 @@ impl HeightfieldPass {
             pipelines,
             textures: HashMap::new(),
             bind_groups: Vec::new(),
+            kept: KeptGroups::default(),
         }
     }
 
@@ -223,30 +226,29 @@ impl HeightfieldPass {
                     .insert(s.view.id, HeightfieldTexture::new(device, size, scratch));
             }
         }
-        self.bind_groups = surfaces
-            .iter()
-            .enumerate()
-            .map(|(s, surface)| {
-                let tex = &self.textures[&surface.view.id];
-                let group = bind_group(
-                    device,
-                    "heightfield",
-                    &self.layout,
-                    &[
-                        pool.as_entire_binding(),
-                        uniform_block(
-                            &self.params.buffer,
-                            s,
-                            std::mem::size_of::<HeightfieldParams>(),
-                        ),
-                        wgpu::BindingResource::TextureView(&tex.shape),
-                        wgpu::BindingResource::TextureView(&tex.light),
-                        ground.as_entire_binding(),
-                    ],
-                );
-                (group, linked(surface))
-            })
-            .collect();
+        self.kept.truncate(surfaces.len());
+        self.bind_groups.clear();
+        for (s, surface) in surfaces.iter().enumerate() {
+            let tex = &self.textures[&surface.view.id];
+            let group = self.kept.get(
+                device,
+                "heightfield",
+                &self.layout,
+                s,
+                &[
+                    pool.as_entire_binding(),
+                    uniform_block(
+                        &self.params.buffer,
+                        s,
+                        std::mem::size_of::<HeightfieldParams>(),
+                    ),
+                    wgpu::BindingResource::TextureView(&tex.shape),
+                    wgpu::BindingResource::TextureView(&tex.light),
+                    ground.as_entire_binding(),
+                ],
+            );
+            self.bind_groups.push((group, linked(surface)));
+        }
     }
 
     /// One indirect dispatch per surface, its arguments written by `classify` in `state`.

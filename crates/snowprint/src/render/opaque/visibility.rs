@@ -10,7 +10,7 @@ use super::super::pipeline;
 use super::super::readback::{Timestamps, compute_pass, render_writes};
 use super::super::targets::{Targets, VISIBILITY_FORMAT};
 use super::geometry::MeshGeometry;
-use crate::gpu::resources::bind_group;
+use crate::gpu::resources::KeptGroups;
 
 /// Pixels a workgroup of `shade.wgsl` covers along each axis.
 const WORKGROUP: u32 = 8;
@@ -25,6 +25,8 @@ pub(super) struct VisibilityPass {
     /// This frame's bind groups: the raster's geometry, the shading's geometry and targets; and
     /// the scene's size.
     current: Option<([wgpu::BindGroup; 3], (u32, u32))>,
+    /// The three groups (slots 0, 1, 2), kept while what they bind stays.
+    kept: KeptGroups,
 }
 
 impl VisibilityPass {
@@ -68,6 +70,7 @@ impl VisibilityPass {
             targets_layout,
             geometry: MeshGeometry::new(device),
             current: None,
+            kept: KeptGroups::default(),
         }
     }
 
@@ -85,22 +88,25 @@ impl VisibilityPass {
             return;
         };
         let instances = meshes.instance_buffer();
-        let raster = bind_group(
+        let raster = self.kept.get(
             device,
             "visibility geometry",
             &self.raster_layout,
+            0,
             &self.geometry.entries(instances),
         );
-        let shade = bind_group(
+        let shade = self.kept.get(
             device,
             "shade geometry",
             &self.shade_layout,
+            1,
             &self.geometry.entries(instances),
         );
-        let outputs = bind_group(
+        let outputs = self.kept.get(
             device,
             "shade targets",
             &self.targets_layout,
+            2,
             &[
                 wgpu::BindingResource::TextureView(visibility),
                 wgpu::BindingResource::TextureView(&targets.color_view),

@@ -2,7 +2,7 @@
 //! its map, one instanced draw of quads writing the cached depth (`cache.rs` says when).
 
 use super::cache::clip_rect;
-use crate::gpu::resources::{Growable, bind_group};
+use crate::gpu::resources::{Growable, KeptGroups};
 use crate::render::pipeline;
 
 /// What a cascade restores this frame: texel rectangles and the view of its cache.
@@ -15,6 +15,8 @@ pub(super) struct Restore {
     rects: Growable,
     /// This frame, per cascade: its group (the cache and the rectangles) and its instances.
     groups: [Option<(wgpu::BindGroup, std::ops::Range<u32>)>; 2],
+    /// The groups by cascade, kept while the cache and the rectangles' buffer stay.
+    kept: KeptGroups,
 }
 
 impl Restore {
@@ -55,6 +57,7 @@ impl Restore {
                 16 * 64,
             ),
             groups: [None, None],
+            kept: KeptGroups::default(),
         }
     }
 
@@ -81,15 +84,17 @@ impl Restore {
                 .ensure(device, std::mem::size_of_val(clip.as_slice()) as u64);
             queue.write_buffer(&self.rects.buffer, 0, bytemuck::cast_slice(&clip));
         }
+        let (kept, layout, rects) = (&mut self.kept, &self.layout, &self.rects);
         self.groups = [0, 1].map(|c| {
             let (range, (_, cache)) = (ranges[c].clone()?, per_cascade[c]?);
-            let group = bind_group(
+            let group = kept.get(
                 device,
                 "shadow restore",
-                &self.layout,
+                layout,
+                c,
                 &[
                     wgpu::BindingResource::TextureView(cache),
-                    self.rects.buffer.as_entire_binding(),
+                    rects.buffer.as_entire_binding(),
                 ],
             );
             Some((group, range))

@@ -24,7 +24,7 @@ use super::targets::{KEEP, Targets};
 use super::tessellate::dice::DicePass;
 use super::tessellate::seams::seam_sides;
 use super::tessellate::snow_shadow::TessSurface;
-use crate::gpu::resources::{Growable, bind_group};
+use crate::gpu::resources::{Growable, KeptGroups};
 use crate::view::GroundMaterial;
 
 pub(super) struct SnowPass {
@@ -44,6 +44,8 @@ pub(super) struct SnowPass {
     pub uniforms: Growable,
     /// This frame's group 1 per surface slot; `None` where the tessellated tier dices it.
     bind_groups: Vec<Option<wgpu::BindGroup>>,
+    /// The groups by surface slot, kept while what they bind stays.
+    kept: KeptGroups,
     /// The pipelines of the visibility path (only on `OpaquePath::Visibility`).
     visible: Option<visible::VisiblePath>,
 }
@@ -139,6 +141,7 @@ impl SnowPass {
             outside: Vec::new(),
             tessellated: Vec::new(),
             bind_groups: Vec::new(),
+            kept: KeptGroups::default(),
             visible,
         }
     }
@@ -190,6 +193,8 @@ impl SnowPass {
         }
         self.uniforms.ensure(device, bytes.len() as u64);
         queue.write_buffer(&self.uniforms.buffer, 0, &bytes);
+        self.kept.truncate(surfaces.len());
+        let (kept, layout) = (&mut self.kept, &self.layout);
         self.bind_groups = surfaces
             .iter()
             .enumerate()
@@ -198,10 +203,11 @@ impl SnowPass {
                     return None;
                 }
                 let tex = heightfields.texture(surface.view.id)?;
-                Some(bind_group(
+                Some(kept.get(
                     device,
                     "snow surface",
-                    &self.layout,
+                    layout,
+                    s,
                     &[
                         SurfaceUniform::block(&self.uniforms.buffer, s),
                         wgpu::BindingResource::TextureView(&tex.shape),

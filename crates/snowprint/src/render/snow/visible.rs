@@ -15,7 +15,7 @@ use super::super::pipeline;
 use super::super::readback::{Timestamps, compute_pass};
 use super::super::targets::Targets;
 use super::super::tessellate::snow_shadow::TessSurface;
-use crate::gpu::resources::{Growable, bind_group};
+use crate::gpu::resources::{Growable, KeptGroups};
 
 /// Pixels a workgroup of `shade_deformable` covers along each axis.
 const WORKGROUP: u32 = 8;
@@ -40,6 +40,8 @@ pub(super) struct VisiblePath {
     /// where it is not shaded here).
     current: Option<wgpu::BindGroup>,
     dispatches: Vec<Option<(u32, u32)>>,
+    /// The targets' group, kept while the targets and the rectangles' buffer stay.
+    kept: KeptGroups,
 }
 
 /// What the snow pass's pipelines are built from.
@@ -120,6 +122,7 @@ impl VisiblePath {
             ),
             current: None,
             dispatches: Vec::new(),
+            kept: KeptGroups::default(),
         }
     }
 
@@ -165,10 +168,11 @@ impl VisiblePath {
         let bytes: &[u8] = bytemuck::cast_slice(&rects);
         self.rects.ensure(device, bytes.len() as u64);
         queue.write_buffer(&self.rects.buffer, 0, bytes);
-        self.current = Some(bind_group(
+        self.current = Some(self.kept.get(
             device,
             "snow shade targets",
             &self.targets_layout,
+            0,
             &[
                 wgpu::BindingResource::TextureView(visibility),
                 wgpu::BindingResource::TextureView(hits),

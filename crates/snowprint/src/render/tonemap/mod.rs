@@ -14,7 +14,7 @@ use super::graph::PASSES;
 use super::pipeline;
 use super::readback::{Timestamps, compute_pass, render_writes};
 use super::targets::{OUTPUT_FORMAT, Targets};
-use crate::gpu::resources::bind_group;
+use crate::gpu::resources::KeptGroups;
 
 /// Output pixels a workgroup of `tonemap_compute.wgsl` covers along each axis.
 const WORKGROUP: u32 = 8;
@@ -37,6 +37,8 @@ pub(super) struct TonemapPass {
     compute_pipeline_layout: wgpu::PipelineLayout,
     compute_pipelines: HashMap<u32, wgpu::ComputePipeline>,
     current: Option<Current>,
+    /// The inputs' groups, kept while the targets stay: compute at slot 0, raster at 1.
+    kept: KeptGroups,
 }
 
 /// Whether the tonemap can write `target` (in `format`) as a storage texture: an `Rgba8Unorm`
@@ -68,6 +70,7 @@ impl TonemapPass {
             compute_pipeline_layout,
             compute_pipelines: HashMap::new(),
             current: None,
+            kept: KeptGroups::default(),
         }
     }
 
@@ -155,17 +158,20 @@ impl TonemapPass {
         let depth = wgpu::BindingResource::TextureView(&targets.depth_view);
         self.current = Some(if can_compute(target, format) {
             let output = wgpu::BindingResource::TextureView(target);
-            let inputs = bind_group(
+            let inputs = self.kept.get(
                 device,
                 "tonemap compute inputs",
                 &self.compute_layout,
+                0,
                 &[color, depth, output],
             );
             let t = target.texture();
             let pipeline = self.compute_pipeline(device, supersample);
             Current::Compute(pipeline, inputs, (t.width(), t.height()))
         } else {
-            let inputs = bind_group(device, "tonemap inputs", &self.layout, &[color, depth]);
+            let inputs = self
+                .kept
+                .get(device, "tonemap inputs", &self.layout, 1, &[color, depth]);
             Current::Raster(self.raster_pipeline(device, format, supersample), inputs)
         });
     }

@@ -5,7 +5,7 @@
 //! scratch texture, `bank_gather` collects it into the bank heights.
 
 use super::BankParams;
-use crate::gpu::resources::{Growable, bind_group, uniform_block};
+use crate::gpu::resources::{Growable, KeptGroups, uniform_block};
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::{STATE_BANKS_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
 use crate::render::heightfield::{HeightfieldPass, linked, linked_pipelines};
@@ -22,6 +22,9 @@ pub(in crate::render) struct BanksPass {
     /// This frame's bind groups (norm, gather) per surface and whether it is linked; `None` where
     /// it draws no banks.
     bind_groups: Vec<Option<([wgpu::BindGroup; 2], bool)>>,
+    /// The groups by surface slot (norm at `2 s`, gather at `2 s + 1`), kept while what they
+    /// bind stays.
+    kept: KeptGroups,
 }
 
 impl BanksPass {
@@ -40,6 +43,7 @@ impl BanksPass {
             layout,
             pipelines,
             bind_groups: Vec::new(),
+            kept: KeptGroups::default(),
         }
     }
 
@@ -89,6 +93,8 @@ impl BanksPass {
         self.params.ensure(device, bytes.len() as u64);
         queue.write_buffer(&self.params.buffer, 0, &bytes);
         let tv = wgpu::BindingResource::TextureView;
+        self.kept.truncate(2 * surfaces.len());
+        let (kept, layout) = (&mut self.kept, &self.layout);
         self.bind_groups = surfaces
             .iter()
             .enumerate()
@@ -100,10 +106,11 @@ impl BanksPass {
                 let params =
                     uniform_block(&self.params.buffer, s, std::mem::size_of::<BankParams>());
                 let texels = [pool.as_entire_binding(), heightfields.params(s)];
-                let norm = bind_group(
+                let norm = kept.get(
                     device,
                     "bank norm",
-                    &self.layout,
+                    layout,
+                    2 * s,
                     &[
                         params.clone(),
                         tv(&tex.shape),
@@ -114,10 +121,11 @@ impl BanksPass {
                         texels[1].clone(),
                     ],
                 );
-                let gather = bind_group(
+                let gather = kept.get(
                     device,
                     "bank gather",
-                    &self.layout,
+                    layout,
+                    2 * s + 1,
                     &[
                         params,
                         tv(&tex.shape),

@@ -12,7 +12,7 @@ use super::VERTEX_BYTES;
 use super::gpu::counters_bytes;
 use super::seams;
 use super::{ARGS_BASE, ARGS_STRIDE, DiceParams, DicedKind, DicedMesh, DicedVertex, SurfaceMesh};
-use crate::gpu::resources::{Growable, bind_group, uniform_block};
+use crate::gpu::resources::{Growable, KeptGroups, uniform_block};
 use crate::render::config::RenderConfig;
 use crate::render::error::RenderResult;
 use crate::render::frame::{FAR, FrameSurface, NEAR};
@@ -54,6 +54,8 @@ pub(in crate::render) struct DicePass {
     base_meshes: HashMap<SurfaceId, BaseMeshGpu>,
     /// This frame's bind group and base triangles per surface; `None` where it is not diced.
     bind_groups: Vec<Option<(wgpu::BindGroup, u32)>>,
+    /// The groups by surface slot, kept while what they bind stays.
+    kept: KeptGroups,
 }
 
 impl DicePass {
@@ -88,6 +90,7 @@ impl DicePass {
             seal,
             base_meshes: HashMap::new(),
             bind_groups: Vec::new(),
+            kept: KeptGroups::default(),
         }
     }
 
@@ -183,6 +186,7 @@ impl DicePass {
         self.params.ensure(device, bytes.len() as u64);
         queue.write_buffer(&self.params.buffer, 0, &bytes);
         let tv = wgpu::BindingResource::TextureView;
+        self.kept.truncate(n);
         for (s, surface) in surfaces.iter().enumerate() {
             let tex = heightfields.texture(surface.view.id);
             let (true, Some(tex)) = (surface.tessellated && surface.seen, tex) else {
@@ -190,10 +194,11 @@ impl DicePass {
                 continue;
             };
             let base = &self.base_meshes[&surface.view.id];
-            let group = bind_group(
+            let group = self.kept.get(
                 device,
                 "dice",
                 &self.layout,
+                s,
                 &[
                     uniform_block(&self.params.buffer, s, std::mem::size_of::<DiceParams>()),
                     base.buffer.buffer.as_entire_binding(),

@@ -7,12 +7,12 @@
 
 use super::VERTEX_BYTES;
 use super::dice::DicePass;
-use crate::gpu::resources::bind_group;
+use crate::gpu::resources::KeptGroups;
 use crate::render::frame::FrameSurface;
 use crate::render::gpu::SurfaceUniform;
 use crate::render::heightfield::HeightfieldPass;
 use crate::render::pipeline;
-use crate::render::readback::Timestamps;
+use crate::render::readback::{Timestamps, compute_pass};
 use crate::render::shadow::ShadowPass;
 
 pub(in crate::render) struct TessSurface {
@@ -23,6 +23,8 @@ pub(in crate::render) struct TessSurface {
     shadow: [wgpu::RenderPipeline; 2],
     /// This frame's group 1 per surface slot; `None` where it is not diced.
     pub bind_groups: Vec<Option<wgpu::BindGroup>>,
+    /// The groups by surface slot, kept while what they bind stays.
+    kept: KeptGroups,
     /// On the visibility path: the draw into the visibility buffer, and its shading.
     visible: Option<(wgpu::RenderPipeline, wgpu::ComputePipeline)>,
 }
@@ -104,6 +106,7 @@ impl TessSurface {
             draw,
             shadow,
             bind_groups: Vec::new(),
+            kept: KeptGroups::default(),
             visible,
         }
     }
@@ -120,6 +123,8 @@ impl TessSurface {
         ground: &wgpu::Buffer,
     ) {
         let tv = wgpu::BindingResource::TextureView;
+        self.kept.truncate(surfaces.len());
+        let (kept, layout) = (&mut self.kept, &self.layout);
         self.bind_groups = surfaces
             .iter()
             .enumerate()
@@ -128,10 +133,11 @@ impl TessSurface {
                     return None;
                 }
                 let tex = heightfields.texture(surface.view.id)?;
-                Some(bind_group(
+                Some(kept.get(
                     device,
                     "tessellated snow surface",
-                    &self.layout,
+                    layout,
+                    s,
                     &[
                         SurfaceUniform::block(uniforms, s),
                         tv(&tex.shape),
@@ -155,6 +161,14 @@ impl TessSurface {
         shadow: &ShadowPass,
         dice: &DicePass,
     ) {
+        if !dice.any() {
+            // Nothing diced (the relief and POM tiers): no render pass into the cascades, which
+            // would only load and store them; an empty compute pass keeps the pass's timestamps.
+            if ts.is_some() {
+                drop(compute_pass(encoder, ts, slot));
+            }
+            return;
+        }
         for cascade in 0..2 {
             let label = if cascade == 0 {
                 "snow shadow (near cascade)"
@@ -162,11 +176,9 @@ impl TessSurface {
                 "snow shadow (far cascade)"
             };
             let mut p = shadow.cascade_pass(encoder, ts, slot, cascade, label, false);
-            if dice.any() {
-                p.set_pipeline(&self.shadow[cascade]);
-                p.set_bind_group(0, shadow_frame, &[]);
-                dice.draw(&mut p, &self.bind_groups);
-            }
+            p.set_pipeline(&self.shadow[cascade]);
+            p.set_bind_group(0, shadow_frame, &[]);
+            dice.draw(&mut p, &self.bind_groups);
         }
     }
 
