@@ -46,34 +46,51 @@ impl FramePlan {
             return;
         }
         self.clear();
+        // This thread plans the first run into the plan itself (nothing of it to copy), the
+        // others each plan one into a part of their own, appended after it.
         let mut parts = std::mem::take(&mut self.parts);
-        parts.resize_with(threads, FramePlan::default);
+        parts.resize_with(threads - 1, FramePlan::default);
         let run = items.len().div_ceil(threads);
         let check = self.check_short_lists;
         let (surface, meshes) = (&surface, &meshes);
-        let plan_run = |part: &mut FramePlan, run: &'a [T]| {
-            part.clear();
-            part.check_short_lists = check;
+        let plan_run = |plan: &mut FramePlan, run: &'a [T]| {
             for s in run.iter().filter_map(surface) {
-                part.plan_surface(settings, &s, meshes);
+                plan.plan_surface(settings, &s, meshes);
             }
         };
+        let mut runs = items.chunks(run);
+        let first = runs.next().unwrap_or_default();
         std::thread::scope(|scope| {
-            let mut runs = parts.iter_mut().zip(items.chunks(run));
-            // This thread plans the first run while the others plan the rest.
-            let first = runs.next();
-            for (part, run) in runs {
-                scope.spawn(move || plan_run(part, run));
+            for (part, run) in parts.iter_mut().zip(runs) {
+                scope.spawn(move || {
+                    part.clear();
+                    part.check_short_lists = check;
+                    plan_run(part, run);
+                });
             }
-            if let Some((part, run)) = first {
-                plan_run(part, run);
-            }
+            plan_run(self, first);
         });
+        self.reserve_for(&parts);
         for part in &mut parts {
             self.append(part);
         }
         self.parts = parts;
         self.finish(settings);
+    }
+
+    /// Make room for the parts' vectors at once (rather than growing as they are appended).
+    fn reserve_for(&mut self, parts: &[FramePlan]) {
+        let total = |f: fn(&FramePlan) -> usize| parts.iter().map(f).sum::<usize>();
+        let c = &mut self.capture;
+        c.prims.reserve(total(|p| p.capture.prims.len()));
+        c.draws.reserve(total(|p| p.capture.draws.len()));
+        c.draw_meshes
+            .reserve(total(|p| p.capture.draw_meshes.len()));
+        self.reached.reserve(total(|p| p.reached.len()));
+        self.carries.reserve(total(|p| p.carries.len()));
+        self.settles.reserve(total(|p| p.settles.len()));
+        self.footsteps.reserve(total(|p| p.footsteps.len()));
+        self.jobs.reserve(total(|p| p.jobs.len()));
     }
 
     /// Append a partial plan of the surfaces after this plan's, as if they had been planned

@@ -277,7 +277,7 @@ fn split_plan_is_the_serial_plan() {
                 );
             }
         }
-        assert_eq!(split.parts.len(), 5);
+        assert_eq!(split.parts.len(), 4);
     }
 }
 
