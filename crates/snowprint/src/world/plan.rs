@@ -312,14 +312,17 @@ impl FramePlan {
         // Surfaces that refill snow first (the refill pass streams records 0..dense), those the
         // update casts first among them and last among the others, so that the fused grid covers
         // a run of records that it captures (`accumulation_shape`).
-        self.jobs.sort_by_key(
-            |j| match (j.record.replenish_units > 0, j.way == Way::Cast) {
-                (true, true) => 0,
-                (true, false) => 1,
-                (false, false) => 2,
-                (false, true) => 3,
-            },
-        );
+        let order = |j: &Job| match (j.record.replenish_units > 0, j.way == Way::Cast) {
+            (true, true) => 0,
+            (true, false) => 1,
+            (false, false) => 2,
+            (false, true) => 3,
+        };
+        // A stable sort takes scratch memory of half the jobs: not when they are in order already
+        // (a frame whose surfaces all take one way, say).
+        if !self.jobs.is_sorted_by_key(order) {
+            self.jobs.sort_by_key(order);
+        }
         self.pack_atlas(settings);
         self.write_tables(settings);
     }

@@ -20,12 +20,16 @@ pub(crate) const AUTO_THREADS_MAX: usize = 8;
 /// The threads to plan over when the world's configuration asks for `threads` (0: the machine's
 /// available parallelism, up to [`AUTO_THREADS_MAX`]).
 pub(crate) fn plan_threads(threads: usize) -> usize {
+    // Asked once a process: on Linux the answer reads the cgroup's quota from files.
+    static AUTO: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     if threads > 0 {
         return threads;
     }
-    std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(AUTO_THREADS_MAX)
+    *AUTO.get_or_init(|| {
+        std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(AUTO_THREADS_MAX)
+    })
 }
 
 impl FramePlan {
