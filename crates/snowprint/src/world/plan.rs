@@ -16,15 +16,15 @@ use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
 use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
 use crate::capture::{
-    self, CaptureConfig, CaptureMode, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
+    self, CaptureConfig, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
 };
 use crate::deformer::Deformer;
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::pool::{
-    MODE_CAST, MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat,
-    SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+    MODE_CAST, MODE_GROUND, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord,
+    TILE_LIST_HEADER, TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
@@ -37,7 +37,7 @@ mod tests;
 pub(crate) use parallel::plan_threads;
 
 pub use surface::replenish;
-use surface::{Way, pressed_rect, refused, way};
+use surface::{Way, pressed_rect, record_mode, refused, way};
 
 /// The settings of a world that a plan follows.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -461,15 +461,7 @@ impl FramePlan {
         let texel = s.desc.size / Vec2::new(s.layout.width as f32, s.layout.height as f32);
         let way = way(settings, p1 - p0, d1 > d0);
         let (tiles, sparse) = self.reach_tiles(way, p0..p1, s.layout, half_size);
-        let mode = match settings.capture.mode {
-            CaptureMode::Depth => 0,
-            CaptureMode::Mask => 1,
-        } | if d1 > d0 { MODE_MESHES } else { 0 }
-            | if d1 > d0 && s.ground.is_some() {
-                MODE_GROUND
-            } else {
-                0
-            };
+        let mode = record_mode(settings.capture.mode, d1 > d0, s.ground.is_some());
         self.jobs.push(Job {
             surface: PlannedSurface {
                 index: s.index,
