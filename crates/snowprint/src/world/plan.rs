@@ -222,9 +222,10 @@ struct Job {
     draws: Range<u32>,
     /// How its analytic deformers reach the update.
     way: Way,
-    /// The tiles its primitives reach, in the plan's `reached` (computed with the rest of the
-    /// surface's own work, so that it is spread over threads with it: `reach_tiles`), and
-    /// whether the compute path takes the tiles beside them (`capture::tiles_reached`).
+    /// In a split plan, the tiles its primitives reach, in the plan's `reached` (computed with
+    /// the rest of the surface's own work, so that it is spread over threads with it:
+    /// `reach_tiles`), and whether the compute path takes the tiles beside them
+    /// (`capture::tiles_reached`); else empty.
     tiles: Range<u32>,
     sparse: bool,
     /// Relaxation steps this update (0: none), the material's repose angle (degrees) and the
@@ -262,6 +263,10 @@ pub struct FramePlan {
     /// The tiles each job's primitives reach (`Job::tiles`), `[0, tile y << 16 | tile x]`: the
     /// view or record is set as the tables are written.
     reached: Vec<[u32; 2]>,
+    /// Whether each surface lists its tiles into `reached` as it is planned (a split plan, so
+    /// that the listing is spread over the threads), rather than as the tables are written (one
+    /// copy fewer).
+    tiles_early: bool,
     /// Partial plans of contiguous runs of surfaces, planned on threads of their own and then
     /// appended in order (`parallel.rs`); kept for their memory.
     parts: Vec<FramePlan>,
@@ -300,6 +305,7 @@ impl FramePlan {
         meshes: impl PlanMeshes,
     ) {
         self.clear();
+        self.tiles_early = false;
         for s in surfaces {
             self.plan_surface(settings, &s, &meshes);
         }
@@ -460,7 +466,11 @@ impl FramePlan {
         }
         let texel = s.desc.size / Vec2::new(s.layout.width as f32, s.layout.height as f32);
         let way = way(settings, p1 - p0, d1 > d0);
-        let (tiles, sparse) = self.reach_tiles(way, p0..p1, s.layout, half_size);
+        let (tiles, sparse) = if self.tiles_early {
+            self.reach_tiles(way, p0..p1, s.layout, half_size)
+        } else {
+            (0..0, false)
+        };
         let mode = record_mode(settings.capture.mode, d1 > d0, s.ground.is_some());
         self.jobs.push(Job {
             surface: PlannedSurface {
@@ -664,10 +674,15 @@ impl FramePlan {
                         (0..r.tile_count())
                             .map(|t| [j as u32, ((t / tiles_x) << 16) | (t % tiles_x)]),
                     );
-                } else {
+                } else if self.tiles_early {
                     let tiles = &self.reached[job.tiles.start as usize..job.tiles.end as usize];
                     c.listed
                         .extend(tiles.iter().map(|&[_, tile]| [j as u32, tile]));
+                } else {
+                    let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
+                    let (size, seen) = ((r.width, r.height), &mut self.seen);
+                    let (half, list) = (job.half_size, &mut c.listed);
+                    capture::update_tiles_reached(prims, size, half, j as u32, seen, list);
                 }
             }
             if !job.surface.captured || job.way == Way::Cast {
@@ -689,12 +704,19 @@ impl FramePlan {
             let mut whole = 0;
             if job.way == Way::Compute {
                 let view = c.views.len() as u32;
-                let tiles = &self.reached[job.tiles.start as usize..job.tiles.end as usize];
-                c.work.extend(tiles.iter().map(|&[_, tile]| [view, tile]));
+                let sparse = if self.tiles_early {
+                    let tiles = &self.reached[job.tiles.start as usize..job.tiles.end as usize];
+                    c.work.extend(tiles.iter().map(|&[_, tile]| [view, tile]));
+                    job.sparse
+                } else {
+                    let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
+                    let (size, seen) = ((r.width, r.height), &mut self.seen);
+                    capture::tiles_reached(prims, size, job.half_size, view, seen, &mut c.work)
+                };
                 if let Some(s) = c.surfaces.last_mut() {
-                    s.cleared = !job.sparse;
+                    s.cleared = !sparse;
                 }
-                whole = u32::from(job.sparse);
+                whole = u32::from(sparse);
             }
             c.views.push(CaptureView {
                 half_size: job.half_size.to_array(),

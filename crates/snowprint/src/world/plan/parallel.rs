@@ -50,6 +50,7 @@ impl FramePlan {
             return;
         }
         self.clear();
+        self.tiles_early = true;
         // This thread plans the first run into the plan itself (nothing of it to copy), the
         // others each plan one into a part of their own, appended after it.
         let mut parts = std::mem::take(&mut self.parts);
@@ -69,6 +70,7 @@ impl FramePlan {
                 scope.spawn(move || {
                     part.clear();
                     part.check_short_lists = check;
+                    part.tiles_early = true;
                     plan_run(part, run);
                 });
             }
