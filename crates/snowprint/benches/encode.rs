@@ -11,7 +11,8 @@
 //! `--surfaces 256,1024,4096` to choose the counts, `--path update` for the update's own ray cast
 //! (what `snowprint bench` measures on a GPU), and `--texels 64` for smaller surfaces (a
 //! software adapter binds at most 128 MiB, and the capture buffer holds 4 bytes a texel of every
-//! captured surface: 2048 of 128^2 at most); `--frames N` and `--only shared|each` for a profile.
+//! captured surface: 2048 of 128^2 at most); `--frames N` and `--only shared|each` for a profile;
+//! `--plan-threads N` for `WorldConfig::plan_threads` (default 0: the machine's, up to 8).
 //! Results: `docs/PERFORMANCE.md`, "CPU encode".
 
 use std::time::Instant;
@@ -30,9 +31,7 @@ fn median(v: &mut [f64]) -> f64 {
 
 fn world(
     gpu: &GpuContext,
-    surfaces: u32,
-    texels: u32,
-    path: CapturePath,
+    (surfaces, texels, path, plan_threads): Case,
 ) -> (SnowWorld, Vec<(SurfaceId, [f32; 3])>) {
     // Texels of 4 cm, as `snowprint bench` has them, at 8 bits (the smallest pool).
     let metres = texels as f32 * 0.04;
@@ -45,6 +44,7 @@ fn world(
             capture_path: path,
             format,
             atlas_side: 8192.min(gpu.caps.max_texture_side),
+            plan_threads,
             ..Default::default()
         },
     )
@@ -83,15 +83,13 @@ fn flush(gpu: &GpuContext) {
 /// Which ways of handing deformers over to measure: (shared list, a list per surface).
 type Cases = (bool, bool);
 
+/// A world measured: surfaces, their side in texels, the capture path and the plan's threads.
+type Case = (u32, u32, CapturePath, usize);
+
 /// Median milliseconds to encode a frame: (shared list, a list per surface), NaN for a case not
 /// measured.
-fn run(
-    gpu: &GpuContext,
-    (surfaces, texels, path): (u32, u32, CapturePath),
-    frames: u32,
-    cases: Cases,
-) -> (f64, f64) {
-    let (mut world, ids) = world(gpu, surfaces, texels, path);
+fn run(gpu: &GpuContext, case: Case, frames: u32, cases: Cases) -> (f64, f64) {
+    let (mut world, ids) = world(gpu, case);
     let (mut shared, mut each) = (Vec::new(), Vec::new());
     for f in 0..frames {
         let t = f as f32 / 60.0;
@@ -175,8 +173,10 @@ fn main() {
         Some("compute") | None => CapturePath::Compute,
         Some(other) => panic!("--path takes update or compute, not {other}"),
     };
+    let threads: usize =
+        value("--plan-threads").map_or(0, |t| t.parse().expect("--plan-threads takes a count"));
     println!(
-        "encode on {}, surfaces of {texels}^2, {path:?}",
+        "encode on {}, surfaces of {texels}^2, {path:?}, plan threads {threads}",
         gpu.info.name
     );
     println!(
@@ -184,7 +184,7 @@ fn main() {
         "surfaces", "shared_list_ms", "per_surface_ms"
     );
     for n in counts {
-        let (shared, each) = run(&gpu, (n, texels, path), frames, cases);
+        let (shared, each) = run(&gpu, (n, texels, path, threads), frames, cases);
         println!("{n:<10} {shared:>16.3} {each:>16.3}");
     }
 }

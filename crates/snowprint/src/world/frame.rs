@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use super::nearby::INDEX_FROM;
-use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
+use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface, plan_threads};
 use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
 use crate::capture::{self, CaptureBuffers, CaptureMesh};
@@ -440,11 +440,12 @@ impl SnowWorld {
     }
 
     /// The frame's plan, from the surfaces' state and the (validated) updates.
-    fn plan_into(&self, plan: &mut FramePlan, updates: &[SurfaceUpdate<'_>]) {
+    fn plan_into<'a>(&'a self, plan: &mut FramePlan, updates: &'a [SurfaceUpdate<'a>]) {
         let format = self.config.format;
-        let surfaces = updates.iter().filter_map(|u| {
+        let states = &self.surfaces;
+        let surface = |u: &'a SurfaceUpdate<'a>| -> Option<PlanSurface<'a>> {
             let index = u.surface.0 as usize;
-            let s = self.surfaces[index].as_ref()?;
+            let s = states.get(index)?.as_ref()?;
             Some(PlanSurface {
                 index,
                 id: u.surface,
@@ -462,12 +463,14 @@ impl SnowWorld {
                 ground: s.ground.as_ref().map(|g| g.plan()),
                 ground_field: s.ground.as_ref().map(|g| &g.field),
             })
-        });
+        };
         let meshes = WorldMeshes {
             capture: &self.meshes,
             vertices: &self.probes.mesh_vertices,
         };
-        plan.rebuild(&PlanSettings::of(&self.config), surfaces, meshes);
+        let settings = PlanSettings::of(&self.config);
+        let threads = plan_threads(self.config.plan_threads);
+        plan.rebuild_split(&settings, updates, surface, meshes, threads);
     }
 
     /// Grow the per-frame buffers the plan needs and write its tables: with `queue.write_buffer`

@@ -16,25 +16,28 @@ use super::nearby::{INDEX_FROM, NearbyDeformers, surface_rect};
 use super::{FrameStats, PassMode, WorldConfig};
 use crate::accumulate::AccumulatePlan;
 use crate::capture::{
-    self, CaptureConfig, CaptureMode, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
+    self, CaptureConfig, CapturePlan, CaptureView, CaptureVolume, CapturedSurface,
 };
 use crate::deformer::Deformer;
 use crate::gpu::resources::UNIFORM_STRIDE;
 use crate::ground::GroundField;
 use crate::mesh::MeshId;
 use crate::pool::{
-    MODE_CAST, MODE_GROUND, MODE_MESHES, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat,
-    SurfaceRecord, TILE_LIST_HEADER, TILE_SIDE,
+    MODE_CAST, MODE_GROUND, MODE_REFILLED, NO_CAPTURE, NO_NORMALS, PoolFormat, SurfaceRecord,
+    TILE_LIST_HEADER, TILE_SIDE,
 };
 use crate::relax::{Rect, RelaxPlan, RelaxRecord, Settle};
 use crate::surface::{SurfaceDesc, SurfaceId, SurfaceLayout};
 
+mod parallel;
 mod surface;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use parallel::plan_threads;
+
 pub use surface::replenish;
-use surface::{Way, pressed_rect, refused, way};
+use surface::{Way, pressed_rect, record_mode, refused, way};
 
 /// The settings of a world that a plan follows.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -219,6 +222,12 @@ struct Job {
     draws: Range<u32>,
     /// How its analytic deformers reach the update.
     way: Way,
+    /// In a split plan, the tiles its primitives reach, in the plan's `reached` (computed with
+    /// the rest of the surface's own work, so that it is spread over threads with it:
+    /// `reach_tiles`), and whether the compute path takes the tiles beside them
+    /// (`capture::tiles_reached`); else empty.
+    tiles: Range<u32>,
+    sparse: bool,
     /// Relaxation steps this update (0: none), the material's repose angle (degrees) and the
     /// rectangle that relaxes.
     relax: (u32, f32, Rect),
@@ -251,6 +260,16 @@ pub struct FramePlan {
     rects: Vec<(u32, u32)>,
     /// Scratch of the compute path's tiles, a flag a tile of one surface.
     seen: Vec<bool>,
+    /// The tiles each job's primitives reach (`Job::tiles`), `[0, tile y << 16 | tile x]`: the
+    /// view or record is set as the tables are written.
+    reached: Vec<[u32; 2]>,
+    /// Whether each surface lists its tiles into `reached` as it is planned (a split plan, so
+    /// that the listing is spread over the threads), rather than as the tables are written (one
+    /// copy fewer).
+    tiles_early: bool,
+    /// Partial plans of contiguous runs of surfaces, planned on threads of their own and then
+    /// appended in order (`parallel.rs`); kept for their memory.
+    parts: Vec<FramePlan>,
     /// The grid over a long list of deformers shared by surfaces (`encode_step`'s), kept for the
     /// frame's footsteps; forgotten at the next rebuild.
     pub(crate) nearby: NearbyDeformers,
@@ -286,20 +305,30 @@ impl FramePlan {
         meshes: impl PlanMeshes,
     ) {
         self.clear();
+        self.tiles_early = false;
         for s in surfaces {
             self.plan_surface(settings, &s, &meshes);
         }
+        self.finish(settings);
+    }
+
+    /// Order the jobs, pack the atlas and write the tables: the work of the whole frame, once
+    /// every surface is planned.
+    fn finish(&mut self, settings: &PlanSettings) {
         // Surfaces that refill snow first (the refill pass streams records 0..dense), those the
         // update casts first among them and last among the others, so that the fused grid covers
         // a run of records that it captures (`accumulation_shape`).
-        self.jobs.sort_by_key(
-            |j| match (j.record.replenish_units > 0, j.way == Way::Cast) {
-                (true, true) => 0,
-                (true, false) => 1,
-                (false, false) => 2,
-                (false, true) => 3,
-            },
-        );
+        let order = |j: &Job| match (j.record.replenish_units > 0, j.way == Way::Cast) {
+            (true, true) => 0,
+            (true, false) => 1,
+            (false, false) => 2,
+            (false, true) => 3,
+        };
+        // A stable sort takes scratch memory of half the jobs: not when they are in order already
+        // (a frame whose surfaces all take one way, say).
+        if !self.jobs.is_sorted_by_key(order) {
+            self.jobs.sort_by_key(order);
+        }
         self.pack_atlas(settings);
         self.write_tables(settings);
     }
@@ -334,6 +363,7 @@ impl FramePlan {
         self.refused = false;
         self.jobs.clear();
         self.rects.clear();
+        self.reached.clear();
         self.nearby.forget();
     }
 
@@ -435,15 +465,13 @@ impl FramePlan {
             return;
         }
         let texel = s.desc.size / Vec2::new(s.layout.width as f32, s.layout.height as f32);
-        let mode = match settings.capture.mode {
-            CaptureMode::Depth => 0,
-            CaptureMode::Mask => 1,
-        } | if d1 > d0 { MODE_MESHES } else { 0 }
-            | if d1 > d0 && s.ground.is_some() {
-                MODE_GROUND
-            } else {
-                0
-            };
+        let way = way(settings, p1 - p0, d1 > d0);
+        let (tiles, sparse) = if self.tiles_early {
+            self.reach_tiles(way, p0..p1, s.layout, half_size)
+        } else {
+            (0..0, false)
+        };
+        let mode = record_mode(settings.capture.mode, d1 > d0, s.ground.is_some());
         self.jobs.push(Job {
             surface: PlannedSurface {
                 index: s.index,
@@ -479,13 +507,41 @@ impl FramePlan {
             ground_codes: s.ground.map_or(0, |g| g.codes),
             prims: p0..p1,
             draws: d0..d1,
-            way: way(settings, p1 - p0, d1 > d0),
+            way,
+            tiles,
+            sparse,
             relax: if relaxes && !rect.is_empty() {
                 (steps, material.repose_degrees.unwrap_or(90.0), rect)
             } else {
                 (0, 90.0, Rect::default())
             },
         });
+    }
+
+    /// The tiles that a surface's primitives `prims` reach, appended to `reached`: the update's
+    /// ([`capture::update_tiles_reached`]) when it casts them, the capture region's
+    /// ([`capture::tiles_reached`], with whether it takes the tiles beside them) on the compute
+    /// path, none on the raster path.
+    fn reach_tiles(
+        &mut self,
+        way: Way,
+        prims: Range<u32>,
+        layout: SurfaceLayout,
+        half_size: Vec2,
+    ) -> (Range<u32>, bool) {
+        let t0 = self.reached.len() as u32;
+        let prims = &self.capture.prims[prims.start as usize..prims.end as usize];
+        let size = (layout.width, layout.height);
+        let (seen, reached) = (&mut self.seen, &mut self.reached);
+        let sparse = match way {
+            Way::Raster => false,
+            Way::Cast => {
+                capture::update_tiles_reached(prims, size, half_size, 0, seen, reached);
+                false
+            }
+            Way::Compute => capture::tiles_reached(prims, size, half_size, 0, seen, reached),
+        };
+        (t0..self.reached.len() as u32, sparse)
     }
 
     /// Place captured surfaces in the atlas (those the raster path captures), the capture buffer
@@ -618,15 +674,15 @@ impl FramePlan {
                         (0..r.tile_count())
                             .map(|t| [j as u32, ((t / tiles_x) << 16) | (t % tiles_x)]),
                     );
+                } else if self.tiles_early {
+                    let tiles = &self.reached[job.tiles.start as usize..job.tiles.end as usize];
+                    c.listed
+                        .extend(tiles.iter().map(|&[_, tile]| [j as u32, tile]));
                 } else {
-                    capture::update_tiles_reached(
-                        &c.prims[job.prims.start as usize..job.prims.end as usize],
-                        (r.width, r.height),
-                        job.half_size,
-                        j as u32,
-                        &mut self.seen,
-                        &mut c.listed,
-                    );
+                    let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
+                    let (size, seen) = ((r.width, r.height), &mut self.seen);
+                    let (half, list) = (job.half_size, &mut c.listed);
+                    capture::update_tiles_reached(prims, size, half, j as u32, seen, list);
                 }
             }
             if !job.surface.captured || job.way == Way::Cast {
@@ -647,17 +703,16 @@ impl FramePlan {
             });
             let mut whole = 0;
             if job.way == Way::Compute {
-                let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
                 let view = c.views.len() as u32;
-                let size = (r.width, r.height);
-                let sparse = capture::tiles_reached(
-                    prims,
-                    size,
-                    job.half_size,
-                    view,
-                    &mut self.seen,
-                    &mut c.work,
-                );
+                let sparse = if self.tiles_early {
+                    let tiles = &self.reached[job.tiles.start as usize..job.tiles.end as usize];
+                    c.work.extend(tiles.iter().map(|&[_, tile]| [view, tile]));
+                    job.sparse
+                } else {
+                    let prims = &c.prims[job.prims.start as usize..job.prims.end as usize];
+                    let (size, seen) = ((r.width, r.height), &mut self.seen);
+                    capture::tiles_reached(prims, size, job.half_size, view, seen, &mut c.work)
+                };
                 if let Some(s) = c.surfaces.last_mut() {
                     s.cleared = !sparse;
                 }

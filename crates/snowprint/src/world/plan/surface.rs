@@ -5,8 +5,9 @@
 use glam::{Vec2, Vec3};
 
 use super::{PlanMeshes, PlanSettings};
-use crate::capture::{self, CapturePlan, CaptureVolume};
+use crate::capture::{self, CaptureMode, CapturePlan, CaptureVolume};
 use crate::deformer::{Deformer, Shape};
+use crate::pool::{MODE_GROUND, MODE_MESHES};
 use crate::relax::Rect;
 use crate::surface::SurfaceLayout;
 
@@ -89,6 +90,20 @@ pub(super) fn way(settings: &PlanSettings, prims: u32, meshes: bool) -> Way {
         return Way::Cast;
     }
     Way::Compute
+}
+
+/// A surface record's `mode` bits: the capture mode, and whether meshes press it
+/// ([`MODE_MESHES`]) on ground that is not flat ([`MODE_GROUND`]).
+pub(super) fn record_mode(capture: CaptureMode, meshes: bool, ground: bool) -> u32 {
+    let mode = match capture {
+        CaptureMode::Depth => 0,
+        CaptureMode::Mask => 1,
+    };
+    match (meshes, ground) {
+        (false, _) => mode,
+        (true, false) => mode | MODE_MESHES,
+        (true, true) => mode | MODE_MESHES | MODE_GROUND,
+    }
 }
 
 /// Add a surface's replenishment over `elapsed` seconds to its carry: `(new carry, whole units

@@ -5,7 +5,7 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::deformer::{Pose, Shape};
-use crate::pool::Precision;
+use crate::pool::{MODE_MESHES, Precision};
 
 fn settings() -> PlanSettings {
     PlanSettings::of(&WorldConfig::default())

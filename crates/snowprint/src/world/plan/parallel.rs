@@ -1,0 +1,126 @@
+//! A frame of many surfaces planned on several threads: each plans a contiguous run of the
+//! surfaces into a partial plan of its own (the per-surface work: replenishment, culling,
+//! sweeping, the footstep test, the tiles reached), and the runs are then appended in order,
+//! their ranges shifted, before the frame's own work (`FramePlan::finish`). The plan is the one
+//! [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for byte
+//! (`tests.rs`, `split_plan_is_the_serial_plan`).
+
+use super::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
+
+/// Fewest surfaces in a frame from which its plan is split over threads: below it, starting the
+/// threads costs more than the work they share (tens of microseconds, against about a microsecond
+/// a surface).
+pub(crate) const SPLIT_FROM: usize = 256;
+
+/// Most threads a plan is split over when the world leaves the count to the machine
+/// ([`crate::WorldConfig::plan_threads`] 0): past it, the serial work of the frame (the appends,
+/// the tables, the upload) leaves little to gain.
+pub(crate) const AUTO_THREADS_MAX: usize = 8;
+
+/// The threads to plan over when the world's configuration asks for `threads` (0: the machine's
+/// available parallelism, up to [`AUTO_THREADS_MAX`]).
+pub(crate) fn plan_threads(threads: usize) -> usize {
+    // Asked once a process: on Linux the answer reads the cgroup's quota from files.
+    static AUTO: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    if threads > 0 {
+        return threads;
+    }
+    *AUTO.get_or_init(|| {
+        std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(AUTO_THREADS_MAX)
+    })
+}
+
+impl FramePlan {
+    /// [`FramePlan::rebuild`] of the surfaces that `surface` makes of `items` (skipping those it
+    /// gives `None` for), split over up to `threads` threads when there are at least
+    /// [`SPLIT_FROM`] items: the same plan, made sooner.
+    pub(crate) fn rebuild_split<'a, T: Sync>(
+        &mut self,
+        settings: &PlanSettings,
+        items: &'a [T],
+        surface: impl Fn(&'a T) -> Option<PlanSurface<'a>> + Sync,
+        meshes: impl PlanMeshes + Sync,
+        threads: usize,
+    ) {
+        let threads = threads.min(items.len() / (SPLIT_FROM / 2)).max(1);
+        if threads == 1 || items.len() < SPLIT_FROM {
+            self.rebuild(settings, items.iter().filter_map(surface), meshes);
+            return;
+        }
+        self.clear();
+        self.tiles_early = true;
+        // This thread plans the first run into the plan itself (nothing of it to copy), the
+        // others each plan one into a part of their own, appended after it.
+        let mut parts = std::mem::take(&mut self.parts);
+        parts.resize_with(threads - 1, FramePlan::default);
+        let run = items.len().div_ceil(threads);
+        let check = self.check_short_lists;
+        let (surface, meshes) = (&surface, &meshes);
+        let plan_run = |plan: &mut FramePlan, run: &'a [T]| {
+            for s in run.iter().filter_map(surface) {
+                plan.plan_surface(settings, &s, meshes);
+            }
+        };
+        let mut runs = items.chunks(run);
+        let first = runs.next().unwrap_or_default();
+        std::thread::scope(|scope| {
+            for (part, run) in parts.iter_mut().zip(runs) {
+                scope.spawn(move || {
+                    part.clear();
+                    part.check_short_lists = check;
+                    part.tiles_early = true;
+                    plan_run(part, run);
+                });
+            }
+            plan_run(self, first);
+        });
+        self.reserve_for(&parts);
+        for part in &mut parts {
+            self.append(part);
+        }
+        self.parts = parts;
+        self.finish(settings);
+    }
+
+    /// Make room for the parts' vectors at once (rather than growing as they are appended).
+    fn reserve_for(&mut self, parts: &[FramePlan]) {
+        let total = |f: fn(&FramePlan) -> usize| parts.iter().map(f).sum::<usize>();
+        let c = &mut self.capture;
+        c.prims.reserve(total(|p| p.capture.prims.len()));
+        c.draws.reserve(total(|p| p.capture.draws.len()));
+        c.draw_meshes
+            .reserve(total(|p| p.capture.draw_meshes.len()));
+        self.reached.reserve(total(|p| p.reached.len()));
+        self.carries.reserve(total(|p| p.carries.len()));
+        self.settles.reserve(total(|p| p.settles.len()));
+        self.footsteps.reserve(total(|p| p.footsteps.len()));
+        self.jobs.reserve(total(|p| p.jobs.len()));
+    }
+
+    /// Append a partial plan of the surfaces after this plan's, as if they had been planned
+    /// here: its jobs' ranges of primitives, draws and tiles shifted past this plan's.
+    fn append(&mut self, part: &mut FramePlan) {
+        let shift = |r: &std::ops::Range<u32>, by: usize| r.start + by as u32..r.end + by as u32;
+        let c = &mut self.capture;
+        let (prims, draws, tiles) = (c.prims.len(), c.draws.len(), self.reached.len());
+        c.prims.extend_from_slice(&part.capture.prims);
+        c.draws.extend_from_slice(&part.capture.draws);
+        c.draw_meshes.extend_from_slice(&part.capture.draw_meshes);
+        self.reached.extend_from_slice(&part.reached);
+        self.carries.extend_from_slice(&part.carries);
+        self.settles.extend_from_slice(&part.settles);
+        self.footsteps.extend_from_slice(&part.footsteps);
+        self.jobs.extend(part.jobs.drain(..).map(|mut job| {
+            job.prims = shift(&job.prims, prims);
+            job.draws = shift(&job.draws, draws);
+            job.tiles = shift(&job.tiles, tiles);
+            job
+        }));
+        self.refused |= part.refused;
+    }
+}
+
+#[cfg(test)]
+mod tests;
