@@ -9,7 +9,7 @@ use snowprint::{
 };
 
 /// Surfaces of 16 x 16 texels (0.64 m at 4 cm), a row of them.
-const SURFACES: u32 = 300;
+const SURFACES: u32 = 520;
 
 fn world(plan_threads: usize, capture_path: CapturePath) -> (SnowWorld, Vec<SurfaceId>) {
     let format = PoolFormat::new(Precision::Bits8);

@@ -9,8 +9,13 @@ use super::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
 
 /// Fewest surfaces in a frame from which its plan is split over threads: below it, starting the
 /// threads costs more than the work they share (tens of microseconds, against about a microsecond
-/// a surface).
-pub(crate) const SPLIT_FROM: usize = 256;
+/// a surface). On the H100's 16-core host two threads of 128 surfaces took 0.30 to 0.34 ms
+/// against one thread's 0.25 to 0.26 (`docs/PERFORMANCE.md`, "The CPU's frame build and encode on
+/// the H100's host").
+pub(crate) const SPLIT_FROM: usize = 512;
+
+/// Fewest surfaces a thread of a split plan takes.
+pub(crate) const RUN_MIN: usize = 128;
 
 /// Most threads a plan is split over when the world leaves the count to the machine
 /// ([`crate::WorldConfig::plan_threads`] 0): past it, the serial work of the frame (the appends,
@@ -44,7 +49,7 @@ impl FramePlan {
         meshes: impl PlanMeshes + Sync,
         threads: usize,
     ) {
-        let threads = threads.min(items.len() / (SPLIT_FROM / 2)).max(1);
+        let threads = threads.min(items.len() / RUN_MIN).max(1);
         if threads == 1 || items.len() < SPLIT_FROM {
             self.rebuild(settings, items.iter().filter_map(surface), meshes);
             return;
