@@ -5,7 +5,7 @@ mod common;
 
 use glam::{Mat4, Vec3};
 use snowprint::render::{
-    Environment, Instance, PASSES, RenderConfig, RenderError, RenderFrame, Renderer,
+    Environment, Instance, OpaquePath, PASSES, RenderConfig, RenderError, RenderFrame, Renderer,
     SnowMaterialKind, Tier,
 };
 use snowprint::{
@@ -497,6 +497,56 @@ fn kept_bind_groups_follow_grown_buffers_and_reordered_surfaces() {
             assert!(
                 again == fresh,
                 "{tier:?}, {name}: the running renderer differs"
+            );
+        }
+    }
+}
+
+/// The meshes live in one vertex and one index buffer: a mesh replaced by one of its own size is
+/// written in place, by one of another size (or a mesh added) every mesh is laid out again. Either
+/// way the frame is the one a renderer given the new meshes from the start draws, on both opaque
+/// paths (the visibility path pulls the same buffers).
+#[test]
+fn replaced_meshes_draw_as_meshes_registered_anew() {
+    let gpu = common::gpu();
+    let world = world();
+    let place = |mesh, x: f32| {
+        Instance::new(
+            mesh,
+            Mat4::from_translation(Vec3::new(x, 0.4, 0.0)),
+            [0.7, 0.5, 0.3],
+        )
+    };
+    let shoot = |r: &mut Renderer, meshes: &[snowprint::render::RenderMeshId]| {
+        let instances = [place(meshes[0], -0.6), place(meshes[1], 0.6)];
+        r.render(&world, &frame(&[], &instances)).unwrap().rgba8
+    };
+    let first = [Mesh::cuboid(Vec3::splat(0.3)), Mesh::uv_sphere(0.3, 6, 8)];
+    // The same sizes as `first` (in place), then the sphere finer (laid out again).
+    let second = [Mesh::cuboid(Vec3::new(0.2, 0.5, 0.25)), first[1].clone()];
+    let third = [second[0].clone(), Mesh::uv_sphere(0.35, 12, 16)];
+    for opaque in [OpaquePath::Forward, OpaquePath::Visibility] {
+        let config = RenderConfig {
+            opaque,
+            ..small(Tier::Relief)
+        };
+        let mut kept = Renderer::new(gpu, config).unwrap();
+        let ids: Vec<_> = first.iter().map(|m| kept.add_mesh(m).unwrap()).collect();
+        let before = shoot(&mut kept, &ids);
+        for (name, meshes) in [("same sizes", &second), ("another size", &third)] {
+            for (id, mesh) in ids.iter().zip(meshes) {
+                kept.update_mesh(*id, mesh).unwrap();
+            }
+            let mut fresh = Renderer::new(gpu, config).unwrap();
+            let fresh_ids: Vec<_> = meshes.iter().map(|m| fresh.add_mesh(m).unwrap()).collect();
+            let expected = shoot(&mut fresh, &fresh_ids);
+            assert!(
+                expected != before,
+                "{opaque:?}, {name}: the new meshes change nothing"
+            );
+            assert!(
+                shoot(&mut kept, &ids) == expected,
+                "{opaque:?}, {name}: the replaced meshes draw otherwise"
             );
         }
     }

@@ -13,12 +13,14 @@ use crate::gpu::resources::Growable;
 use crate::mesh::Mesh;
 
 pub(super) struct GpuMesh {
-    vertices: wgpu::Buffer,
-    indices: wgpu::Buffer,
     pub index_count: u32,
+    /// Where the mesh lies in the set's one index buffer and one vertex buffer (its indices count
+    /// from its own first vertex).
+    pub first_index: u32,
+    pub base_vertex: u32,
     pub radius: f32,
-    /// The vertices and indices uploaded, kept for the visibility path's one buffer of every
-    /// mesh (`opaque::geometry`).
+    /// The vertices and indices uploaded, kept to rebuild the set's buffers when a mesh is added
+    /// or replaced by one of another size.
     pub source: (Vec<MeshVertexRaw>, Vec<u32>),
 }
 
@@ -37,6 +39,15 @@ type Run = (u32, std::ops::Range<u32>);
 /// Registered meshes and the frame's instances.
 pub(super) struct MeshSet {
     pub meshes: Vec<GpuMesh>,
+    /// Every mesh's vertices, then every mesh's indices, in one buffer each: a pass binds them
+    /// once and draws each run of instances with one command (a buffer bound per mesh cost three,
+    /// each validated and tracked as the frame's commands are encoded).
+    vertices: Growable,
+    indices: Growable,
+    /// The `version` the two buffers hold (`None`: never written), and the meshes replaced since
+    /// by meshes of the same size, written in place (any other change rewrites both whole).
+    uploaded: Option<u64>,
+    replaced: Vec<u32>,
     instances: Growable,
     /// This frame's draws: every instance, then the shadow casters.
     draws: Vec<Run>,
@@ -59,8 +70,16 @@ pub(super) struct MeshSet {
 
 impl MeshSet {
     pub(super) fn new(device: &wgpu::Device) -> Self {
+        use wgpu::BufferUsages as U;
+        // Storage too: the visibility path pulls the vertices and indices in its own passes.
+        let geometry =
+            |label, usage| Growable::new(device, label, usage | U::STORAGE | U::COPY_DST, 16);
         Self {
             meshes: Vec::new(),
+            vertices: geometry("render mesh vertices", U::VERTEX),
+            indices: geometry("render mesh indices", U::INDEX),
+            uploaded: None,
+            replaced: Vec::new(),
             instances: Growable::new(
                 device,
                 "mesh instances",
@@ -82,26 +101,77 @@ impl MeshSet {
     }
 
     /// Register a mesh; normals are computed here (smooth, split at creases).
-    pub(super) fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
-        let gpu = upload(device, mesh)?;
+    pub(super) fn add(&mut self, mesh: &Mesh) -> RenderResult<RenderMeshId> {
+        let gpu = shade(mesh)?;
         self.meshes.push(gpu);
+        self.replaced.clear();
+        self.uploaded = None;
         self.version += 1;
         Ok(RenderMeshId(self.meshes.len() as u32 - 1))
     }
 
     /// Replace a registered mesh.
-    pub(super) fn update(
-        &mut self,
-        device: &wgpu::Device,
-        id: RenderMeshId,
-        mesh: &Mesh,
-    ) -> RenderResult<()> {
-        if id.0 as usize >= self.meshes.len() {
+    pub(super) fn update(&mut self, id: RenderMeshId, mesh: &Mesh) -> RenderResult<()> {
+        let Some(old) = self.meshes.get(id.0 as usize) else {
             return Err(RenderError::StaleMesh { index: id.0 });
+        };
+        let mut gpu = shade(mesh)?;
+        let sizes = |m: &GpuMesh| (m.source.0.len(), m.source.1.len());
+        if sizes(&gpu) == sizes(old) {
+            (gpu.first_index, gpu.base_vertex) = (old.first_index, old.base_vertex);
+            self.replaced.push(id.0);
+        } else {
+            self.uploaded = None;
         }
-        self.meshes[id.0 as usize] = upload(device, mesh)?;
+        self.meshes[id.0 as usize] = gpu;
         self.version += 1;
         Ok(())
+    }
+
+    /// Bring the two buffers up to the registered meshes: the replaced ones written in place, or
+    /// every mesh laid out again and both buffers written whole.
+    fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
+        if self.uploaded == Some(self.version) {
+            return;
+        }
+        if self.uploaded.is_some() {
+            for &id in &self.replaced {
+                let m = &self.meshes[id as usize];
+                let vertex = std::mem::size_of::<MeshVertexRaw>() as u64;
+                let at = (m.base_vertex as u64 * vertex, m.first_index as u64 * 4);
+                queue.write_buffer(
+                    &self.vertices.buffer,
+                    at.0,
+                    bytemuck::cast_slice(&m.source.0),
+                );
+                queue.write_buffer(
+                    &self.indices.buffer,
+                    at.1,
+                    bytemuck::cast_slice(&m.source.1),
+                );
+            }
+        } else {
+            let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+            for m in &mut self.meshes {
+                (m.first_index, m.base_vertex) = (indices.len() as u32, vertices.len() as u32);
+                vertices.extend_from_slice(&m.source.0);
+                indices.extend_from_slice(&m.source.1);
+            }
+            for (buffer, bytes) in [
+                (&mut self.vertices, bytemuck::cast_slice::<_, u8>(&vertices)),
+                (&mut self.indices, bytemuck::cast_slice(&indices)),
+            ] {
+                buffer.ensure(device, bytes.len() as u64);
+                queue.write_buffer(&buffer.buffer, 0, bytes);
+            }
+        }
+        self.replaced.clear();
+        self.uploaded = Some(self.version);
+    }
+
+    /// The buffers of every registered mesh's vertices and indices (as of the last `prepare`).
+    pub(super) fn geometry_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        (&self.vertices.buffer, &self.indices.buffer)
     }
 
     /// Upload the frame's instances: those the view may see (`cull::visible` against
@@ -117,6 +187,7 @@ impl MeshSet {
         view_proj: glam::Mat4,
         (cascades, shadow_size): ([glam::Mat4; 2], u32),
     ) {
+        self.upload(device, queue);
         let bounds = || {
             frame
                 .iter()
@@ -204,12 +275,13 @@ impl MeshSet {
 
     /// Draw the frame's instances of `set` with the pass's pipeline and bind groups set.
     pub(super) fn draw(&self, p: &mut wgpu::RenderPass<'_>, set: DrawSet) {
+        p.set_vertex_buffer(0, self.vertices.buffer.slice(..));
         p.set_vertex_buffer(1, self.instances.buffer.slice(..));
+        p.set_index_buffer(self.indices.buffer.slice(..), wgpu::IndexFormat::Uint32);
         for (mesh, range) in self.runs(set) {
             let m = &self.meshes[*mesh as usize];
-            p.set_vertex_buffer(0, m.vertices.slice(..));
-            p.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
-            p.draw_indexed(0..m.index_count, 0, range.clone());
+            let indices = m.first_index..m.first_index + m.index_count;
+            p.draw_indexed(indices, m.base_vertex as i32, range.clone());
         }
     }
 }
@@ -246,22 +318,13 @@ fn raw(inst: &Instance) -> InstanceRaw {
     }
 }
 
-fn upload(device: &wgpu::Device, mesh: &Mesh) -> RenderResult<GpuMesh> {
+fn shade(mesh: &Mesh) -> RenderResult<GpuMesh> {
     mesh.validate("render mesh")?;
     let (vertices, indices) = geometry::shade_normals(mesh, geometry::CREASE_DEGREES);
-    use wgpu::util::DeviceExt;
     Ok(GpuMesh {
-        vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("render mesh vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        }),
-        indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("render mesh indices"),
-            contents: bytemuck::cast_slice(&indices),
-            usage: wgpu::BufferUsages::INDEX,
-        }),
         index_count: indices.len() as u32,
+        first_index: 0,
+        base_vertex: 0,
         radius: mesh.bounding_radius(),
         source: (vertices, indices),
     })

@@ -87,20 +87,19 @@ impl VisibilityPass {
             self.current = None;
             return;
         };
-        let instances = meshes.instance_buffer();
         let raster = self.kept.get(
             device,
             "visibility geometry",
             &self.raster_layout,
             0,
-            &self.geometry.entries(instances),
+            &self.geometry.entries(meshes),
         );
         let shade = self.kept.get(
             device,
             "shade geometry",
             &self.shade_layout,
             1,
-            &self.geometry.entries(instances),
+            &self.geometry.entries(meshes),
         );
         let outputs = self.kept.get(
             device,
