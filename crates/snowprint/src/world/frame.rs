@@ -479,14 +479,15 @@ impl SnowWorld {
     /// before its passes ran).
     fn upload(&mut self, plan: &FramePlan, mut enc: Option<&mut wgpu::CommandEncoder>) {
         let (device, queue) = (&self.device, &self.queue);
-        let mut write = |buffer: &wgpu::Buffer, bytes: &[u8]| match enc.as_deref_mut() {
-            None => queue.write_buffer(buffer, 0, bytes),
-            Some(enc) => crate::gpu::resources::write_in_order(device, enc, buffer, 0, bytes),
+        let mut write_at = |buffer: &wgpu::Buffer, at: u64, bytes: &[u8]| match enc.as_deref_mut() {
+            None => queue.write_buffer(buffer, at, bytes),
+            Some(enc) => crate::gpu::resources::write_in_order(device, enc, buffer, at, bytes),
         };
         let sizes = &plan.sizes;
         self.records.ensure(device, sizes.records);
-        write(
+        write_at(
             &self.records.buffer,
+            0,
             bytemuck::cast_slice(&plan.accumulate.records),
         );
         let c = &plan.capture;
@@ -498,20 +499,26 @@ impl SnowWorld {
             capture::append_work_table(c, blocks);
         }
         self.views.ensure(device, sizes.views);
-        write(&self.views.buffer, blocks);
-        if !c.prims.is_empty() {
+        write_at(&self.views.buffer, 0, blocks);
+        if sizes.prims > 0 {
+            // Run by run, where each was planned (a split plan's parts are not appended).
             self.prims.ensure(device, sizes.prims);
-            write(&self.prims.buffer, bytemuck::cast_slice(&c.prims));
+            let mut at = 0;
+            for run in plan.prims().filter(|run| !run.is_empty()) {
+                write_at(&self.prims.buffer, at, bytemuck::cast_slice(run));
+                at += std::mem::size_of_val(run) as u64;
+            }
         }
         if !c.draws.is_empty() {
             uniform_blocks(blocks, &c.draws, 0);
             self.draws.ensure(device, sizes.draws);
-            write(&self.draws.buffer, blocks);
+            write_at(&self.draws.buffer, 0, blocks);
         }
         if !plan.relax.is_empty() {
             self.relax.records.ensure(device, sizes.relax_records);
-            write(
+            write_at(
                 &self.relax.records.buffer,
+                0,
                 bytemuck::cast_slice(&plan.relax.records),
             );
             self.relax.scratch.ensure(device, sizes.relax_scratch);
@@ -531,7 +538,7 @@ impl SnowWorld {
             blocks.clear();
             blocks.extend_from_slice(bytemuck::cast_slice(&header));
             blocks.extend_from_slice(bytemuck::cast_slice(&c.listed));
-            write(&self.tile_list.buffer, blocks);
+            write_at(&self.tile_list.buffer, 0, blocks);
         }
     }
 

@@ -270,6 +270,9 @@ pub struct FramePlan {
     /// Partial plans of contiguous runs of surfaces, planned on threads of their own and then
     /// appended in order (`parallel.rs`); kept for their memory.
     parts: Vec<FramePlan>,
+    /// Whether the parts' primitives follow this plan's (a split plan): they are not appended,
+    /// but written to the GPU from where they were planned ([`FramePlan::prims`]).
+    prims_in_parts: bool,
     /// The grid over a long list of deformers shared by surfaces (`encode_step`'s), kept for the
     /// frame's footsteps; forgotten at the next rebuild.
     pub(crate) nearby: NearbyDeformers,
@@ -344,7 +347,7 @@ impl FramePlan {
             updated: self.surfaces.len() as u32,
             captured: self.surfaces.iter().filter(|s| s.captured).count() as u32,
             capture_batches: self.capture.batches,
-            primitives: self.capture.prims.len() as u32,
+            primitives: self.prims_len() as u32,
             mesh_draws: self.capture.draws.len() as u32,
             cleared_capture_bytes: self.capture.clears.iter().map(|c| c.1 as u64 * 4).sum(),
             ..Default::default()
@@ -364,6 +367,7 @@ impl FramePlan {
         self.jobs.clear();
         self.rects.clear();
         self.reached.clear();
+        self.prims_in_parts = false;
         self.nearby.forget();
     }
 
@@ -656,6 +660,7 @@ impl FramePlan {
     /// Records, views, the accumulation's dispatch shape and the buffer sizes.
     fn write_tables(&mut self, settings: &PlanSettings) {
         self.accumulation_shape(settings);
+        let prims = self.prims_len() * std::mem::size_of::<capture::GpuPrimitive>();
         let a = &mut self.accumulate;
         let c = &mut self.capture;
         for (j, job) in self.jobs.iter().enumerate() {
@@ -775,7 +780,7 @@ impl FramePlan {
                 } else {
                     capture::work_table_bytes(c) - c.views.len() as u64 * UNIFORM_STRIDE
                 },
-            prims: std::mem::size_of_val(c.prims.as_slice()) as u64,
+            prims: prims as u64,
             draws: c.draws.len() as u64 * UNIFORM_STRIDE,
             // The blurred capture goes through memory only when blur and merge are separate.
             scratch: if self.accumulate.fused { 0 } else { texels },

@@ -1,11 +1,14 @@
 //! A frame of many surfaces planned on several threads: each plans a contiguous run of the
 //! surfaces into a partial plan of its own (the per-surface work: replenishment, culling,
 //! sweeping, the footstep test, the tiles reached), and the runs are then appended in order,
-//! their ranges shifted, before the frame's own work (`FramePlan::finish`). The plan is the one
-//! [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for byte
-//! (`tests.rs`, `split_plan_is_the_serial_plan`).
+//! their ranges shifted, before the frame's own work (`FramePlan::finish`). The primitives, most
+//! of a frame's bytes, are not appended: they stay in the parts, after the first run's, and are
+//! written to the GPU from there ([`FramePlan::prims`]), copied once rather than twice. The plan
+//! is the one [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for
+//! byte (`tests.rs`, `split_plan_is_the_serial_plan`).
 
 use super::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
+use crate::capture::GpuPrimitive;
 
 /// Fewest surfaces in a frame from which its plan is split over threads: below it, starting the
 /// threads costs more than the work they share (tens of microseconds, against about a microsecond
@@ -82,18 +85,36 @@ impl FramePlan {
             plan_run(self, first);
         });
         self.reserve_for(&parts);
+        let mut prims = self.capture.prims.len();
         for part in &mut parts {
-            self.append(part);
+            self.append(part, prims);
+            prims += part.capture.prims.len();
         }
         self.parts = parts;
+        self.prims_in_parts = true;
         self.finish(settings);
+    }
+
+    /// The frame's primitives, in order, as runs of consecutive ones: the plan's own, then (a
+    /// split plan) each part's. The jobs' ranges index their concatenation.
+    pub(crate) fn prims(&self) -> impl Iterator<Item = &[GpuPrimitive]> {
+        let parts = if self.prims_in_parts {
+            &self.parts[..]
+        } else {
+            &[]
+        };
+        std::iter::once(&self.capture.prims[..]).chain(parts.iter().map(|p| &p.capture.prims[..]))
+    }
+
+    /// How many primitives the frame has ([`FramePlan::prims`]).
+    pub(crate) fn prims_len(&self) -> usize {
+        self.prims().map(<[GpuPrimitive]>::len).sum()
     }
 
     /// Make room for the parts' vectors at once (rather than growing as they are appended).
     fn reserve_for(&mut self, parts: &[FramePlan]) {
         let total = |f: fn(&FramePlan) -> usize| parts.iter().map(f).sum::<usize>();
         let c = &mut self.capture;
-        c.prims.reserve(total(|p| p.capture.prims.len()));
         c.draws.reserve(total(|p| p.capture.draws.len()));
         c.draw_meshes
             .reserve(total(|p| p.capture.draw_meshes.len()));
@@ -105,12 +126,12 @@ impl FramePlan {
     }
 
     /// Append a partial plan of the surfaces after this plan's, as if they had been planned
-    /// here: its jobs' ranges of primitives, draws and tiles shifted past this plan's.
-    fn append(&mut self, part: &mut FramePlan) {
+    /// here: its jobs' ranges of draws and tiles shifted past this plan's, and of primitives past
+    /// the `prims` of the runs before it (which stay where they were planned).
+    fn append(&mut self, part: &mut FramePlan, prims: usize) {
         let shift = |r: &std::ops::Range<u32>, by: usize| r.start + by as u32..r.end + by as u32;
         let c = &mut self.capture;
-        let (prims, draws, tiles) = (c.prims.len(), c.draws.len(), self.reached.len());
-        c.prims.extend_from_slice(&part.capture.prims);
+        let (draws, tiles) = (c.draws.len(), self.reached.len());
         c.draws.extend_from_slice(&part.capture.draws);
         c.draw_meshes.extend_from_slice(&part.capture.draw_meshes);
         self.reached.extend_from_slice(&part.reached);

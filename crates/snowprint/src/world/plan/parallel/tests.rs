@@ -203,15 +203,23 @@ fn surfaces(f: &Frame) -> Vec<Option<PlanSurface<'_>>> {
         .collect()
 }
 
-/// Every public vector and table of the plan, the primitives as bytes.
+/// Every public vector and table of the plan, the primitives (in their runs, as the GPU gets
+/// them) as bytes.
 fn assert_same(serial: &FramePlan, split: &FramePlan, case: &str) {
     assert_eq!(serial.surfaces, split.surfaces, "{case}: surfaces");
-    assert_eq!(
-        bytemuck::cast_slice::<_, u8>(&serial.capture.prims),
-        bytemuck::cast_slice::<_, u8>(&split.capture.prims),
-        "{case}: primitive bytes"
-    );
-    assert_eq!(serial.capture, split.capture, "{case}: capture");
+    let bytes = |p: &FramePlan| -> Vec<u8> {
+        p.prims()
+            .flat_map(|run| bytemuck::cast_slice::<_, u8>(run).to_vec())
+            .collect()
+    };
+    assert_eq!(bytes(serial), bytes(split), "{case}: primitive bytes");
+    assert_eq!(serial.prims_len(), split.prims_len(), "{case}: primitives");
+    let rest = |p: &FramePlan| {
+        let mut c = p.capture.clone();
+        c.prims.clear();
+        c
+    };
+    assert_eq!(rest(serial), rest(split), "{case}: capture");
     assert_eq!(serial.accumulate, split.accumulate, "{case}: accumulate");
     assert_eq!(serial.carries, split.carries, "{case}: carries");
     assert_eq!(serial.relax, split.relax, "{case}: relax");
@@ -278,6 +286,9 @@ fn split_plan_is_the_serial_plan() {
             }
         }
         assert_eq!(split.parts.len(), 4);
+        // Planned serially again, the plan leaves the parts' primitives behind.
+        split.rebuild_split(&settings, &items, |s| *s, Meshes, 1);
+        assert_same(&serial, &split, &format!("seed {seed}, serial after split"));
     }
 }
 
