@@ -40,6 +40,24 @@ pub(crate) fn plan_threads(threads: usize) -> usize {
     })
 }
 
+/// Plan each of `work`'s runs into its plan, this thread the first: half of the runs are handed
+/// to a new thread, which hands on half of its own likewise, and so on, so that the last thread
+/// starts after a few spawns rather than one spawn a thread (tens of microseconds each on the H100's
+/// host).
+fn fan_out<'scope, W: Send + 'scope>(
+    scope: &'scope std::thread::Scope<'scope, '_>,
+    mut work: Vec<W>,
+    plan_run: &'scope (impl Fn(W) + Sync),
+) {
+    while work.len() > 1 {
+        let later = work.split_off(work.len().div_ceil(2));
+        scope.spawn(move || fan_out(scope, later, plan_run));
+    }
+    if let Some(w) = work.pop() {
+        plan_run(w);
+    }
+}
+
 impl FramePlan {
     /// [`FramePlan::rebuild`] of the surfaces that `surface` makes of `items` (skipping those it
     /// gives `None` for), split over up to `threads` threads when there are at least
@@ -63,27 +81,25 @@ impl FramePlan {
         // others each plan one into a part of their own, appended after it.
         let mut parts = std::mem::take(&mut self.parts);
         parts.resize_with(threads - 1, FramePlan::default);
+        for part in &mut parts {
+            part.clear();
+            part.check_short_lists = self.check_short_lists;
+            part.tiles_early = true;
+        }
         let run = items.len().div_ceil(threads);
-        let check = self.check_short_lists;
         let (surface, meshes) = (&surface, &meshes);
-        let plan_run = |plan: &mut FramePlan, run: &'a [T]| {
+        let plan_run = |(plan, run): (&mut FramePlan, &'a [T])| {
             for s in run.iter().filter_map(surface) {
                 plan.plan_surface(settings, &s, meshes);
             }
         };
-        let mut runs = items.chunks(run);
-        let first = runs.next().unwrap_or_default();
-        std::thread::scope(|scope| {
-            for (part, run) in parts.iter_mut().zip(runs) {
-                scope.spawn(move || {
-                    part.clear();
-                    part.check_short_lists = check;
-                    part.tiles_early = true;
-                    plan_run(part, run);
-                });
-            }
-            plan_run(self, first);
-        });
+        let mut work: Vec<(&mut FramePlan, &'a [T])> = Vec::with_capacity(threads);
+        work.push((self, &[]));
+        work.extend(parts.iter_mut().map(|p| (p, &[][..])));
+        for (w, run) in work.iter_mut().zip(items.chunks(run)) {
+            w.1 = run;
+        }
+        std::thread::scope(|scope| fan_out(scope, work, &plan_run));
         self.reserve_for(&parts);
         let mut prims = self.capture.prims.len();
         for part in &mut parts {
