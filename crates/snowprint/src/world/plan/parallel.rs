@@ -1,11 +1,13 @@
-//! A frame of many surfaces planned on several threads: each plans a contiguous run of the
-//! surfaces into a partial plan of its own (the per-surface work: replenishment, culling,
-//! sweeping, the footstep test, the tiles reached), and the runs are then appended in order,
-//! their ranges shifted, before the frame's own work (`FramePlan::finish`). The primitives, most
-//! of a frame's bytes, are not appended: they stay in the parts, after the first run's, and are
-//! written to the GPU from there ([`FramePlan::prims`]), copied once rather than twice. The plan
-//! is the one [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for
-//! byte (`tests.rs`, `split_plan_is_the_serial_plan`).
+//! A frame of many surfaces planned on several threads. The surfaces are cut into contiguous
+//! runs, several a thread ([`RUNS_A_THREAD`]); each thread takes the next run not yet taken and
+//! plans it into a partial plan of its own (the per-surface work: replenishment, culling,
+//! sweeping, the footstep test, the tiles reached), so that a thread slowed by another process
+//! leaves its share to the others. The runs are then appended in order, their ranges shifted,
+//! before the frame's own work (`FramePlan::finish`). The primitives, most of a frame's bytes,
+//! are not appended: they stay in the parts, after the first run's, and are written to the GPU
+//! from there ([`FramePlan::prims`]), copied once rather than twice. The plan is the one
+//! [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for byte
+//! (`tests.rs`, `split_plan_is_the_serial_plan`).
 
 use super::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
 use crate::capture::GpuPrimitive;
@@ -19,6 +21,9 @@ pub(crate) const SPLIT_FROM: usize = 512;
 
 /// Fewest surfaces a thread of a split plan takes.
 pub(crate) const RUN_MIN: usize = 128;
+
+/// Runs a split plan cuts its surfaces into, a thread (runs of [`RUN_MIN`] / 4 surfaces at least).
+pub(crate) const RUNS_A_THREAD: usize = 8;
 
 /// Most threads a plan is split over when the world leaves the count to the machine
 /// ([`crate::WorldConfig::plan_threads`] 0): past it, the serial work of the frame (the appends,
@@ -40,22 +45,21 @@ pub(crate) fn plan_threads(threads: usize) -> usize {
     })
 }
 
-/// Plan each of `work`'s runs into its plan, this thread the first: half of the runs are handed
-/// to a new thread, which hands on half of its own likewise, and so on, so that the last thread
-/// starts after a few spawns rather than one spawn a thread (tens of microseconds each on the H100's
+/// Run `work` on `threads` threads, this one among them: half of the others are started by a
+/// new thread, which starts half of its own likewise, and so on, so that the last thread starts
+/// after a few spawns rather than one spawn a thread (tens of microseconds each on the H100's
 /// host).
-fn fan_out<'scope, W: Send + 'scope>(
+fn fan_out<'scope>(
     scope: &'scope std::thread::Scope<'scope, '_>,
-    mut work: Vec<W>,
-    plan_run: &'scope (impl Fn(W) + Sync),
+    mut threads: usize,
+    work: &'scope (impl Fn() + Sync),
 ) {
-    while work.len() > 1 {
-        let later = work.split_off(work.len().div_ceil(2));
-        scope.spawn(move || fan_out(scope, later, plan_run));
+    while threads > 1 {
+        let later = threads / 2;
+        threads -= later;
+        scope.spawn(move || fan_out(scope, later, work));
     }
-    if let Some(w) = work.pop() {
-        plan_run(w);
-    }
+    work();
 }
 
 impl FramePlan {
@@ -77,29 +81,40 @@ impl FramePlan {
         }
         self.clear();
         self.tiles_early = true;
-        // This thread plans the first run into the plan itself (nothing of it to copy), the
-        // others each plan one into a part of their own, appended after it.
+        // The first run is planned into the plan itself (nothing of it to copy), the others each
+        // into a part of their own, appended after it.
+        let run = items
+            .len()
+            .div_ceil(threads * RUNS_A_THREAD)
+            .max(RUN_MIN / 4);
+        let runs = items.chunks(run);
         let mut parts = std::mem::take(&mut self.parts);
-        parts.resize_with(threads - 1, FramePlan::default);
+        parts.resize_with(runs.len() - 1, FramePlan::default);
         for part in &mut parts {
             part.clear();
             part.check_short_lists = self.check_short_lists;
             part.tiles_early = true;
         }
-        let run = items.len().div_ceil(threads);
         let (surface, meshes) = (&surface, &meshes);
-        let plan_run = |(plan, run): (&mut FramePlan, &'a [T])| {
+        let plan_run = |plan: &mut FramePlan, run: &'a [T]| {
             for s in run.iter().filter_map(surface) {
                 plan.plan_surface(settings, &s, meshes);
             }
         };
-        let mut work: Vec<(&mut FramePlan, &'a [T])> = Vec::with_capacity(threads);
-        work.push((self, &[]));
-        work.extend(parts.iter_mut().map(|p| (p, &[][..])));
-        for (w, run) in work.iter_mut().zip(items.chunks(run)) {
-            w.1 = run;
-        }
-        std::thread::scope(|scope| fan_out(scope, work, &plan_run));
+        let plans = std::iter::once(&mut *self).chain(parts.iter_mut());
+        let work = std::sync::Mutex::new(plans.zip(runs));
+        let next = || {
+            let mut work = work
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            work.next()
+        };
+        let take_runs = || {
+            while let Some((plan, run)) = next() {
+                plan_run(plan, run);
+            }
+        };
+        std::thread::scope(|scope| fan_out(scope, threads, &take_runs));
         self.reserve_for(&parts);
         let mut prims = self.capture.prims.len();
         for part in &mut parts {
