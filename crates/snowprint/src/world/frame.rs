@@ -531,14 +531,16 @@ impl SnowWorld {
         self.tile_list.ensure(device, sizes.tile_list);
         if c.uploads_list_header() {
             // The list's header (its count, the dispatch arguments seal.wgsl writes, the grid's
-            // first record) and the plan's entries; the capture appends after them.
+            // first record) and the plan's entries, written where they lie rather than copied
+            // together first; the capture appends after them.
             let mut header = [0u32; TILE_LIST_HEADER as usize];
             header[3] = c.listed.len() as u32;
             header[TILE_LIST_GRID_FIRST as usize] = c.grid_first;
-            blocks.clear();
-            blocks.extend_from_slice(bytemuck::cast_slice(&header));
-            blocks.extend_from_slice(bytemuck::cast_slice(&c.listed));
-            write_at(&self.tile_list.buffer, 0, blocks);
+            let list = &self.tile_list.buffer;
+            write_at(list, 0, bytemuck::cast_slice(&header));
+            if !c.listed.is_empty() {
+                write_at(list, TILE_LIST_HEADER * 4, bytemuck::cast_slice(&c.listed));
+            }
         }
     }
 
