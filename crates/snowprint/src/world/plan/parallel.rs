@@ -62,6 +62,28 @@ fn fan_out<'scope>(
     work();
 }
 
+/// Run `each` on every item of `work`, on `threads` threads (this one among them), each taking the
+/// next item not yet taken.
+fn in_parallel<W: Send>(
+    threads: usize,
+    work: impl Iterator<Item = W> + Send,
+    each: impl Fn(W) + Sync,
+) {
+    let work = std::sync::Mutex::new(work);
+    let next = || {
+        let mut work = work
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        work.next()
+    };
+    let take = || {
+        while let Some(w) = next() {
+            each(w);
+        }
+    };
+    std::thread::scope(|scope| fan_out(scope, threads, &take));
+}
+
 impl FramePlan {
     /// [`FramePlan::rebuild`] of the surfaces that `surface` makes of `items` (skipping those it
     /// gives `None` for), split over up to `threads` threads when there are at least
@@ -102,19 +124,7 @@ impl FramePlan {
             }
         };
         let plans = std::iter::once(&mut *self).chain(parts.iter_mut());
-        let work = std::sync::Mutex::new(plans.zip(runs));
-        let next = || {
-            let mut work = work
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
-            work.next()
-        };
-        let take_runs = || {
-            while let Some((plan, run)) = next() {
-                plan_run(plan, run);
-            }
-        };
-        std::thread::scope(|scope| fan_out(scope, threads, &take_runs));
+        in_parallel(threads, plans.zip(runs), |(plan, run)| plan_run(plan, run));
         self.reserve_for(&parts);
         let mut prims = self.capture.prims.len();
         for part in &mut parts {
