@@ -36,6 +36,19 @@ pub enum RenderError {
         /// The handle's index.
         index: u32,
     },
+    /// The registered meshes would not fit in one buffer of the device (they share one vertex
+    /// and one index buffer).
+    #[error(
+        "the registered meshes' {what} would take {bytes} bytes, but this device's buffers hold at most {max}: register fewer or smaller meshes"
+    )]
+    MeshesTooLarge {
+        /// `vertices` or `indices`.
+        what: &'static str,
+        /// Bytes they would take with the mesh given.
+        bytes: u64,
+        /// The device's `max_buffer_size`.
+        max: u64,
+    },
     /// The target view given to [`Renderer::render_to_view`](super::Renderer::render_to_view) does not have the configured size.
     #[error(
         "the target is {got:?} pixels but the renderer is configured for {expected:?}; call Renderer::resize first"

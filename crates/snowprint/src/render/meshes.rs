@@ -101,8 +101,12 @@ impl MeshSet {
     }
 
     /// Register a mesh; normals are computed here (smooth, split at creases).
-    pub(super) fn add(&mut self, mesh: &Mesh) -> RenderResult<RenderMeshId> {
+    pub(super) fn add(&mut self, device: &wgpu::Device, mesh: &Mesh) -> RenderResult<RenderMeshId> {
         let gpu = shade(mesh)?;
+        room(
+            self.meshes.iter().chain([&gpu]),
+            device.limits().max_buffer_size,
+        )?;
         self.meshes.push(gpu);
         self.replaced.clear();
         self.uploaded = None;
@@ -111,11 +115,25 @@ impl MeshSet {
     }
 
     /// Replace a registered mesh.
-    pub(super) fn update(&mut self, id: RenderMeshId, mesh: &Mesh) -> RenderResult<()> {
+    pub(super) fn update(
+        &mut self,
+        device: &wgpu::Device,
+        id: RenderMeshId,
+        mesh: &Mesh,
+    ) -> RenderResult<()> {
         let Some(old) = self.meshes.get(id.0 as usize) else {
             return Err(RenderError::StaleMesh { index: id.0 });
         };
         let mut gpu = shade(mesh)?;
+        let others = self
+            .meshes
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != id.0 as usize);
+        room(
+            others.map(|(_, m)| m).chain([&gpu]),
+            device.limits().max_buffer_size,
+        )?;
         let sizes = |m: &GpuMesh| (m.source.0.len(), m.source.1.len());
         if sizes(&gpu) == sizes(old) {
             (gpu.first_index, gpu.base_vertex) = (old.first_index, old.base_vertex);
@@ -318,6 +336,22 @@ fn raw(inst: &Instance) -> InstanceRaw {
     }
 }
 
+/// Whether `meshes` fit the one vertex and one index buffer of a device whose buffers hold at
+/// most `max` bytes.
+fn room<'a>(meshes: impl Iterator<Item = &'a GpuMesh>, max: u64) -> RenderResult<()> {
+    let (mut vertices, mut indices) = (0u64, 0u64);
+    for m in meshes {
+        vertices += std::mem::size_of_val(m.source.0.as_slice()) as u64;
+        indices += std::mem::size_of_val(m.source.1.as_slice()) as u64;
+    }
+    for (what, bytes) in [("vertices", vertices), ("indices", indices)] {
+        if bytes > max {
+            return Err(RenderError::MeshesTooLarge { what, bytes, max });
+        }
+    }
+    Ok(())
+}
+
 fn shade(mesh: &Mesh) -> RenderResult<GpuMesh> {
     mesh.validate("render mesh")?;
     let (vertices, indices) = geometry::shade_normals(mesh, geometry::CREASE_DEGREES);
@@ -328,4 +362,38 @@ fn shade(mesh: &Mesh) -> RenderResult<GpuMesh> {
         radius: mesh.bounding_radius(),
         source: (vertices, indices),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two cubes (24 vertices, split at the creases, and 36 indices each) fit in 48 vertices'
+    /// bytes and no fewer, refused by their vertices; 100 indices alone fit in 400 bytes and no
+    /// fewer, refused by their indices.
+    #[test]
+    fn meshes_past_the_device_s_largest_buffer_are_refused_with_the_bytes() {
+        let cube = shade(&Mesh::cuboid(Vec3::ONE)).expect("cube");
+        let vertex = std::mem::size_of::<MeshVertexRaw>() as u64;
+        assert_eq!((cube.source.0.len(), cube.source.1.len()), (24, 36));
+        let two = [&cube, &cube];
+        assert!(room(two.into_iter(), 48 * vertex).is_ok());
+        match room(two.into_iter(), 48 * vertex - 1) {
+            Err(RenderError::MeshesTooLarge { what, bytes, .. }) => {
+                assert_eq!((what, bytes), ("vertices", 48 * vertex));
+            }
+            other => panic!("expected the vertices refused, got {other:?}"),
+        }
+        // Indices alone past the limit: they are what is refused.
+        let strip = GpuMesh {
+            source: (Vec::new(), vec![0; 100]),
+            ..shade(&Mesh::cuboid(Vec3::ONE)).expect("cube")
+        };
+        let e = room([&strip].into_iter(), 399).unwrap_err().to_string();
+        assert!(
+            e.contains("indices would take 400 bytes") && e.contains("at most 399"),
+            "{e}"
+        );
+        assert!(room([&strip].into_iter(), 400).is_ok());
+    }
 }

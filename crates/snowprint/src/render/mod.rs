@@ -359,12 +359,12 @@ impl Renderer {
 
     /// Register a mesh to draw; normals are computed here (smooth, split at creases).
     pub fn add_mesh(&mut self, mesh: &Mesh) -> RenderResult<RenderMeshId> {
-        self.meshes.add(mesh)
+        self.meshes.add(&self.device, mesh)
     }
 
     /// Replace a registered mesh (an animated one, re-posed).
     pub fn update_mesh(&mut self, id: RenderMeshId, mesh: &Mesh) -> RenderResult<()> {
-        self.meshes.update(id, mesh)
+        self.meshes.update(&self.device, id, mesh)
     }
 
     /// Render a frame offscreen and read it back (waits for the GPU).
