@@ -19,7 +19,8 @@ use crate::capture::GpuPrimitive;
 /// the H100's host").
 pub(crate) const SPLIT_FROM: usize = 512;
 
-/// Fewest surfaces a thread of a split plan takes.
+/// Fewest surfaces a split plan has a thread for: a frame of `n` surfaces is planned on at most
+/// `n / RUN_MIN` threads (each of which may take more or fewer, as the runs come).
 pub(crate) const RUN_MIN: usize = 128;
 
 /// Runs a split plan cuts its surfaces into, a thread (runs of [`RUN_MIN`] / 4 surfaces at least).
