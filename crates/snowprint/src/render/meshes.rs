@@ -44,8 +44,8 @@ pub(super) struct MeshSet {
     /// each validated and tracked as the frame's commands are encoded).
     vertices: Growable,
     indices: Growable,
-    /// The `version` the two buffers hold (`None`: never written), and the meshes replaced since
-    /// by meshes of the same size, written in place (any other change rewrites both whole).
+    /// The `version` the two buffers hold (`None`: every mesh to be laid out and written again),
+    /// and the meshes replaced since by meshes of the same size, to be written in place.
     uploaded: Option<u64>,
     replaced: Vec<u32>,
     instances: Growable,
@@ -108,7 +108,6 @@ impl MeshSet {
             device.limits().max_buffer_size,
         )?;
         self.meshes.push(gpu);
-        self.replaced.clear();
         self.uploaded = None;
         self.version += 1;
         Ok(RenderMeshId(self.meshes.len() as u32 - 1))
@@ -146,42 +145,31 @@ impl MeshSet {
         Ok(())
     }
 
-    /// Bring the two buffers up to the registered meshes: the replaced ones written in place, or
-    /// every mesh laid out again and both buffers written whole.
+    /// Bring the two buffers up to the registered meshes: after an addition or a change of size
+    /// every mesh is laid out again (the buffers grown to hold them) and written, else only the
+    /// replaced ones, in place.
     fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
         if self.uploaded == Some(self.version) {
             return;
         }
-        if self.uploaded.is_some() {
-            for &id in &self.replaced {
-                let m = &self.meshes[id as usize];
-                let vertex = std::mem::size_of::<MeshVertexRaw>() as u64;
-                let at = (m.base_vertex as u64 * vertex, m.first_index as u64 * 4);
-                queue.write_buffer(
-                    &self.vertices.buffer,
-                    at.0,
-                    bytemuck::cast_slice(&m.source.0),
-                );
-                queue.write_buffer(
-                    &self.indices.buffer,
-                    at.1,
-                    bytemuck::cast_slice(&m.source.1),
-                );
-            }
-        } else {
-            let (mut vertices, mut indices) = (Vec::new(), Vec::new());
+        let vertex = std::mem::size_of::<MeshVertexRaw>() as u64;
+        if self.uploaded.is_none() {
+            let (mut vertices, mut indices) = (0, 0);
             for m in &mut self.meshes {
-                (m.first_index, m.base_vertex) = (indices.len() as u32, vertices.len() as u32);
-                vertices.extend_from_slice(&m.source.0);
-                indices.extend_from_slice(&m.source.1);
+                (m.first_index, m.base_vertex) = (indices, vertices);
+                vertices += m.source.0.len() as u32;
+                indices += m.index_count;
             }
-            for (buffer, bytes) in [
-                (&mut self.vertices, bytemuck::cast_slice::<_, u8>(&vertices)),
-                (&mut self.indices, bytemuck::cast_slice(&indices)),
-            ] {
-                buffer.ensure(device, bytes.len() as u64);
-                queue.write_buffer(&buffer.buffer, 0, bytes);
-            }
+            self.vertices.ensure(device, vertices as u64 * vertex);
+            self.indices.ensure(device, indices as u64 * 4);
+            self.replaced = (0..self.meshes.len() as u32).collect();
+        }
+        for &id in &self.replaced {
+            let m = &self.meshes[id as usize];
+            let at = (m.base_vertex as u64 * vertex, m.first_index as u64 * 4);
+            let (vertices, indices) = (&self.vertices.buffer, &self.indices.buffer);
+            queue.write_buffer(vertices, at.0, bytemuck::cast_slice(&m.source.0));
+            queue.write_buffer(indices, at.1, bytemuck::cast_slice(&m.source.1));
         }
         self.replaced.clear();
         self.uploaded = Some(self.version);
