@@ -111,15 +111,29 @@ fn heightfield_case(slope: Option<Vec2>) {
         // The field starts 3 texels into the ground buffer, as a world's second surface might.
         ground: slope.map_or(snowprint::low_level::ground::NO_GROUND, |_| 3),
         wrap: 0,
-        _pad: [0; 3],
+        // The frame's second surface: classify shaded it, and not the first (`state` below).
+        slot: 1,
+        _pad: [0; 2],
         light: [light.x, light.y, light.z, 0.0],
         // Nothing beside it: every side's texels clamp to the edge.
         sides: Default::default(),
     };
-    let params = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("params"),
-        contents: bytemuck::bytes_of(&params),
-        usage: wgpu::BufferUsages::UNIFORM,
+    let uniform = |p: &HeightfieldParams| {
+        dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(p),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    };
+    let unshaded = uniform(&HeightfieldParams { slot: 0, ..params });
+    let params = uniform(&params);
+    let words = snowprint::wgsl::consts::STATE_WORDS as usize;
+    let mut state = vec![0u32; 2 * words];
+    state[words + snowprint::wgsl::consts::STATE_SHADED as usize] = 1;
+    let state = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("state"),
+        contents: bytemuck::cast_slice(&state),
+        usage: wgpu::BufferUsages::STORAGE,
     });
     // The textures hold a border around the heightmap's texels.
     let b = snowprint::wgsl::consts::HEIGHTFIELD_BORDER as u32;
@@ -141,6 +155,7 @@ fn heightfield_case(slope: Option<Vec2>) {
         })
     };
     let (shape, lit) = (texture(), texture());
+    let (bare_shape, bare_lit) = (texture(), texture());
     // `[base, bare]` per texel: the plane at the texel centres (none bare), after 3 texels of
     // another field; a zero texel on flat ground (never read).
     let mut columns = vec![[9.0f32, 0.0]; 3];
@@ -168,34 +183,29 @@ fn heightfield_case(slope: Option<Vec2>) {
         compilation_options: Default::default(),
         cache: None,
     });
-    let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: pool.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: params.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(
-                    &shape.create_view(&Default::default()),
-                ),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::TextureView(&lit.create_view(&Default::default())),
-            },
-            wgpu::BindGroupEntry {
-                binding: 4,
-                resource: ground.as_entire_binding(),
-            },
-        ],
-    });
+    let bind = |params: &wgpu::Buffer, shape: &wgpu::Texture, lit: &wgpu::Texture| {
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (shape, lit) = (view(shape), view(lit));
+        let resources = [
+            pool.as_entire_binding(),
+            params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&shape),
+            wgpu::BindingResource::TextureView(&lit),
+            ground.as_entire_binding(),
+            state.as_entire_binding(),
+        ];
+        let entries: Vec<_> = (0u32..)
+            .zip(resources)
+            .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+            .collect();
+        dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        })
+    };
+    let bg = bind(&params, &shape, &lit);
+    let bare_bg = bind(&unshaded, &bare_shape, &bare_lit);
     let row = (tw * 8).div_ceil(256) * 256;
     let readback = |t: &wgpu::Texture, enc: &mut wgpu::CommandEncoder| {
         let b = dev.create_buffer(&wgpu::BufferDescriptor {
@@ -226,12 +236,26 @@ fn heightfield_case(slope: Option<Vec2>) {
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(tw.div_ceil(8), th.div_ceil(8), 1);
+        for bg in [&bg, &bare_bg] {
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(tw.div_ceil(8), th.div_ceil(8), 1);
+        }
     }
     let (shape_rb, lit_rb) = (readback(&shape, &mut enc), readback(&lit, &mut enc));
+    let bare_rb = [
+        readback(&bare_shape, &mut enc),
+        readback(&bare_lit, &mut enc),
+    ];
     gpu.queue.submit([enc.finish()]);
     let (shape_bytes, lit_bytes) = (read_buffer(&shape_rb), read_buffer(&lit_rb));
+    // A surface classify left unshaded (the first's state) is dispatched all the same, and leaves
+    // its textures as they were.
+    for rb in &bare_rb {
+        assert!(
+            read_buffer(rb).iter().all(|&b| b == 0),
+            "an unshaded surface was written"
+        );
+    }
     // Texel (c, r) of the heightmap, which may lie in the border.
     let texel_at = |bytes: &[u8], c: i32, r: i32| -> [f32; 4] {
         let (c, r) = ((c + b as i32) as u32, (r + b as i32) as u32);

@@ -10,10 +10,9 @@ pub const STATE_WORDS: u64 = crate::wgsl::consts::STATE_WORDS as u64;
 pub const STATE_BASIC_DRAW: u64 = 0;
 /// Offset of the deformable material's indirect draw arguments.
 pub const STATE_DEFORMABLE_DRAW: u64 = 4;
-/// Offset of the heightfield pass's indirect dispatch arguments.
-pub const STATE_HEIGHTFIELD_DISPATCH: u64 = 8;
-/// Offset of the bank passes' indirect dispatch arguments.
-pub const STATE_BANKS_DISPATCH: u64 = 13;
+/// Offset of the flag the heightfield and bank passes run by (1: the surface is shaded this
+/// frame), which they read themselves (`heightfield.wgsl`, `banks.wgsl`).
+pub const STATE_SHADED: u64 = crate::wgsl::consts::STATE_SHADED as u64;
 /// Offset of the "deformed" flag.
 pub const STATE_TOUCHED: u64 = crate::wgsl::consts::STATE_TOUCHED as u64;
 /// Offset of the deepest depression (an f32 fraction of the snow depth, as bits).
@@ -297,15 +296,11 @@ pub struct ClassifyRecord {
     pub always_deformable: u32,
     /// Toroidal storage offsets (`pool::wrapped`).
     pub wrap: u32,
-    /// The texels the bank passes run over: along x in the low 16 bits, along z in the high.
-    pub banks: u32,
-    /// The texels the heightfield pass runs over, likewise.
-    pub heightfield: u32,
     /// 1 when anything of the frame can show the surface (`frame::seen`), else 0: its heightfield
-    /// and bank passes are not dispatched then.
+    /// and bank passes do not run then.
     pub seen: u32,
     /// Padding.
-    pub _pad: [u32; 2],
+    pub _pad: [u32; 4],
 }
 
 /// One surface for the heightfield pass. Must match `HeightfieldParams` in `heightfield.wgsl`.
@@ -331,8 +326,11 @@ pub struct HeightfieldParams {
     pub ground: u32,
     /// Toroidal storage offsets (`pool::wrapped`).
     pub wrap: u32,
-    /// Padding (three members, as in WGSL).
-    pub _pad: [u32; 3],
+    /// The surface's slot in the frame: its words in the surface state table start at
+    /// `slot * STATE_WORDS`.
+    pub slot: u32,
+    /// Padding (two members, as in WGSL).
+    pub _pad: [u32; 2],
     /// Unit direction towards the moon in the surface's local frame; w unused.
     pub light: [f32; 4],
     /// The surfaces beside its sides (local -x, +x, -z, +z), whose texels the pass reads beyond

@@ -620,8 +620,9 @@ impl Renderer {
         self.classify.prepare(device, queue, pool, &surfaces);
         laps.mark("classify");
         let moon = frame.environment.moon_direction;
+        let state = &self.classify.state.buffer;
         self.heightfield
-            .prepare(device, queue, (pool, ground), &surfaces, moon);
+            .prepare(device, queue, (pool, ground, state), &surfaces, moon);
         laps.mark("heightfield");
         self.snow.prepare(
             device,
@@ -638,7 +639,6 @@ impl Renderer {
         );
         laps.mark("snow");
         self.last_surfaces = surfaces.iter().map(|s| s.view.id).collect();
-        let state = &self.classify.state.buffer;
         self.dice.prepare(
             device,
             queue,
@@ -657,7 +657,7 @@ impl Renderer {
             device,
             queue,
             tessellated_tier,
-            (pool, &surfaces),
+            (pool, state, &surfaces),
             &self.heightfield,
         );
         laps.mark("banks");
@@ -730,8 +730,8 @@ impl Renderer {
         let targets = &self.targets;
         match slot {
             pass::CLASSIFY => self.classify.encode(encoder, ts, slot),
-            pass::HEIGHTFIELD => self.heightfield.encode(encoder, ts, slot, state),
-            pass::BANKS => self.banks.encode(encoder, ts, slot, state),
+            pass::HEIGHTFIELD => self.heightfield.encode(encoder, ts, slot),
+            pass::BANKS => self.banks.encode(encoder, ts, slot),
             pass::DICE => self.dice.encode(encoder, ts, slot),
             pass::SHADOW => self
                 .shadow

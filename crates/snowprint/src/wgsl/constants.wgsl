@@ -63,6 +63,9 @@ const HEIGHTFIELD_BORDER: i32 = 2;
 const STATE_WORDS: u32 = 16u;
 // Word of a surface's state holding the "deformed" flag.
 const STATE_TOUCHED: u32 = 11u;
+// Word of a surface's state that is 1 when its heightfield and bank passes are to run this frame
+// (classify.wgsl: it takes the deformable material and the frame can show it), else 0.
+const STATE_SHADED: u32 = 8u;
 // Words of the dicing counters before the per-surface draw arguments.
 const ARGS_BASE: u32 = 8u;
 // Words per surface of the dicing's draw arguments.

@@ -3,9 +3,9 @@
 // gets the basic material; any other the deformable one, and so does every surface on ground that is
 // not flat (the basic material draws a flat top) or with a hole (a coarser terrain window level:
 // the basic material cannot meet the step at the hole's edge). The pass writes, per surface, the
-// indirect draw arguments of both snow pipelines (one of them with zero instances), the indirect
-// dispatches of its heightfield and bank passes (zero workgroups when basic, or when nothing of
-// the frame can show the surface: render/frame/seen.rs), and the flag the report reads.
+// indirect draw arguments of both snow pipelines (one of them with zero instances), whether its
+// heightfield and bank passes run (not when basic, or when nothing of the frame can show the
+// surface: render/frame/seen.rs), and the flag the report reads.
 // Reads: the heightmap pool, the surface list. Writes: the surface state table.
 
 // import texel, constants
@@ -19,11 +19,11 @@ struct ClassifyRecord {
     bits: u32,        // bits a channel (pool/texel.wgsl)
     always_deformable: u32, // 1 on ground that is not flat, or with a hole (ClassifyRecord)
     wrap: u32,        // toroidal storage offsets (pool/texel.wgsl)
-    banks: u32,       // texels the bank passes run over: x | z << 16
-    heightfield: u32, // texels the heightfield pass runs over, likewise
     seen: u32,        // 1 when anything of the frame can show the surface (render/frame/seen.rs)
+    _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+    _pad3: u32,
 }
 
 @group(0) @binding(0) var<storage, read> pool: array<u32>;
@@ -62,16 +62,10 @@ fn classify(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg:
         state[base + 5u] = deformable;
         state[base + 6u] = 0u;
         state[base + 7u] = 0u;
-        // Heightfield dispatch (8 x 8 workgroups over its domain), where the frame shows it.
-        let shaded = deformable == 1u && rec.seen == 1u;
-        state[base + 8u] = select(0u, ((rec.heightfield & 0xffffu) + 7u) / 8u, shaded);
-        state[base + 9u] = ((rec.heightfield >> 16u) + 7u) / 8u;
-        state[base + 10u] = 1u;
+        // Whether the heightfield and bank passes run over it: deformable, where the frame shows
+        // it (they are dispatched over every surface seen, and leave at once where this is 0).
+        state[base + STATE_SHADED] = select(0u, 1u, deformable == 1u && rec.seen == 1u);
         state[base + STATE_TOUCHED] = touched;
         state[base + 12u] = bitcast<u32>(f32(d) / f32(channel_max(rec.bits)));
-        // The bank passes' dispatch (8 x 8 workgroups over their domain).
-        state[base + 13u] = select(0u, ((rec.banks & 0xffffu) + 7u) / 8u, shaded);
-        state[base + 14u] = ((rec.banks >> 16u) + 7u) / 8u;
-        state[base + 15u] = 1u;
     }
 }

@@ -1,18 +1,13 @@
 //! The `classify` pass (compute, `classify.wgsl`): one workgroup per surface reads its heightmap
 //! and writes its state words: whether anything touched it (the basic or the deformable
-//! material), the deepest point, and the indirect arguments of the heightfield and bank
-//! dispatches and of the two snow draws.
+//! material), the deepest point, whether the heightfield and bank passes run over it, and the
+//! indirect arguments of the two snow draws.
 
 use super::frame::FrameSurface;
 use super::gpu::{BOX_VERTICES, ClassifyRecord, STATE_WORDS};
 use super::pipeline;
 use super::readback::{Timestamps, compute_pass};
 use crate::gpu::resources::{Growable, KeptGroups};
-
-/// A domain's size, x in the low 16 bits and z in the high.
-fn packed_size([x0, z0, x1, z1]: [i32; 4]) -> u32 {
-    (x1 - x0) as u32 | ((z1 - z0) as u32) << 16
-}
 
 pub(super) struct ClassifyPass {
     layout: wgpu::BindGroupLayout,
@@ -76,10 +71,8 @@ impl ClassifyPass {
                     s.view.ground != crate::capture::NO_GROUND || s.view.hole.is_some(),
                 ),
                 wrap: s.view.wrap,
-                banks: packed_size(s.bank_domain()),
-                heightfield: packed_size(s.heightfield_domain()),
                 seen: u32::from(s.seen),
-                _pad: [0; 2],
+                _pad: [0; 4],
             })
             .collect();
         if n > 0 {

@@ -93,6 +93,16 @@ impl FrameSurface<'_> {
         ]
     }
 
+    /// The heightfield pass's workgroups (8 x 8 texels each) over [`Self::heightfield_domain`].
+    pub(super) fn heightfield_workgroups(&self) -> (u32, u32) {
+        workgroups(self.heightfield_domain())
+    }
+
+    /// The bank passes' workgroups (8 x 8 texels each) over [`Self::bank_domain`].
+    pub(super) fn bank_workgroups(&self) -> (u32, u32) {
+        workgroups(self.bank_domain())
+    }
+
     /// `by` (texels past -x, +x, -z, +z) where a surface lies beside that side, else 0, as
     /// `[-x, -z, +x, +z]`.
     fn beyond(&self, by: [i32; 4]) -> [i32; 4] {
@@ -344,4 +354,10 @@ pub(super) fn frame_surfaces<'a>(
             })
         })
         .collect()
+}
+
+/// The workgroups of 8 x 8 texels that cover a domain `[x0, z0, x1, z1)`.
+fn workgroups([x0, z0, x1, z1]: [i32; 4]) -> (u32, u32) {
+    let side = |a: i32, b: i32| (b - a).max(0).unsigned_abs().div_ceil(8);
+    (side(x0, x1), side(z0, z1))
 }

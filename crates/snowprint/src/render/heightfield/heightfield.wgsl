@@ -5,14 +5,14 @@
 // binomial filter), and a second texture with the moon's visibility
 // over the snow of each texel (a soft shadow of the prints' walls on their floors, computed once
 // per texel instead of per pixel) in .r and the displaced snow (the pool's high 16 bits, raw) in
-// .g, which the tessellated tier's banks read. Dispatched indirectly: zero workgroups for a surface on the
-// basic material.
+// .g, which the tessellated tier's banks read. Dispatched over every surface the frame can show;
+// a surface on the basic material (classify.wgsl's STATE_SHADED, 0) leaves at once.
 // The textures hold HEIGHTFIELD_BORDER texels more on each side than the heightmap: there, and in
 // every tap that reaches past the surface's edge, the heights are those of the surface linked
 // beside that side (render/heightfield/sides.rs) where there is one, so that two surfaces side by
 // side shade as one; elsewhere the taps clamp to the edge and the border repeats it.
-// Reads: the heightmap pool (this surface's and its neighbours'). Writes: the surface's
-// heightfield and light textures.
+// Reads: the heightmap pool (this surface's and its neighbours'), the surface state table.
+// Writes: the surface's heightfield and light textures.
 // CPU reference: render::cpu::{smoothed_depression, sobel_normal, horizon_ao, light_visibility,
 // displaced_fraction}.
 
@@ -25,6 +25,8 @@
 @group(0) @binding(3) var out_light: texture_storage_2d<rgba16float, write>;
 // The world's ground fields; this surface's starts at `params.ground`.
 @group(0) @binding(4) var<storage, read> ground: array<vec2<f32>>;
+// The surface state table (classify.wgsl); this surface's words start at `params.slot`'s.
+@group(0) @binding(5) var<storage, read> state: array<u32>;
 
 // Must match AO_RADII in cpu.rs (PENUMBRA_*, LIGHT_TAPS and AO_DIRECTIONS: constants.wgsl).
 const AO_RADII: array<f32, 4> = array<f32, 4>(0.04, 0.09, 0.16, 0.28);
@@ -154,6 +156,9 @@ fn held_span(t: i32, size: i32, low: bool, high: bool) -> vec2<i32> {
 // heightfield_domain`): a surface with nothing beside it keeps its grid of workgroups.
 @compute @workgroup_size(8, 8, 1)
 fn heightfield(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if state[params.slot * STATE_WORDS + STATE_SHADED] == 0u {
+        return;
+    }
     let b = HEIGHTFIELD_BORDER;
     let w = i32(params.width);
     let h = i32(params.height);

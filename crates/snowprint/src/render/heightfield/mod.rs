@@ -9,9 +9,7 @@ use glam::Vec3;
 
 use super::error::{RenderError, RenderResult};
 use super::frame::FrameSurface;
-use super::gpu::{
-    HeightfieldParams, HeightfieldSide, STATE_HEIGHTFIELD_DISPATCH, STATE_WORDS, UNIFORM_STRIDE,
-};
+use super::gpu::{HeightfieldParams, HeightfieldSide, UNIFORM_STRIDE};
 use super::pipeline;
 use super::readback::{Timestamps, compute_pass, f16_to_f32, map_staging};
 use super::targets::HEIGHTFIELD_FORMAT;
@@ -132,8 +130,9 @@ pub(super) struct HeightfieldPass {
     params: Growable,
     /// Every surface's textures (kept while its size holds).
     textures: HashMap<SurfaceId, HeightfieldTexture>,
-    /// This frame's bind groups, in surface order, and whether each surface is linked.
-    bind_groups: Vec<(wgpu::BindGroup, bool)>,
+    /// This frame's bind groups, in surface order, whether each surface is linked, and its
+    /// workgroups (none where nothing of the frame shows it).
+    bind_groups: Vec<(wgpu::BindGroup, bool, (u32, u32))>,
     /// The groups by surface slot, kept while what they bind stays.
     kept: KeptGroups,
 }
@@ -179,7 +178,7 @@ impl HeightfieldPass {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        (pool, ground): (&wgpu::Buffer, &wgpu::Buffer),
+        (pool, ground, state): (&wgpu::Buffer, &wgpu::Buffer, &wgpu::Buffer),
         surfaces: &[FrameSurface<'_>],
         moon_direction: Vec3,
     ) {
@@ -198,7 +197,8 @@ impl HeightfieldPass {
                 texel_z: desc.size.y / layout.height as f32,
                 ground: surface.view.ground,
                 wrap: surface.view.wrap,
-                _pad: [0; 3],
+                slot: s as u32,
+                _pad: [0; 2],
                 light: {
                     let l = local_to_world
                         .inverse()
@@ -245,32 +245,39 @@ impl HeightfieldPass {
                     wgpu::BindingResource::TextureView(&tex.shape),
                     wgpu::BindingResource::TextureView(&tex.light),
                     ground.as_entire_binding(),
+                    state.as_entire_binding(),
                 ],
             );
-            self.bind_groups.push((group, linked(surface)));
+            let workgroups = match surface.seen {
+                true => surface.heightfield_workgroups(),
+                false => (0, 0),
+            };
+            self.bind_groups.push((group, linked(surface), workgroups));
         }
     }
 
-    /// One indirect dispatch per surface, its arguments written by `classify` in `state`.
+    /// One dispatch per surface the frame can show, over its domain; a surface that `classify`
+    /// left unshaded (`STATE_SHADED`) leaves at once. Direct dispatches rather than indirect
+    /// ones sized by `classify`: each indirect dispatch costs the CPU a validation dispatch of
+    /// wgpu's, with its barriers, in the encoder's `finish`.
     pub(super) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
         slot: usize,
-        state: &wgpu::Buffer,
     ) {
         let mut p = compute_pass(encoder, ts, slot);
         let mut bound = None;
-        for (s, (bg, linked)) in self.bind_groups.iter().enumerate() {
+        for (bg, linked, (x, z)) in &self.bind_groups {
+            if *x == 0 || *z == 0 {
+                continue;
+            }
             if bound != Some(*linked) {
                 p.set_pipeline(&self.pipelines[usize::from(*linked)]);
                 bound = Some(*linked);
             }
             p.set_bind_group(0, bg, &[]);
-            p.dispatch_workgroups_indirect(
-                state,
-                (s as u64 * STATE_WORDS + STATE_HEIGHTFIELD_DISPATCH) * 4,
-            );
+            p.dispatch_workgroups(*x, *z, 1);
         }
     }
 

@@ -33,7 +33,7 @@ struct HeightfieldParams {
     texel_z: f32,
     ground: u32,        // first texel of the ground field (ground_texel), or NO_GROUND
     wrap: u32,          // toroidal storage offsets (pool/texel.wgsl)
-    _pad0: u32,
+    slot: u32,          // the surface's slot in the frame (its words in the state table)
     _pad1: u32,
     _pad2: u32,
     light: vec4<f32>,   // xyz: unit direction towards the moon in the surface's local frame

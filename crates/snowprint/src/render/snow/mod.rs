@@ -269,7 +269,10 @@ impl SnowPass {
         }
     }
 
-    /// The relief-mapped surfaces (indirect draws of both materials), then the diced ones.
+    /// The relief-mapped surfaces (indirect draws of both materials), then the diced ones. Only
+    /// the render passes that draw are recorded (an empty one costs the CPU its encoding all the
+    /// same): the slot's time spans the first to the last, and a frame that draws no snow records
+    /// the last one empty for its timestamps.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn encode(
         &self,
@@ -284,7 +287,16 @@ impl SnowPass {
     ) {
         let scene = targets.color(wgpu::LoadOp::Load);
         let visible = self.visible.as_ref().zip(targets.snow_visible());
-        {
+        let relief = self.bind_groups.iter().any(Option::is_some);
+        let recorded = [
+            relief,
+            relief && visible.is_some(),
+            dice.any() || (!relief && ts.is_some()),
+        ];
+        let first = recorded.iter().position(|&r| r);
+        let last = recorded.iter().rposition(|&r| r);
+        let span = |k: usize| render_span(ts, slot, first == Some(k), last == Some(k));
+        if recorded[0] {
             // On the visibility path the basic material tells the visibility buffer too.
             let basic_visible = visible.as_ref().zip(targets.snow_basic_visible());
             let (attachments, basic): (&[_], _) = match &basic_visible {
@@ -295,8 +307,7 @@ impl SnowPass {
                 label: Some(PASSES[slot].name),
                 color_attachments: attachments,
                 depth_stencil_attachment: targets.depth(KEEP),
-                // The pass's time spans this render pass and the tessellated one after it.
-                timestamp_writes: render_span(ts, slot, true, false),
+                timestamp_writes: span(0),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -310,17 +321,20 @@ impl SnowPass {
         // On the visibility path the deformable material writes the visibility buffer and its
         // hits, not the scene's colour: a render pass of its own (depth orders it against the
         // basic material's pixels as in one pass: nothing blends).
-        if let Some((v, attachments)) = &visible {
+        if let Some((v, attachments)) = visible.as_ref().filter(|_| recorded[1]) {
             let mut p = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("snow (visibility)"),
                 color_attachments: attachments,
                 depth_stencil_attachment: targets.depth(KEEP),
-                timestamp_writes: None,
+                timestamp_writes: span(1),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
             p.set_bind_group(0, frame, &[]);
             self.draw_deformable(&mut p, state, [&v.deformable_outside, &v.deformable]);
+        }
+        if !recorded[2] {
+            return;
         }
         let attachments: &[_] = match &visible {
             Some((_, attachments)) => attachments,
@@ -330,7 +344,7 @@ impl SnowPass {
             label: Some("snow (tessellated)"),
             color_attachments: attachments,
             depth_stencil_attachment: targets.depth(KEEP),
-            timestamp_writes: render_span(ts, slot, false, true),
+            timestamp_writes: span(2),
             occlusion_query_set: None,
             multiview_mask: None,
         });

@@ -1,7 +1,8 @@
 // banks.wgsl: snow banks (berms) from the displaced-snow channel, the talk's "projected
 // displacement". A fraction of the snow each texel's captures pushed down is moved sideways onto
 // the snow around it, within the bank width, and the rest is compacted. Two passes per deformed
-// surface, both gathers (no atomics):
+// surface (dispatched over every surface seen; where classify.wgsl left it unshaded, every
+// workgroup leaves at once), both gathers (no atomics):
 //   bank_norm:   N(y) = sum over x within the bank width of K(x - y) m(x), how much room for banks
 //                there is around texel y. m(x) = receptivity: 1 on untouched snow, fading to a
 //                floor of RECEPTIVITY_FLOOR at the bottom of trails (snow is pushed onto the snow
@@ -17,7 +18,7 @@
 // over the surface and the border of HEIGHTFIELD_BORDER texels that the bank texture holds around
 // the heightmap's, as the heightfield textures do (past a side with nothing linked, the edge
 // repeated: the edge texel's invocation stores it).
-// Reads: the surface's heightfield textures (heightfield.wgsl: smoothed depression in .x, the
+// Reads: the surface state table, the surface's heightfield textures (heightfield.wgsl: smoothed depression in .x, the
 // displaced channel in the light texture's .g; texel p at p + HEIGHTFIELD_BORDER), past their
 // border the pool (this surface's neighbours). Writes: the bank scratch (N over the domain, texel
 // p at p - domain.xy) and the bank texture (metres of snow added, .x, p at p + HEIGHTFIELD_BORDER).
@@ -50,6 +51,8 @@ struct BankParams {
 // What heightfield_texels.wgsl reads: the pool and this surface's heightfield parameters.
 @group(0) @binding(5) var<storage, read> pool: array<u32>;
 @group(0) @binding(6) var<uniform> params: HeightfieldParams;
+// The surface state table (classify.wgsl); this surface's words start at `params.slot`'s.
+@group(0) @binding(7) var<storage, read> state: array<u32>;
 
 // Whether texel p holds snow (`held`) and is within the domain, where N is: a source of banks.
 fn inside(c: i32, r: i32) -> bool {
@@ -116,6 +119,17 @@ var<workgroup> tile_a: array<f32, TILE_TEXELS>;
 var<workgroup> tile_b: array<f32, TILE_TEXELS>;
 // Whether any texel within the reach of this workgroup's texels had snow displaced.
 var<workgroup> displaced_near: atomic<u32>;
+var<workgroup> shaded: u32;
+
+// Whether the passes run over the surface this frame (classify.wgsl's STATE_SHADED): they are
+// dispatched over every surface seen, and a workgroup of one left unshaded leaves at once. Called
+// by every invocation, in uniform control flow; the result is uniform.
+fn runs(lane: u32) -> bool {
+    if lane == 0u {
+        shaded = state[params.slot * STATE_WORDS + STATE_SHADED];
+    }
+    return workgroupUniformLoad(&shaded) != 0u;
+}
 
 // A workgroup's neighbourhood: its first texel less the reach, and its side.
 struct Neighbourhood {
@@ -143,6 +157,9 @@ fn bank_norm(
     @builtin(workgroup_id) group: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
+    if !runs(lane) {
+        return;
+    }
     let hood = neighbourhood(group);
     if hood.tiled {
         for (var k = i32(lane); k < hood.span.x * hood.span.y; k += 64) {
@@ -223,6 +240,9 @@ fn bank_gather(
     // The workgroup first reads the displaced snow within reach of its texels (and the room for
     // banks there), each lane a share: where none was displaced, every bank here is 0 (most of a
     // surface, away from its trails), and the gather's taps are skipped.
+    if !runs(lane) {
+        return;
+    }
     let hood = neighbourhood(group);
     for (var k = i32(lane); k < hood.span.x * hood.span.y; k += 64) {
         let p = hood.origin + vec2<i32>(k % hood.span.x, k / hood.span.x);

@@ -1,13 +1,14 @@
-//! The `banks` pass (compute, indirect, `banks.wgsl`): a share of the snow each diced surface's
-//! captures pushed down rises in banks beside the trails, on it and on the surfaces beside it. Two
-//! dispatches per deformed surface (indirect, `classify` writes them) over its texels and a band
-//! around it (`FrameSurface::bank_domain`): `bank_norm` spreads each texel's share into the
-//! scratch texture, `bank_gather` collects it into the bank heights.
+//! The `banks` pass (compute, `banks.wgsl`): a share of the snow each diced surface's captures
+//! pushed down rises in banks beside the trails, on it and on the surfaces beside it. Two
+//! dispatches per surface seen over its texels and a band around it
+//! (`FrameSurface::bank_domain`), which leave at once where `classify` left the surface unshaded:
+//! `bank_norm` spreads each texel's share into the scratch texture, `bank_gather` collects it
+//! into the bank heights.
 
 use super::BankParams;
 use crate::gpu::resources::{Growable, KeptGroups, uniform_block};
 use crate::render::frame::FrameSurface;
-use crate::render::gpu::{STATE_BANKS_DISPATCH, STATE_WORDS, UNIFORM_STRIDE};
+use crate::render::gpu::UNIFORM_STRIDE;
 use crate::render::heightfield::{HeightfieldPass, linked, linked_pipelines};
 use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_pass};
@@ -19,9 +20,9 @@ pub(in crate::render) struct BanksPass {
     pipelines: [[wgpu::ComputePipeline; 2]; 2],
     /// Per surface: `BankParams` in a uniform block.
     params: Growable,
-    /// This frame's bind groups (norm, gather) per surface and whether it is linked; `None` where
-    /// it draws no banks.
-    bind_groups: Vec<Option<([wgpu::BindGroup; 2], bool)>>,
+    /// This frame's bind groups (norm, gather) per surface, whether it is linked, and its
+    /// workgroups; `None` where it draws no banks or nothing of the frame shows it.
+    bind_groups: Vec<Option<([wgpu::BindGroup; 2], bool, (u32, u32))>>,
     /// The groups by surface slot (norm at `2 s`, gather at `2 s + 1`), kept while what they
     /// bind stays.
     kept: KeptGroups,
@@ -56,7 +57,7 @@ impl BanksPass {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         active: bool,
-        (pool, surfaces): (&wgpu::Buffer, &[FrameSurface<'_>]),
+        (pool, state, surfaces): (&wgpu::Buffer, &wgpu::Buffer, &[FrameSurface<'_>]),
         heightfields: &HeightfieldPass,
     ) {
         self.bind_groups.clear();
@@ -99,7 +100,7 @@ impl BanksPass {
             .iter()
             .enumerate()
             .map(|(s, surface)| {
-                if !banked(surface) {
+                if !banked(surface) || !surface.seen {
                     return None;
                 }
                 let tex = heightfields.texture(surface.view.id)?;
@@ -119,6 +120,7 @@ impl BanksPass {
                         tv(&tex.bank_scratch),
                         texels[0].clone(),
                         texels[1].clone(),
+                        state.as_entire_binding(),
                     ],
                 );
                 let gather = kept.get(
@@ -134,36 +136,32 @@ impl BanksPass {
                         tv(&tex.bank),
                         texels[0].clone(),
                         texels[1].clone(),
+                        state.as_entire_binding(),
                     ],
                 );
-                Some(([norm, gather], linked(surface)))
+                Some(([norm, gather], linked(surface), surface.bank_workgroups()))
             })
             .collect();
     }
 
-    /// Both bank passes run over the deformed surfaces only (their dispatch from `classify`).
+    /// Both bank passes over the surfaces seen that draw banks (direct dispatches, as the
+    /// heightfield pass's: the deformed ones among them do the work).
     pub(crate) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         ts: Option<&Timestamps>,
         slot: usize,
-        state: &wgpu::Buffer,
     ) {
         let mut p = compute_pass(encoder, ts, slot);
         for (step, pipelines) in self.pipelines.iter().enumerate() {
             let mut bound = None;
-            for (s, groups) in self.bind_groups.iter().enumerate() {
-                if let Some((groups, linked)) = groups {
-                    if bound != Some(*linked) {
-                        p.set_pipeline(&pipelines[usize::from(*linked)]);
-                        bound = Some(*linked);
-                    }
-                    p.set_bind_group(0, &groups[step], &[]);
-                    p.dispatch_workgroups_indirect(
-                        state,
-                        (s as u64 * STATE_WORDS + STATE_BANKS_DISPATCH) * 4,
-                    );
+            for (groups, linked, (x, z)) in self.bind_groups.iter().flatten() {
+                if bound != Some(*linked) {
+                    p.set_pipeline(&pipelines[usize::from(*linked)]);
+                    bound = Some(*linked);
                 }
+                p.set_bind_group(0, &groups[step], &[]);
+                p.dispatch_workgroups(*x, *z, 1);
             }
         }
     }
