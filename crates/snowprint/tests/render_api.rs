@@ -502,6 +502,60 @@ fn kept_bind_groups_follow_grown_buffers_and_reordered_surfaces() {
     }
 }
 
+/// The passes keep a table the CPU wrote while the next frame's is the same, byte for byte: a
+/// frame whose tables change but not their sizes (the surfaces in another order, an instance
+/// moved) draws what a fresh renderer draws.
+#[test]
+fn tables_kept_between_frames_are_written_again_when_they_change() {
+    let gpu = common::gpu();
+    let mut world = world();
+    let ids: Vec<_> = [[-0.7, 0.0, 0.0], [0.7, 0.0, 0.0]]
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let desc = SurfaceDesc::new(&format!("s{i}"), c, [1.2, 1.2], 0.2);
+            world.add_surface(desc).unwrap()
+        })
+        .collect();
+    // Prints in different places, so that each surface's tables are its own.
+    let presses = [[-0.9, 0.1, 0.2], [0.6, 0.1, -0.3]]
+        .map(|at| Deformer::new(Shape::Sphere { radius: 0.2 }, Pose::at(at)));
+    world.step(1.0 / 30.0, &presses).unwrap();
+    let concrete = |id| (id, GroundMaterial::Concrete);
+    let (first, second) = (
+        [concrete(ids[0]), concrete(ids[1])],
+        [concrete(ids[1]), concrete(ids[0])],
+    );
+    let cube = Mesh::cuboid(Vec3::splat(0.2));
+    let at = |mesh, x: f32| {
+        let place = Mat4::from_translation(Vec3::new(x, 0.5, 0.0));
+        [Instance::new(mesh, place, [0.7, 0.5, 0.3])]
+    };
+    for tier in [Tier::Relief, Tier::Tessellated] {
+        let mut kept = Renderer::new(gpu, small(tier)).unwrap();
+        let mesh = kept.add_mesh(&cube).unwrap();
+        let before = kept
+            .render(&world, &frame(&first, &at(mesh, -0.5)))
+            .unwrap()
+            .rgba8;
+        let again = kept
+            .render(&world, &frame(&second, &at(mesh, 0.5)))
+            .unwrap()
+            .rgba8;
+        let mut fresh = Renderer::new(gpu, small(tier)).unwrap();
+        let mesh = fresh.add_mesh(&cube).unwrap();
+        let expected = fresh
+            .render(&world, &frame(&second, &at(mesh, 0.5)))
+            .unwrap()
+            .rgba8;
+        assert!(
+            expected != before,
+            "{tier:?}: the second frame changes nothing"
+        );
+        assert!(again == expected, "{tier:?}: the running renderer differs");
+    }
+}
+
 /// The meshes live in one vertex and one index buffer: a mesh replaced by one of its own size is
 /// written in place, by one of another size (or a mesh added) every mesh is laid out again. Either
 /// way the frame is the one a renderer given the new meshes from the start draws, on both opaque

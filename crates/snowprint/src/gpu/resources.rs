@@ -7,6 +7,8 @@ pub(crate) struct Growable {
     pub buffer: wgpu::Buffer,
     usage: wgpu::BufferUsages,
     label: &'static str,
+    /// What [`Growable::write_whole`] last wrote at the start of this buffer, while it holds it.
+    written: Option<Vec<u8>>,
 }
 
 impl Growable {
@@ -27,7 +29,23 @@ impl Growable {
             buffer,
             usage,
             label,
+            written: None,
         }
+    }
+
+    /// Write `bytes` at the start of the buffer, unless it holds them already: the last
+    /// `write_whole` wrote the same bytes to this buffer (not replaced since). Each write costs
+    /// wgpu a staging buffer of its own and a copy at the next submission, and a frame's tables
+    /// are often the last frame's. Only for a buffer that nothing else writes (no other
+    /// `queue.write_buffer`, no pass).
+    pub(crate) fn write_whole(&mut self, queue: &wgpu::Queue, bytes: &[u8]) {
+        if self.written.as_deref() == Some(bytes) {
+            return;
+        }
+        queue.write_buffer(&self.buffer, 0, bytes);
+        let written = self.written.get_or_insert_with(Vec::new);
+        written.clear();
+        written.extend_from_slice(bytes);
     }
 
     /// Make sure the buffer holds at least `size` bytes: the next power of two, but no more than

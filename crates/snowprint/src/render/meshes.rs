@@ -249,7 +249,8 @@ impl MeshSet {
         if !instances.is_empty() {
             self.instances
                 .ensure(device, std::mem::size_of_val(instances.as_slice()) as u64);
-            queue.write_buffer(&self.instances.buffer, 0, bytemuck::cast_slice(&instances));
+            self.instances
+                .write_whole(queue, bytemuck::cast_slice(&instances));
         }
     }
 

@@ -78,7 +78,8 @@ impl ClassifyPass {
         if n > 0 {
             self.records
                 .ensure(device, (n * std::mem::size_of::<ClassifyRecord>()) as u64);
-            queue.write_buffer(&self.records.buffer, 0, bytemuck::cast_slice(&records));
+            self.records
+                .write_whole(queue, bytemuck::cast_slice(&records));
         }
         self.state.ensure(device, n.max(1) as u64 * STATE_WORDS * 4);
         self.surfaces = n as u32;

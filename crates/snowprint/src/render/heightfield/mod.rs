@@ -212,7 +212,7 @@ impl HeightfieldPass {
                 .copy_from_slice(bytemuck::bytes_of(&p));
         }
         self.params.ensure(device, bytes.len() as u64);
-        queue.write_buffer(&self.params.buffer, 0, &bytes);
+        self.params.write_whole(queue, &bytes);
         for s in surfaces {
             let size = (s.view.layout.width, s.view.layout.height);
             let [x0, z0, x1, z1] = s.bank_domain();

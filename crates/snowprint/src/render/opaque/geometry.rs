@@ -35,7 +35,7 @@ impl MeshGeometry {
         let bytes: &[u8] = bytemuck::cast_slice(&table);
         if !bytes.is_empty() {
             self.instance_meshes.ensure(device, bytes.len() as u64);
-            queue.write_buffer(&self.instance_meshes.buffer, 0, bytes);
+            self.instance_meshes.write_whole(queue, bytes);
         }
     }
 

@@ -192,7 +192,7 @@ impl SnowPass {
                 .copy_from_slice(bytemuck::bytes_of(&u));
         }
         self.uniforms.ensure(device, bytes.len() as u64);
-        queue.write_buffer(&self.uniforms.buffer, 0, &bytes);
+        self.uniforms.write_whole(queue, &bytes);
         self.kept.truncate(surfaces.len());
         let (kept, layout) = (&mut self.kept, &self.layout);
         self.bind_groups = surfaces

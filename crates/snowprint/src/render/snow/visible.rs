@@ -167,7 +167,7 @@ impl VisiblePath {
         }
         let bytes: &[u8] = bytemuck::cast_slice(&rects);
         self.rects.ensure(device, bytes.len() as u64);
-        queue.write_buffer(&self.rects.buffer, 0, bytes);
+        self.rects.write_whole(queue, bytes);
         self.current = Some(self.kept.get(
             device,
             "snow shade targets",

@@ -92,7 +92,7 @@ impl BanksPass {
                 .copy_from_slice(bytemuck::bytes_of(&bank));
         }
         self.params.ensure(device, bytes.len() as u64);
-        queue.write_buffer(&self.params.buffer, 0, &bytes);
+        self.params.write_whole(queue, &bytes);
         let tv = wgpu::BindingResource::TextureView;
         self.kept.truncate(2 * surfaces.len());
         let (kept, layout) = (&mut self.kept, &self.layout);

@@ -184,7 +184,7 @@ impl DicePass {
                 .copy_from_slice(bytemuck::bytes_of(&dice));
         }
         self.params.ensure(device, bytes.len() as u64);
-        queue.write_buffer(&self.params.buffer, 0, &bytes);
+        self.params.write_whole(queue, &bytes);
         let tv = wgpu::BindingResource::TextureView;
         self.kept.truncate(n);
         for (s, surface) in surfaces.iter().enumerate() {
