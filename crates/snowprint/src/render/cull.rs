@@ -45,14 +45,12 @@ pub(crate) fn bounding_sphere(transform: Mat4, radius: f32) -> (Vec3, f32) {
     (transform.w_axis.truncate(), radius * scale)
 }
 
-/// Which instances (each a transform and its mesh's bounding radius) the view may see.
-pub(crate) fn visible(view_proj: Mat4, instances: impl Iterator<Item = (Mat4, f32)>) -> Vec<bool> {
+/// Which instances (each bounded by a sphere, [`bounding_sphere`]) the view may see.
+pub(crate) fn visible(view_proj: Mat4, spheres: &[(Vec3, f32)]) -> Vec<bool> {
     let frustum = Frustum::from_view_proj(view_proj);
-    instances
-        .map(|(t, r)| {
-            let (c, r) = bounding_sphere(t, r);
-            frustum.sphere_visible(c, r)
-        })
+    spheres
+        .iter()
+        .map(|&(c, r)| frustum.sphere_visible(c, r))
         .collect()
 }
 
@@ -117,17 +115,7 @@ mod tests {
                 Vec3::new(0.0, y, -10.0),
             )
         };
-        assert_eq!(
-            visible(
-                camera(),
-                [
-                    (tall(15.0), 1.0),
-                    (tall(16.0), 1.0),
-                    (at(0.0, 0.0, -5.0), 1.0)
-                ]
-                .into_iter()
-            ),
-            vec![true, false, true]
-        );
+        let spheres = [tall(15.0), tall(16.0), at(0.0, 0.0, -5.0)].map(|t| bounding_sphere(t, 1.0));
+        assert_eq!(visible(camera(), &spheres), vec![true, false, true]);
     }
 }

@@ -194,13 +194,15 @@ impl MeshSet {
         (cascades, shadow_size): ([glam::Mat4; 2], u32),
     ) {
         self.upload(device, queue);
-        let bounds = || {
-            frame
-                .iter()
-                .map(|i| (i.transform, self.meshes[i.mesh.0 as usize].radius))
-        };
-        let visible = cull::visible(view_proj, bounds());
-        let in_cascade = cascades.map(|m| cull::visible(m, bounds()));
+        // Each instance's bounding sphere and its form for the GPU, once for the view and both
+        // cascades.
+        let spheres: Vec<_> = frame
+            .iter()
+            .map(|i| cull::bounding_sphere(i.transform, self.meshes[i.mesh.0 as usize].radius))
+            .collect();
+        let raws: Vec<InstanceRaw> = frame.iter().map(raw).collect();
+        let visible = cull::visible(view_proj, &spheres);
+        let in_cascade = cascades.map(|m| cull::visible(m, &spheres));
         let mut order: Vec<usize> = (0..frame.len()).collect();
         order.sort_by_key(|&i| frame[i].mesh.0);
         let casters = in_cascade.map(|inside| {
@@ -213,7 +215,7 @@ impl MeshSet {
         order.retain(|&i| visible[i]);
         self.culled = frame.len() - order.len();
         self.cascade_casters = casters.each_ref().map(Vec::len);
-        let mut instances: Vec<InstanceRaw> = order.iter().map(|&i| raw(&frame[i])).collect();
+        let mut instances: Vec<InstanceRaw> = order.iter().map(|&i| raws[i]).collect();
         let runs = |ids: &[usize], first: usize| {
             let mut out: Vec<Run> = Vec::new();
             for (k, &i) in ids.iter().enumerate() {
@@ -236,14 +238,13 @@ impl MeshSet {
             self.moving_rects[cascade] = moving
                 .iter()
                 .filter_map(|&i| {
-                    let radius = self.meshes[frame[i].mesh.0 as usize].radius;
-                    let (at, radius) = cull::bounding_sphere(frame[i].transform, radius);
+                    let (at, radius) = spheres[i];
                     sphere_rect(cascades[cascade], at, radius, shadow_size)
                 })
                 .collect();
             for (k, ids) in [still, moving].iter().enumerate() {
                 self.shadow_draws[cascade][k] = runs(ids, instances.len());
-                instances.extend(ids.iter().map(|&i| raw(&frame[i])));
+                instances.extend(ids.iter().map(|&i| raws[i]));
             }
         }
         if !instances.is_empty() {
