@@ -525,6 +525,25 @@ fn nested_report_folders_are_created_and_an_unused_camera_is_named() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An adapter whose backend cannot translate the renderer's shaders (wgpu's GL backend cannot load
+/// from a depth texture) gives an error and a non-zero exit, not a panic, and no demo output.
+#[test]
+fn an_adapter_that_cannot_build_the_renderer_is_an_error() {
+    let _serial = serial();
+    let dir = scratch("gl");
+    let out = snowprint()
+        .env("WGPU_BACKEND", "gl")
+        .args(["demo", "--frames", "1", "--size", "64x36", "--out"])
+        .arg(&dir)
+        .output()
+        .expect("run snowprint");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!dir.join("report.json").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Item 7: a scene file over the limit is refused before it is parsed.
 #[test]
 fn a_huge_scene_is_refused_before_parsing() {

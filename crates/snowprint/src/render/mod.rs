@@ -190,9 +190,11 @@ impl Renderer {
         crate::gpu::check_device(&gpu.device)?;
         let device = gpu.device.clone();
         config.validate(&device)?;
-        // Pipelines are checked by naga in the tests; a driver that still refuses one is reported
-        // as an error rather than wgpu's default panic.
+        // Pipelines are checked by naga in the tests; a driver that still refuses one, or a backend
+        // that cannot translate a shader (wgpu's GL backend: an internal error), is reported as an
+        // error rather than wgpu's default panic.
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
         let filterable = gpu.caps.filterable_rgba16f;
         let layouts = FrameLayouts::new(&device, filterable);
         let mesh_module = opaque::mesh_module(&device);
@@ -250,7 +252,9 @@ impl Renderer {
             device,
             config,
         };
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        let internal = pollster::block_on(internal.pop());
+        let validation = pollster::block_on(scope.pop());
+        if let Some(e) = internal.or(validation) {
             return Err(RenderError::Gpu(e));
         }
         Ok(renderer)
