@@ -13,6 +13,16 @@ use crate::render::heightfield::{HeightfieldPass, linked, linked_pipelines};
 use crate::render::pipeline;
 use crate::render::readback::{Timestamps, compute_pass};
 
+/// A surface's dispatches of both bank passes.
+struct SurfaceBanks {
+    /// The groups of `bank_norm` and `bank_gather`.
+    groups: [wgpu::BindGroup; 2],
+    /// Whether a surface lies beside a side (the linked pipelines).
+    linked: bool,
+    /// Workgroups over its domain (`FrameSurface::bank_workgroups`).
+    workgroups: (u32, u32),
+}
+
 pub(in crate::render) struct BanksPass {
     layout: wgpu::BindGroupLayout,
     /// `bank_norm` and `bank_gather`, each for surfaces with nothing beside them and with a
@@ -22,7 +32,7 @@ pub(in crate::render) struct BanksPass {
     params: Growable,
     /// This frame's bind groups (norm, gather) per surface, whether it is linked, and its
     /// workgroups; `None` where it draws no banks or nothing of the frame shows it.
-    bind_groups: Vec<Option<([wgpu::BindGroup; 2], bool, (u32, u32))>>,
+    bind_groups: Vec<Option<SurfaceBanks>>,
     /// The groups by surface slot (norm at `2 s`, gather at `2 s + 1`), kept while what they
     /// bind stays.
     kept: KeptGroups,
@@ -139,7 +149,11 @@ impl BanksPass {
                         state.as_entire_binding(),
                     ],
                 );
-                Some(([norm, gather], linked(surface), surface.bank_workgroups()))
+                Some(SurfaceBanks {
+                    groups: [norm, gather],
+                    linked: linked(surface),
+                    workgroups: surface.bank_workgroups(),
+                })
             })
             .collect();
     }
@@ -155,13 +169,13 @@ impl BanksPass {
         let mut p = compute_pass(encoder, ts, slot);
         for (step, pipelines) in self.pipelines.iter().enumerate() {
             let mut bound = None;
-            for (groups, linked, (x, z)) in self.bind_groups.iter().flatten() {
-                if bound != Some(*linked) {
-                    p.set_pipeline(&pipelines[usize::from(*linked)]);
-                    bound = Some(*linked);
+            for s in self.bind_groups.iter().flatten() {
+                if bound != Some(s.linked) {
+                    p.set_pipeline(&pipelines[usize::from(s.linked)]);
+                    bound = Some(s.linked);
                 }
-                p.set_bind_group(0, &groups[step], &[]);
-                p.dispatch_workgroups(*x, *z, 1);
+                p.set_bind_group(0, &s.groups[step], &[]);
+                p.dispatch_workgroups(s.workgroups.0, s.workgroups.1, 1);
             }
         }
     }
