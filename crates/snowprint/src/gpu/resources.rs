@@ -33,12 +33,13 @@ impl Growable {
         }
     }
 
-    /// Write `bytes` at the start of the buffer, unless it holds them already: the last
-    /// `write_whole` wrote the same bytes to this buffer (not replaced since). Each write costs
-    /// wgpu a staging buffer of its own and a copy at the next submission, and a frame's tables
-    /// are often the last frame's. Only for a buffer that nothing else writes (no other
-    /// `queue.write_buffer`, no pass).
-    pub(crate) fn write_whole(&mut self, queue: &wgpu::Queue, bytes: &[u8]) {
+    /// Grow the buffer to hold `bytes` ([`Growable::ensure`]) and write them at its start, unless
+    /// it holds them already: the last `write_whole` wrote the same bytes to this buffer (not
+    /// replaced since). Each write costs wgpu a staging buffer of its own and a copy at the next
+    /// submission, and a frame's tables are often the last frame's. Only for a buffer that nothing
+    /// else writes (no other `queue.write_buffer`, no pass).
+    pub(crate) fn write_whole(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, bytes: &[u8]) {
+        self.ensure(device, bytes.len() as u64);
         if self.written.as_deref() == Some(bytes) {
             return;
         }

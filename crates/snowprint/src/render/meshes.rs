@@ -249,9 +249,7 @@ impl MeshSet {
         }
         if !instances.is_empty() {
             self.instances
-                .ensure(device, std::mem::size_of_val(instances.as_slice()) as u64);
-            self.instances
-                .write_whole(queue, bytemuck::cast_slice(&instances));
+                .write_whole(device, queue, bytemuck::cast_slice(&instances));
         }
     }
 

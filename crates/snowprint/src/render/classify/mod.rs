@@ -77,9 +77,7 @@ impl ClassifyPass {
             .collect();
         if n > 0 {
             self.records
-                .ensure(device, (n * std::mem::size_of::<ClassifyRecord>()) as u64);
-            self.records
-                .write_whole(queue, bytemuck::cast_slice(&records));
+                .write_whole(device, queue, bytemuck::cast_slice(&records));
         }
         self.state.ensure(device, n.max(1) as u64 * STATE_WORDS * 4);
         self.surfaces = n as u32;

@@ -130,8 +130,8 @@ pub(super) struct HeightfieldPass {
     params: Growable,
     /// Every surface's textures (kept while its size holds).
     textures: HashMap<SurfaceId, HeightfieldTexture>,
-    /// This frame's bind groups, in surface order, whether each surface is linked, and its
-    /// workgroups (none where nothing of the frame shows it).
+    /// This frame's bind groups of the surfaces it shows, in surface order, whether each is
+    /// linked, and its workgroups.
     bind_groups: Vec<(wgpu::BindGroup, bool, (u32, u32))>,
     /// The groups by surface slot, kept while what they bind stays.
     kept: KeptGroups,
@@ -211,8 +211,7 @@ impl HeightfieldPass {
             bytes[s * stride..s * stride + std::mem::size_of::<HeightfieldParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&p));
         }
-        self.params.ensure(device, bytes.len() as u64);
-        self.params.write_whole(queue, &bytes);
+        self.params.write_whole(device, queue, &bytes);
         for s in surfaces {
             let size = (s.view.layout.width, s.view.layout.height);
             let [x0, z0, x1, z1] = s.bank_domain();
@@ -228,7 +227,8 @@ impl HeightfieldPass {
         }
         self.kept.truncate(surfaces.len());
         self.bind_groups.clear();
-        for (s, surface) in surfaces.iter().enumerate() {
+        // A surface nothing of the frame shows is not dispatched (as the banks').
+        for (s, surface) in surfaces.iter().enumerate().filter(|(_, s)| s.seen) {
             let tex = &self.textures[&surface.view.id];
             let group = self.kept.get(
                 device,
@@ -248,10 +248,7 @@ impl HeightfieldPass {
                     state.as_entire_binding(),
                 ],
             );
-            let workgroups = match surface.seen {
-                true => surface.heightfield_workgroups(),
-                false => (0, 0),
-            };
+            let workgroups = surface.heightfield_workgroups();
             self.bind_groups.push((group, linked(surface), workgroups));
         }
     }
@@ -269,9 +266,6 @@ impl HeightfieldPass {
         let mut p = compute_pass(encoder, ts, slot);
         let mut bound = None;
         for (bg, linked, (x, z)) in &self.bind_groups {
-            if *x == 0 || *z == 0 {
-                continue;
-            }
             if bound != Some(*linked) {
                 p.set_pipeline(&self.pipelines[usize::from(*linked)]);
                 bound = Some(*linked);

@@ -34,8 +34,7 @@ impl MeshGeometry {
             .collect();
         let bytes: &[u8] = bytemuck::cast_slice(&table);
         if !bytes.is_empty() {
-            self.instance_meshes.ensure(device, bytes.len() as u64);
-            self.instance_meshes.write_whole(queue, bytes);
+            self.instance_meshes.write_whole(device, queue, bytes);
         }
     }
 

@@ -81,8 +81,7 @@ impl Restore {
         }
         if !clip.is_empty() {
             self.rects
-                .ensure(device, std::mem::size_of_val(clip.as_slice()) as u64);
-            self.rects.write_whole(queue, bytemuck::cast_slice(&clip));
+                .write_whole(device, queue, bytemuck::cast_slice(&clip));
         }
         let (kept, layout, rects) = (&mut self.kept, &self.layout, &self.rects);
         self.groups = [0, 1].map(|c| {

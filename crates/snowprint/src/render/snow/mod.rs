@@ -191,8 +191,7 @@ impl SnowPass {
             bytes[s * stride..s * stride + std::mem::size_of::<SurfaceUniform>()]
                 .copy_from_slice(bytemuck::bytes_of(&u));
         }
-        self.uniforms.ensure(device, bytes.len() as u64);
-        self.uniforms.write_whole(queue, &bytes);
+        self.uniforms.write_whole(device, queue, &bytes);
         self.kept.truncate(surfaces.len());
         let (kept, layout) = (&mut self.kept, &self.layout);
         self.bind_groups = surfaces

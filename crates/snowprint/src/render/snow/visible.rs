@@ -166,8 +166,7 @@ impl VisiblePath {
             }));
         }
         let bytes: &[u8] = bytemuck::cast_slice(&rects);
-        self.rects.ensure(device, bytes.len() as u64);
-        self.rects.write_whole(queue, bytes);
+        self.rects.write_whole(device, queue, bytes);
         self.current = Some(self.kept.get(
             device,
             "snow shade targets",

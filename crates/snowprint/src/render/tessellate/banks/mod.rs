@@ -101,8 +101,7 @@ impl BanksPass {
             bytes[s * stride..s * stride + std::mem::size_of::<BankParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&bank));
         }
-        self.params.ensure(device, bytes.len() as u64);
-        self.params.write_whole(queue, &bytes);
+        self.params.write_whole(device, queue, &bytes);
         let tv = wgpu::BindingResource::TextureView;
         self.kept.truncate(2 * surfaces.len());
         let (kept, layout) = (&mut self.kept, &self.layout);

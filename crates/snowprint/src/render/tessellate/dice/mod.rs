@@ -183,8 +183,7 @@ impl DicePass {
             bytes[s * stride..s * stride + std::mem::size_of::<DiceParams>()]
                 .copy_from_slice(bytemuck::bytes_of(&dice));
         }
-        self.params.ensure(device, bytes.len() as u64);
-        self.params.write_whole(queue, &bytes);
+        self.params.write_whole(device, queue, &bytes);
         let tv = wgpu::BindingResource::TextureView;
         self.kept.truncate(n);
         for (s, surface) in surfaces.iter().enumerate() {
