@@ -207,3 +207,51 @@ pub(crate) fn write_in_order(
     });
     enc.copy_buffer_to_buffer(&staging, 0, target, offset, bytes.len() as u64);
 }
+
+/// Write `runs`, one after the other, into `target` from its start, as one write: with
+/// `queue.write_buffer_with` when `enc` is `None`, else through one staging buffer copied in
+/// `enc`'s order ([`write_in_order`]). Each write costs wgpu a staging buffer of its own; a split
+/// frame plan's primitives come as one run a part, tens of them (`world/plan/parallel.rs`).
+/// `total` is the runs' length together, a multiple of 4 bytes (`wgpu::COPY_BUFFER_ALIGNMENT`).
+pub(crate) fn write_runs<'a>(
+    (device, queue): (&wgpu::Device, &wgpu::Queue),
+    enc: Option<&mut wgpu::CommandEncoder>,
+    target: &wgpu::Buffer,
+    total: u64,
+    runs: impl Iterator<Item = &'a [u8]>,
+) {
+    let Some(size) = wgpu::BufferSize::new(total) else {
+        return;
+    };
+    let fill = |mut to: wgpu::WriteOnly<'_, [u8]>| {
+        for run in runs {
+            // Runs longer than `total` together are cut short (the caller's sum is theirs).
+            let Ok((mut head, rest)) = to.split_at_checked(run.len()) else {
+                return;
+            };
+            head.copy_from_slice(run);
+            to = rest;
+        }
+    };
+    match enc {
+        None => {
+            // `None` only where wgpu reports a validation error of its own (an error scope sees it).
+            if let Some(mut view) = queue.write_buffer_with(target, 0, size) {
+                fill(view.slice(..));
+            }
+        }
+        Some(enc) => {
+            let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("in-order write"),
+                size: total,
+                usage: wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: true,
+            });
+            if let Ok(mut view) = staging.get_mapped_range_mut(..) {
+                fill(view.slice(..));
+            }
+            staging.unmap();
+            enc.copy_buffer_to_buffer(&staging, 0, target, 0, total);
+        }
+    }
+}

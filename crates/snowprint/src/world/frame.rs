@@ -9,10 +9,10 @@ use super::nearby::INDEX_FROM;
 use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface, plan_threads};
 use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
 use crate::accumulate::{self, AccumulateBuffers};
-use crate::capture::{self, CaptureBuffers, CaptureMesh};
+use crate::capture::{self, CaptureBuffers, CaptureMesh, GpuPrimitive};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
-use crate::gpu::resources::UNIFORM_STRIDE;
+use crate::gpu::resources::{UNIFORM_STRIDE, write_runs};
 use crate::gpu::timestamps::StageQueries;
 use crate::mesh::MeshId;
 use crate::pool::{SurfaceRecord, TILE_LIST_HEADER};
@@ -500,15 +500,6 @@ impl SnowWorld {
         }
         self.views.ensure(device, sizes.views);
         write_at(&self.views.buffer, 0, blocks);
-        if sizes.prims > 0 {
-            // Run by run, where each was planned (a split plan's parts are not appended).
-            self.prims.ensure(device, sizes.prims);
-            let mut at = 0;
-            for run in plan.prims().filter(|run| !run.is_empty()) {
-                write_at(&self.prims.buffer, at, bytemuck::cast_slice(run));
-                at += std::mem::size_of_val(run) as u64;
-            }
-        }
         if !c.draws.is_empty() {
             uniform_blocks(blocks, &c.draws, 0);
             self.draws.ensure(device, sizes.draws);
@@ -541,6 +532,15 @@ impl SnowWorld {
             if !c.listed.is_empty() {
                 write_at(list, TILE_LIST_HEADER * 4, bytemuck::cast_slice(&c.listed));
             }
+        }
+        if sizes.prims > 0 {
+            // Run by run from where each was planned (a split plan's parts are not appended), in
+            // one write.
+            self.prims.ensure(device, sizes.prims);
+            let runs = plan.prims().map(bytemuck::cast_slice);
+            let total = std::mem::size_of::<GpuPrimitive>() * plan.prims_len();
+            let enc = enc.as_deref_mut();
+            write_runs((device, queue), enc, &self.prims.buffer, total as u64, runs);
         }
     }
 
