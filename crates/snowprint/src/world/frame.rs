@@ -539,7 +539,6 @@ impl SnowWorld {
             self.prims.ensure(device, sizes.prims);
             let runs = plan.prims().map(bytemuck::cast_slice);
             let total = std::mem::size_of::<GpuPrimitive>() * plan.prims_len();
-            let enc = enc.as_deref_mut();
             write_runs((device, queue), enc, &self.prims.buffer, total as u64, runs);
         }
     }

@@ -270,6 +270,8 @@ pub struct FramePlan {
     /// Partial plans of contiguous runs of surfaces, planned on threads of their own and then
     /// appended in order (`parallel.rs`); kept for their memory.
     parts: Vec<FramePlan>,
+    /// The threads the parts are planned on, kept between frames.
+    planners: parallel::Planners,
     /// Whether the parts' primitives follow this plan's (a split plan): they are not appended,
     /// but written to the GPU from where they were planned ([`FramePlan::prims`]).
     prims_in_parts: bool,

@@ -2,7 +2,8 @@
 //! runs, several a thread ([`RUNS_A_THREAD`]); each thread takes the next run not yet taken and
 //! plans it into a partial plan of its own (the per-surface work: replenishment, culling,
 //! sweeping, the footstep test, the tiles reached), so that a thread slowed by another process
-//! leaves its share to the others. The runs are then appended in order, their ranges shifted,
+//! leaves its share to the others. The threads are kept, parked, from frame to frame
+//! ([`Planners`]). The runs are then appended in order, their ranges shifted,
 //! before the frame's own work (`FramePlan::finish`). The primitives, most of a frame's bytes,
 //! are not appended: they stay in the parts, after the first run's, and are written to the GPU
 //! from there ([`FramePlan::prims`]), copied once rather than twice. The plan is the one
@@ -63,9 +64,40 @@ fn fan_out<'scope>(
     work();
 }
 
-/// Run `each` on every item of `work`, on `threads` threads (this one among them), each taking the
-/// next item not yet taken.
+/// The threads a split plan runs on, kept from frame to frame: a pool of `threads - 1` parked
+/// workers (the calling thread is the last), made at the first frame that splits over `threads`
+/// and again when the count changes. Waking a parked thread costs a fraction of starting one: on
+/// the H100's host, 4096 surfaces planned on 8 threads took 2.5 to 2.8 ms a frame with the pool
+/// against 3.1 to 3.8 ms with threads started each frame, 1024 surfaces 0.7 against 1.3 to 1.5
+/// (`docs/PERFORMANCE.md`, "Plan threads kept between frames"). Without a pool (one could not be
+/// made) the threads are started for the frame, as scoped threads.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Planners {
+    pool: Option<(usize, std::sync::Arc<rayon::ThreadPool>)>,
+}
+
+impl Planners {
+    /// The pool for `threads` threads (`None`: start them for this frame).
+    fn pool(&mut self, threads: usize) -> Option<&rayon::ThreadPool> {
+        if threads < 2 {
+            return None;
+        }
+        if self.pool.as_ref().is_none_or(|(n, _)| *n != threads) {
+            self.pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads - 1)
+                .thread_name(|i| format!("snowprint plan {i}"))
+                .build()
+                .ok()
+                .map(|pool| (threads, std::sync::Arc::new(pool)));
+        }
+        self.pool.as_ref().map(|(_, pool)| &**pool)
+    }
+}
+
+/// Run `each` on every item of `work`, on `threads` threads (this one among them; the others
+/// `planners`'), each taking the next item not yet taken.
 fn in_parallel<W: Send>(
+    planners: &mut Planners,
     threads: usize,
     work: impl Iterator<Item = W> + Send,
     each: impl Fn(W) + Sync,
@@ -82,7 +114,15 @@ fn in_parallel<W: Send>(
             each(w);
         }
     };
-    std::thread::scope(|scope| fan_out(scope, threads, &take));
+    match planners.pool(threads) {
+        Some(pool) => pool.in_place_scope(|scope| {
+            for _ in 1..threads {
+                scope.spawn(|_| take());
+            }
+            take();
+        }),
+        None => std::thread::scope(|scope| fan_out(scope, threads, &take)),
+    }
 }
 
 impl FramePlan {
@@ -124,8 +164,11 @@ impl FramePlan {
                 plan.plan_surface(settings, &s, meshes);
             }
         };
+        let mut planners = std::mem::take(&mut self.planners);
         let plans = std::iter::once(&mut *self).chain(parts.iter_mut());
-        in_parallel(threads, plans.zip(runs), |(plan, run)| plan_run(plan, run));
+        let each = |(plan, run)| plan_run(plan, run);
+        in_parallel(&mut planners, threads, plans.zip(runs), each);
+        self.planners = planners;
         self.reserve_for(&parts);
         let mut prims = self.capture.prims.len();
         for part in &mut parts {
