@@ -6,13 +6,16 @@
 use std::time::Instant;
 
 use super::nearby::INDEX_FROM;
-use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface, plan_threads};
-use super::{FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceUpdate};
+use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface, PrimsTarget, plan_threads};
+use super::{
+    FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceState,
+    SurfaceUpdate, WorldConfig,
+};
 use crate::accumulate::{self, AccumulateBuffers};
 use crate::capture::{self, CaptureBuffers, CaptureMesh, GpuPrimitive};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
-use crate::gpu::resources::{UNIFORM_STRIDE, write_runs};
+use crate::gpu::resources::{Growable, UNIFORM_STRIDE, write_runs};
 use crate::gpu::timestamps::StageQueries;
 use crate::mesh::MeshId;
 use crate::pool::{SurfaceRecord, TILE_LIST_HEADER};
@@ -225,7 +228,23 @@ impl SnowWorld {
         let planned = checked.is_ok() && !layers.is_empty();
         if planned {
             first.check_short_lists = true;
-            self.plan_into(&mut first, layers[0]);
+            // A split plan copies its primitives straight into the staging memory of the
+            // frame's first write.
+            let mut staging = PrimsStaging {
+                device: &self.device,
+                queue: &self.queue,
+                buffer: &mut self.prims,
+                view: None,
+            };
+            let inputs = PlanInputs {
+                config: &self.config,
+                surfaces: &self.surfaces,
+                meshes: WorldMeshes {
+                    capture: &self.meshes,
+                    vertices: &self.probes.mesh_vertices,
+                },
+            };
+            inputs.plan(&mut first, layers[0], Some(&mut staging));
             first.check_short_lists = false;
         }
         if checked.is_err() || (planned && first.refused) {
@@ -441,36 +460,15 @@ impl SnowWorld {
 
     /// The frame's plan, from the surfaces' state and the (validated) updates.
     fn plan_into<'a>(&'a self, plan: &mut FramePlan, updates: &'a [SurfaceUpdate<'a>]) {
-        let format = self.config.format;
-        let states = &self.surfaces;
-        let surface = |u: &'a SurfaceUpdate<'a>| -> Option<PlanSurface<'a>> {
-            let index = u.surface.0 as usize;
-            let s = states.get(index)?.as_ref()?;
-            Some(PlanSurface {
-                index,
-                id: u.surface,
-                desc: &s.desc,
-                layout: s.layout,
-                heights_word: s.slot.heights_word(),
-                wrap: s.wrap,
-                normals_word: s
-                    .slot
-                    .normals_word(&format, s.layout.width, s.layout.height),
-                carry: s.carry,
-                elapsed: u.elapsed,
-                deformers: u.deformers,
-                settle: s.settle,
-                ground: s.ground.as_ref().map(|g| g.plan()),
-                ground_field: s.ground.as_ref().map(|g| &g.field),
-            })
+        let inputs = PlanInputs {
+            config: &self.config,
+            surfaces: &self.surfaces,
+            meshes: WorldMeshes {
+                capture: &self.meshes,
+                vertices: &self.probes.mesh_vertices,
+            },
         };
-        let meshes = WorldMeshes {
-            capture: &self.meshes,
-            vertices: &self.probes.mesh_vertices,
-        };
-        let settings = PlanSettings::of(&self.config);
-        let threads = plan_threads(self.config.plan_threads);
-        plan.rebuild_split(&settings, updates, surface, meshes, threads);
+        inputs.plan(plan, updates, None);
     }
 
     /// Grow the per-frame buffers the plan needs and write its tables: with `queue.write_buffer`
@@ -533,7 +531,7 @@ impl SnowWorld {
                 write_at(list, TILE_LIST_HEADER * 4, bytemuck::cast_slice(&c.listed));
             }
         }
-        if sizes.prims > 0 {
+        if sizes.prims > 0 && !plan.prims_written {
             // Run by run from where each was planned (a split plan's parts are not appended), in
             // one write.
             self.prims.ensure(device, sizes.prims);
@@ -618,6 +616,82 @@ impl SnowWorld {
         );
     }
 }
+
+/// What a frame's plan reads of the world, borrowed field by field (so that the world's
+/// primitives buffer can be borrowed beside it, [`PrimsStaging`]).
+struct PlanInputs<'a> {
+    config: &'a WorldConfig,
+    surfaces: &'a [Option<SurfaceState>],
+    meshes: WorldMeshes<'a>,
+}
+
+impl<'a> PlanInputs<'a> {
+    /// Plan `updates` into `plan` (on the world's threads when they are many); a split plan's
+    /// primitives go to `prims` when given.
+    fn plan(
+        self,
+        plan: &mut FramePlan,
+        updates: &'a [SurfaceUpdate<'a>],
+        prims: Option<&mut dyn PrimsTarget>,
+    ) {
+        let format = self.config.format;
+        let states = self.surfaces;
+        let surface = |u: &'a SurfaceUpdate<'a>| -> Option<PlanSurface<'a>> {
+            let index = u.surface.0 as usize;
+            let s = states.get(index)?.as_ref()?;
+            Some(PlanSurface {
+                index,
+                id: u.surface,
+                desc: &s.desc,
+                layout: s.layout,
+                heights_word: s.slot.heights_word(),
+                wrap: s.wrap,
+                normals_word: s
+                    .slot
+                    .normals_word(&format, s.layout.width, s.layout.height),
+                carry: s.carry,
+                elapsed: u.elapsed,
+                deformers: u.deformers,
+                settle: s.settle,
+                ground: s.ground.as_ref().map(|g| g.plan()),
+                ground_field: s.ground.as_ref().map(|g| &g.field),
+            })
+        };
+        let settings = PlanSettings::of(self.config);
+        let threads = plan_threads(self.config.plan_threads);
+        plan.rebuild_split(&settings, updates, surface, self.meshes, (threads, prims));
+    }
+}
+
+/// The world's primitives buffer, grown to what a split plan asks and opened for it with
+/// `queue.write_buffer_with`: the plan's threads copy their primitives into the staging memory,
+/// which lands in the buffer at the next submission (as `queue.write_buffer`'s would).
+struct PrimsStaging<'w> {
+    device: &'w wgpu::Device,
+    queue: &'w wgpu::Queue,
+    buffer: &'w mut Growable,
+    view: Option<wgpu::QueueWriteBufferView>,
+}
+
+impl PrimsTarget for PrimsStaging<'_> {
+    fn open(&mut self, bytes: usize) -> Option<wgpu::WriteOnly<'_, [u8]>> {
+        let size = wgpu::BufferSize::new(bytes as u64)?;
+        // More than the device binds: the world refuses the frame once it is planned
+        // (`check_sizes`), and nothing is written.
+        let limits = self.device.limits();
+        if size.get()
+            > limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size)
+        {
+            return None;
+        }
+        self.buffer.ensure(self.device, size.get());
+        self.view = self.queue.write_buffer_with(&self.buffer.buffer, 0, size);
+        self.view.as_mut().map(|v| v.slice(..))
+    }
+}
+
 /// The world's meshes as its plan sees them: their capture radius and the CPU copy of their
 /// vertices the footstep test reads, both by mesh index.
 struct WorldMeshes<'a> {

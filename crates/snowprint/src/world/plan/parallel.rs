@@ -3,15 +3,23 @@
 //! plans it into a partial plan of its own (the per-surface work: replenishment, culling,
 //! sweeping, the footstep test, the tiles reached), so that a thread slowed by another process
 //! leaves its share to the others. The threads are kept, parked, from frame to frame
-//! ([`Planners`]). The runs are then appended in order, their ranges shifted,
-//! before the frame's own work (`FramePlan::finish`). The primitives, most of a frame's bytes,
-//! are not appended: they stay in the parts, after the first run's, and are written to the GPU
-//! from there ([`FramePlan::prims`]), copied once rather than twice. The plan is the one
+//! ([`Planners`]). The runs are then gathered on the threads too, each part's vectors copied to
+//! their place in the plan's, their ranges shifted ([`FramePlan::gather`]), before the frame's own
+//! work (`FramePlan::finish`). The primitives, most of a frame's bytes, are not appended: they
+//! stay in the parts, after the first run's, and are copied from there straight into the GPU's
+//! staging memory when the caller gives it ([`PrimsTarget`]), in the same gathering, else written
+//! to the GPU from the parts ([`FramePlan::prims`]); either way copied once rather than twice. The
+//! plan is the one
 //! [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for byte
 //! (`tests.rs`, `split_plan_is_the_serial_plan`).
 
-use super::{FramePlan, PlanMeshes, PlanSettings, PlanSurface};
-use crate::capture::GpuPrimitive;
+use wgpu::WriteOnly;
+
+use super::{FramePlan, Job, PlanMeshes, PlanSettings, PlanSurface};
+use crate::capture::{GpuPrimitive, MeshDraw};
+use crate::mesh::MeshId;
+use crate::relax::Settle;
+use crate::world::Footstep;
 
 /// Fewest surfaces in a frame from which its plan is split over threads: below it, starting the
 /// threads costs more than the work they share (tens of microseconds, against about a microsecond
@@ -47,11 +55,10 @@ pub(crate) fn plan_threads(threads: usize) -> usize {
     })
 }
 
-/// Run `work` on `threads` threads, this one among them: half of the others are started by a
-/// new thread, which starts half of its own likewise, and so on, so that the last thread starts
-/// after a few spawns rather than one spawn a thread (tens of microseconds each on the H100's
-/// host).
-fn fan_out<'scope>(
+/// Start `threads - 1` threads running `work` besides this one: half of them by a new thread,
+/// which starts half of its own likewise, and so on, so that the last thread starts after a few
+/// spawns rather than one spawn a thread (tens of microseconds each on the H100's host).
+fn start_others<'scope>(
     scope: &'scope std::thread::Scope<'scope, '_>,
     mut threads: usize,
     work: &'scope (impl Fn() + Sync),
@@ -59,9 +66,11 @@ fn fan_out<'scope>(
     while threads > 1 {
         let later = threads / 2;
         threads -= later;
-        scope.spawn(move || fan_out(scope, later, work));
+        scope.spawn(move || {
+            start_others(scope, later, work);
+            work();
+        });
     }
-    work();
 }
 
 /// The threads a split plan runs on, kept from frame to frame: a pool of `threads - 1` parked
@@ -95,12 +104,14 @@ impl Planners {
 }
 
 /// Run `each` on every item of `work`, on `threads` threads (this one among them; the others
-/// `planners`'), each taking the next item not yet taken.
+/// `planners`'), each taking the next item not yet taken; this thread runs `first` before it takes
+/// any.
 fn in_parallel<W: Send>(
     planners: &mut Planners,
     threads: usize,
     work: impl Iterator<Item = W> + Send,
     each: impl Fn(W) + Sync,
+    first: impl FnOnce(),
 ) {
     let work = std::sync::Mutex::new(work);
     let next = || {
@@ -119,23 +130,29 @@ fn in_parallel<W: Send>(
             for _ in 1..threads {
                 scope.spawn(|_| take());
             }
+            first();
             take();
         }),
-        None => std::thread::scope(|scope| fan_out(scope, threads, &take)),
+        None => std::thread::scope(|scope| {
+            start_others(scope, threads, &take);
+            first();
+            take();
+        }),
     }
 }
 
 impl FramePlan {
     /// [`FramePlan::rebuild`] of the surfaces that `surface` makes of `items` (skipping those it
     /// gives `None` for), split over up to `threads` threads when there are at least
-    /// [`SPLIT_FROM`] items: the same plan, made sooner.
+    /// [`SPLIT_FROM`] items: the same plan, made sooner. A split plan's primitives go to
+    /// `prims` when it opens memory for them ([`FramePlan::prims_written`]).
     pub(crate) fn rebuild_split<'a, T: Sync>(
         &mut self,
         settings: &PlanSettings,
         items: &'a [T],
         surface: impl Fn(&'a T) -> Option<PlanSurface<'a>> + Sync,
         meshes: impl PlanMeshes + Sync,
-        threads: usize,
+        (threads, prims): (usize, Option<&mut dyn PrimsTarget>),
     ) {
         let threads = threads.min(items.len() / RUN_MIN).max(1);
         if threads == 1 || items.len() < SPLIT_FROM {
@@ -167,14 +184,17 @@ impl FramePlan {
         let mut planners = std::mem::take(&mut self.planners);
         let plans = std::iter::once(&mut *self).chain(parts.iter_mut());
         let each = |(plan, run)| plan_run(plan, run);
-        in_parallel(&mut planners, threads, plans.zip(runs), each);
+        in_parallel(&mut planners, threads, plans.zip(runs), each, || ());
+        let bytes = std::mem::size_of::<GpuPrimitive>();
+        let total = (self.capture.prims.len()
+            + parts.iter().map(|p| p.capture.prims.len()).sum::<usize>())
+            * bytes;
+        let out = prims
+            .and_then(|p| p.open(total))
+            .filter(|o| o.len() == total);
+        self.prims_written = out.is_some();
+        self.gather(&mut planners, &parts, threads, out);
         self.planners = planners;
-        self.reserve_for(&parts);
-        let mut prims = self.capture.prims.len();
-        for part in &mut parts {
-            self.append(part, prims);
-            prims += part.capture.prims.len();
-        }
         self.parts = parts;
         self.prims_in_parts = true;
         self.finish(settings);
@@ -196,40 +216,130 @@ impl FramePlan {
         self.prims().map(<[GpuPrimitive]>::len).sum()
     }
 
-    /// Make room for the parts' vectors at once (rather than growing as they are appended).
-    fn reserve_for(&mut self, parts: &[FramePlan]) {
-        let total = |f: fn(&FramePlan) -> usize| parts.iter().map(f).sum::<usize>();
-        let c = &mut self.capture;
-        c.draws.reserve(total(|p| p.capture.draws.len()));
-        c.draw_meshes
-            .reserve(total(|p| p.capture.draw_meshes.len()));
-        self.reached.reserve(total(|p| p.reached.len()));
-        self.carries.reserve(total(|p| p.carries.len()));
-        self.settles.reserve(total(|p| p.settles.len()));
-        self.footsteps.reserve(total(|p| p.footsteps.len()));
-        self.jobs.reserve(total(|p| p.jobs.len()));
+    /// Append the partial plans of the surfaces after this plan's, as if they had been planned
+    /// here, on up to `threads` threads, a part at a time: their jobs' ranges of primitives, draws
+    /// and tiles shifted past the runs' before them. `prims`, when given, receives every run's
+    /// primitives, this plan's first (they stay where they were planned, too), copied by this
+    /// thread while the others append: wgpu's staging memory cannot be handed to another thread.
+    fn gather(
+        &mut self,
+        planners: &mut Planners,
+        parts: &[FramePlan],
+        threads: usize,
+        prims: Option<WriteOnly<'_, [u8]>>,
+    ) {
+        let own = &self.capture.prims;
+        let copy_prims = move || {
+            if let Some(mut out) = prims {
+                let runs = std::iter::once(own).chain(parts.iter().map(|p| &p.capture.prims));
+                for run in runs {
+                    let bytes: &[u8] = bytemuck::cast_slice(run);
+                    let (mut head, rest) = out.split_at(bytes.len());
+                    head.copy_from_slice(bytes);
+                    out = rest;
+                }
+            }
+        };
+        let mut shift = [own.len(), self.capture.draws.len(), self.reached.len()];
+        let c = (&mut self.capture.draws, &mut self.capture.draw_meshes);
+        let mut jobs = pieces(&mut self.jobs, parts, |p| &p.jobs).into_iter();
+        let mut draws = pieces(c.0, parts, |p| &p.capture.draws).into_iter();
+        let mut meshes = pieces(c.1, parts, |p| &p.capture.draw_meshes).into_iter();
+        let mut reached = pieces(&mut self.reached, parts, |p| &p.reached).into_iter();
+        let mut carries = pieces(&mut self.carries, parts, |p| &p.carries).into_iter();
+        let mut settles = pieces(&mut self.settles, parts, |p| &p.settles).into_iter();
+        let mut footsteps = pieces(&mut self.footsteps, parts, |p| &p.footsteps).into_iter();
+        let mut work = Vec::with_capacity(parts.len());
+        for part in parts {
+            let dest = Dest {
+                jobs: jobs.next().unwrap_or_default(),
+                draws: draws.next().unwrap_or_default(),
+                draw_meshes: meshes.next().unwrap_or_default(),
+                reached: reached.next().unwrap_or_default(),
+                carries: carries.next().unwrap_or_default(),
+                settles: settles.next().unwrap_or_default(),
+                footsteps: footsteps.next().unwrap_or_default(),
+                shift: shift.map(|n| n as u32),
+            };
+            work.push((part, dest));
+            shift[0] += part.capture.prims.len();
+            shift[1] += part.capture.draws.len();
+            shift[2] += part.reached.len();
+            self.refused |= part.refused;
+        }
+        // The same threads as the planning (a pool of another size would be made anew).
+        in_parallel(
+            planners,
+            threads,
+            work.into_iter(),
+            |(part, dest)| dest.fill(part),
+            copy_prims,
+        );
     }
+}
 
-    /// Append a partial plan of the surfaces after this plan's, as if they had been planned
-    /// here: its jobs' ranges of draws and tiles shifted past this plan's, and of primitives past
-    /// the `prims` of the runs before it (which stay where they were planned).
-    fn append(&mut self, part: &mut FramePlan, prims: usize) {
-        let shift = |r: &std::ops::Range<u32>, by: usize| r.start + by as u32..r.end + by as u32;
-        let c = &mut self.capture;
-        let (draws, tiles) = (c.draws.len(), self.reached.len());
-        c.draws.extend_from_slice(&part.capture.draws);
-        c.draw_meshes.extend_from_slice(&part.capture.draw_meshes);
-        self.reached.extend_from_slice(&part.reached);
-        self.carries.extend_from_slice(&part.carries);
-        self.settles.extend_from_slice(&part.settles);
-        self.footsteps.extend_from_slice(&part.footsteps);
-        self.jobs.extend(part.jobs.drain(..).map(|mut job| {
-            job.prims = shift(&job.prims, prims);
-            job.draws = shift(&job.draws, draws);
-            job.tiles = shift(&job.tiles, tiles);
-            job
-        }));
-        self.refused |= part.refused;
+/// Memory for a split plan's primitives, opened once every run is planned (the GPU's staging
+/// memory for the frame's primitives buffer: `queue.write_buffer_with`).
+pub(crate) trait PrimsTarget {
+    /// `bytes` bytes to fill with the frame's primitives, or `None` (they are then written from
+    /// the parts, [`FramePlan::prims`]).
+    fn open(&mut self, bytes: usize) -> Option<WriteOnly<'_, [u8]>>;
+}
+
+/// The pieces of `v`, grown past its length by every part's elements (`of` a part), in the
+/// parts' order: where [`FramePlan::gather`] copies each part's. The new elements hold a copy of
+/// one of the parts' until then.
+fn pieces<'d, T: Clone>(
+    v: &'d mut Vec<T>,
+    parts: &[FramePlan],
+    of: impl Fn(&FramePlan) -> &[T],
+) -> Vec<&'d mut [T]> {
+    let start = v.len();
+    if let Some(fill) = parts.iter().find_map(|p| of(p).first()) {
+        let total = parts.iter().map(|p| of(p).len()).sum::<usize>();
+        v.resize(start + total, fill.clone());
+    }
+    let mut rest = &mut v[start..];
+    parts
+        .iter()
+        .map(|p| {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(of(p).len());
+            rest = tail;
+            head
+        })
+        .collect()
+}
+
+/// Where one part's vectors go in the plan's ([`FramePlan::gather`]), and how far its jobs'
+/// ranges of primitives, draws and tiles shift.
+struct Dest<'d> {
+    jobs: &'d mut [Job],
+    draws: &'d mut [MeshDraw],
+    draw_meshes: &'d mut [MeshId],
+    reached: &'d mut [[u32; 2]],
+    carries: &'d mut [(usize, f64)],
+    settles: &'d mut [(usize, Settle)],
+    footsteps: &'d mut [Footstep],
+    shift: [u32; 3],
+}
+
+impl Dest<'_> {
+    /// Copy `part`'s vectors here, its jobs' ranges shifted.
+    fn fill(self, part: &FramePlan) {
+        let shifted = |r: &std::ops::Range<u32>, by: u32| r.start + by..r.end + by;
+        let [prims, draws, tiles] = self.shift;
+        for (to, job) in self.jobs.iter_mut().zip(&part.jobs) {
+            to.clone_from(job);
+            to.prims = shifted(&job.prims, prims);
+            to.draws = shifted(&job.draws, draws);
+            to.tiles = shifted(&job.tiles, tiles);
+        }
+        self.draws.copy_from_slice(&part.capture.draws);
+        self.draw_meshes.copy_from_slice(&part.capture.draw_meshes);
+        self.reached.copy_from_slice(&part.reached);
+        self.carries.copy_from_slice(&part.carries);
+        self.settles.copy_from_slice(&part.settles);
+        self.footsteps.copy_from_slice(&part.footsteps);
     }
 }
 

@@ -3,10 +3,11 @@
 use glam::{Quat, Vec3};
 
 use super::super::*;
-use super::{AUTO_THREADS_MAX, RUN_MIN, SPLIT_FROM};
+use super::{AUTO_THREADS_MAX, PrimsTarget, RUN_MIN, SPLIT_FROM};
 use crate::deformer::{Pose, Shape};
 use crate::ground::{GroundField, SlopeRule};
 use crate::material::Material;
+use wgpu::WriteOnly;
 
 /// A small deterministic generator (xorshift), so that a failure is reproduced by its seed.
 struct Rng(u64);
@@ -238,6 +239,26 @@ fn assert_same(serial: &FramePlan, split: &FramePlan, case: &str) {
     assert!(tables.0 == tables.1, "{case}: written tables");
 }
 
+/// Memory for the primitives, as the world's staging opens it (filled with a byte no plan
+/// writes whole, so that a primitive left out shows).
+struct Staging(Vec<u8>);
+
+impl PrimsTarget for Staging {
+    fn open(&mut self, bytes: usize) -> Option<WriteOnly<'_, [u8]>> {
+        self.0 = vec![0xa5; bytes];
+        Some(WriteOnly::from(&mut self.0[..]))
+    }
+}
+
+/// Memory the caller cannot open: the primitives stay in the parts, to be written from there.
+struct NoStaging;
+
+impl PrimsTarget for NoStaging {
+    fn open(&mut self, _bytes: usize) -> Option<WriteOnly<'_, [u8]>> {
+        None
+    }
+}
+
 #[test]
 fn split_plan_is_the_serial_plan() {
     let paths = [
@@ -275,21 +296,30 @@ fn split_plan_is_the_serial_plan() {
             ..Default::default()
         };
         for threads in [2, 3, 5] {
-            // The second pass reuses the parts' memory.
+            // The second pass reuses the parts' memory, and copies the primitives into memory
+            // opened for them, as the world's staging.
             for pass in 0..2 {
-                split.rebuild_split(&settings, &items, |s| *s, Meshes, threads);
-                assert_same(
-                    &serial,
-                    &split,
-                    &format!("seed {seed}, {threads} threads, pass {pass}"),
-                );
+                let mut staging = Staging(Vec::new());
+                let target = (pass == 1).then_some(&mut staging as &mut dyn PrimsTarget);
+                split.rebuild_split(&settings, &items, |s| *s, Meshes, (threads, target));
+                let case = format!("seed {seed}, {threads} threads, pass {pass}");
+                assert_same(&serial, &split, &case);
+                assert_eq!(split.prims_written, pass == 1, "{case}");
+                if pass == 1 {
+                    let serial_bytes: &[u8] = bytemuck::cast_slice(&serial.capture.prims);
+                    assert!(staging.0 == serial_bytes, "{case}: primitives copied");
+                }
             }
         }
         // 5 threads: 40 runs of 18 surfaces, but no run is shorter than RUN_MIN / 4, so 22 runs
         // of 32 (the last of 28); the first is planned into the plan itself.
         assert_eq!(split.parts.len(), 700usize.div_ceil(RUN_MIN / 4) - 1);
+        // Memory not opened: the primitives are left to be written from the parts.
+        split.rebuild_split(&settings, &items, |s| *s, Meshes, (3, Some(&mut NoStaging)));
+        assert!(!split.prims_written);
+        assert_same(&serial, &split, &format!("seed {seed}, not opened"));
         // Planned serially again, the plan leaves the parts' primitives behind.
-        split.rebuild_split(&settings, &items, |s| *s, Meshes, 1);
+        split.rebuild_split(&settings, &items, |s| *s, Meshes, (1, None));
         assert_same(&serial, &split, &format!("seed {seed}, serial after split"));
     }
 }
@@ -300,7 +330,7 @@ fn few_surfaces_are_planned_serially() {
     let items = surfaces(&f);
     let settings = PlanSettings::of(&WorldConfig::default());
     let mut plan = FramePlan::default();
-    plan.rebuild_split(&settings, &items, |s| *s, Meshes, 4);
+    plan.rebuild_split(&settings, &items, |s| *s, Meshes, (4, None));
     assert!(plan.parts.is_empty());
     let serial = FramePlan::build(&settings, items.iter().flatten().copied(), Meshes);
     assert_same(&serial, &plan, "serial");
