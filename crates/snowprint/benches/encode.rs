@@ -12,14 +12,15 @@
 //! (what `snowprint bench` measures on a GPU), and `--texels 64` for smaller surfaces (a
 //! software adapter binds at most 128 MiB, and the capture buffer holds 4 bytes a texel of every
 //! captured surface: 2048 of 128^2 at most); `--frames N` and `--only shared|each` for a profile;
-//! `--plan-threads N` for `WorldConfig::plan_threads` (default 0: the machine's, up to 8).
+//! `--plan-threads N` for `WorldConfig::plan_threads` (default 0: the machine's, up to 8). The
+//! list-per-surface frames' steps (`FrameStats::cpu_steps`, medians) follow each row.
 //! Results: `docs/PERFORMANCE.md`, "CPU encode".
 
 use std::time::Instant;
 
 use snowprint::{
-    CapturePath, Deformer, GpuContext, GpuOptions, PoolFormat, Pose, Precision, Shape, SnowWorld,
-    SurfaceDesc, SurfaceId, SurfaceUpdate, WorldConfig,
+    CapturePath, CpuSteps, Deformer, GpuContext, GpuOptions, PoolFormat, Pose, Precision, Shape,
+    SnowWorld, SurfaceDesc, SurfaceId, SurfaceUpdate, WorldConfig,
 };
 
 const SPHERES: u32 = 10;
@@ -86,11 +87,24 @@ type Cases = (bool, bool);
 /// A world measured: surfaces, their side in texels, the capture path and the plan's threads.
 type Case = (u32, u32, CapturePath, usize);
 
+/// The world's steps of a list-per-surface frame ([`CpuSteps`]), in order, with their names.
+fn steps(s: &CpuSteps) -> [(&'static str, f64); 6] {
+    [
+        ("check", s.check_ms),
+        ("plan", s.plan_ms),
+        ("gather", s.gather_ms),
+        ("tables", s.tables_ms),
+        ("upload", s.upload_ms),
+        ("record", s.record_ms),
+    ]
+}
+
 /// Median milliseconds to encode a frame: (shared list, a list per surface), NaN for a case not
-/// measured.
-fn run(gpu: &GpuContext, case: Case, frames: u32, cases: Cases) -> (f64, f64) {
+/// measured; and the medians of the list-per-surface frames' steps.
+fn run(gpu: &GpuContext, case: Case, frames: u32, cases: Cases) -> (f64, f64, Vec<f64>) {
     let (mut world, ids) = world(gpu, case);
     let (mut shared, mut each) = (Vec::new(), Vec::new());
+    let mut each_steps: Vec<Vec<f64>> = vec![Vec::new(); 6];
     for f in 0..frames {
         let t = f as f32 / 60.0;
         let all: Vec<Deformer> = ids.iter().flat_map(|&(_, c)| spheres(c, t)).collect();
@@ -126,11 +140,15 @@ fn run(gpu: &GpuContext, case: Case, frames: u32, cases: Cases) -> (f64, f64) {
         let start = Instant::now();
         let pending = world.encode_update(&mut encoder, &updates).expect("encode");
         each.push(start.elapsed().as_secs_f64() * 1e3);
+        for (v, (_, ms)) in each_steps.iter_mut().zip(steps(&pending.stats().cpu_steps)) {
+            v.push(ms);
+        }
         drop((pending, encoder));
         world.abandon_pending();
         flush(gpu);
     }
-    (median(&mut shared), median(&mut each))
+    let each_steps = each_steps.iter_mut().map(|v| median(v)).collect();
+    (median(&mut shared), median(&mut each), each_steps)
 }
 
 fn main() {
@@ -179,12 +197,20 @@ fn main() {
         "encode on {}, surfaces of {texels}^2, {path:?}, plan threads {threads}",
         gpu.info.name
     );
+    let names = steps(&CpuSteps::default()).map(|(name, _)| format!("{name:>8}"));
     println!(
-        "{:<10} {:>16} {:>16}",
-        "surfaces", "shared_list_ms", "per_surface_ms"
+        "{:<10} {:>16} {:>16} {}",
+        "surfaces",
+        "shared_list_ms",
+        "per_surface_ms",
+        names.join(" ")
     );
     for n in counts {
-        let (shared, each) = run(&gpu, (n, texels, path, threads), frames, cases);
-        println!("{n:<10} {shared:>16.3} {each:>16.3}");
+        let (shared, each, each_steps) = run(&gpu, (n, texels, path, threads), frames, cases);
+        let each_steps: Vec<String> = each_steps.iter().map(|ms| format!("{ms:>8.3}")).collect();
+        println!(
+            "{n:<10} {shared:>16.3} {each:>16.3} {}",
+            each_steps.join(" ")
+        );
     }
 }

@@ -90,8 +90,9 @@ pub use surface::{MAX_RESOLUTION, MIN_TEXEL_SIZE, SurfaceDesc, SurfaceId, Surfac
 pub use view::{Camera, GroundMaterial};
 pub use window::{LevelDesc, ScrollStats, Terrain, TerrainDesc, TerrainGround};
 pub use world::{
-    CaptureConfig, CaptureMode, CapturePath, FrameStats, MemoryReport, MeshAnimation, PassMode,
-    PendingFrame, SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate, WorldConfig,
+    CaptureConfig, CaptureMode, CapturePath, CpuSteps, FrameStats, MemoryReport, MeshAnimation,
+    PassMode, PendingFrame, SnapshotRead, SnowWorld, StageTimes, SurfaceSnapshot, SurfaceUpdate,
+    WorldConfig,
 };
 
 /// What a [`SkinnedMesh`] holds besides its triangles: joints and influences, the node hierarchy,

@@ -79,6 +79,16 @@ fn many_surfaces_planned_on_threads_update_as_on_one() {
             let b = three.update(&updates).expect("update");
             assert_eq!((a.updated, a.primitives), (b.updated, b.primitives));
             assert!(a.primitives > 0);
+            // The steps account for the encode's time, and only a split plan gathers.
+            for (stats, gathers) in [(&a, false), (&b, true)] {
+                let s = stats.cpu_steps;
+                let steps = [s.check_ms, s.plan_ms, s.gather_ms, s.tables_ms];
+                let steps = steps.into_iter().chain([s.upload_ms, s.record_ms]);
+                assert!(steps.clone().all(|ms| ms >= 0.0));
+                assert!(steps.sum::<f64>() <= stats.cpu_encode_ms, "{s:?}");
+                assert!(s.plan_ms > 0.0 && s.record_ms > 0.0, "{s:?}");
+                assert_eq!(s.gather_ms > 0.0, gathers, "{s:?}");
+            }
             assert_eq!(one.footsteps(), three.footsteps(), "{path:?}, frame {f}");
             assert_eq!(one.footsteps().is_empty(), f != 1);
         }

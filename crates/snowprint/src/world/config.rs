@@ -145,6 +145,8 @@ pub struct FrameStats {
     pub cleared_capture_bytes: u64,
     /// CPU time spent building and encoding the frame, milliseconds.
     pub cpu_encode_ms: f64,
+    /// Where that time went, step by step.
+    pub cpu_steps: CpuSteps,
     /// The world's number of this frame: 1 for its first update, one more for each after.
     pub frame: u64,
     /// Per-stage GPU times of an earlier frame (number [`FrameStats::gpu_frame`]), when
@@ -165,6 +167,39 @@ impl FrameStats {
         self.primitives += layer.primitives;
         self.mesh_draws += layer.mesh_draws;
         self.cleared_capture_bytes += layer.cleared_capture_bytes;
+    }
+}
+
+/// Where the CPU time of a frame's encode ([`FrameStats::cpu_encode_ms`]) went, milliseconds,
+/// summed over the frame's layers (the manager's catch-up records several).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct CpuSteps {
+    /// Checking the updates (their time steps, surfaces and deformers).
+    pub check_ms: f64,
+    /// Planning the surfaces: replenishment, culling, sweeping, the footstep test (on the
+    /// world's threads for a frame of many surfaces, [`WorldConfig::plan_threads`]).
+    pub plan_ms: f64,
+    /// Gathering a split plan's runs into one (their primitives copied into the staging memory
+    /// of the frame's first write meanwhile); 0 for a plan on one thread.
+    pub gather_ms: f64,
+    /// The frame's own work once every surface is planned: ordering, the capture atlas, the
+    /// surface records and capture views.
+    pub tables_ms: f64,
+    /// Growing the frame's buffers and writing its tables to the GPU (`queue.write_buffer`).
+    pub upload_ms: f64,
+    /// Recording the capture and accumulation passes into the encoder.
+    pub record_ms: f64,
+}
+
+impl CpuSteps {
+    /// The steps of one more layer added to these.
+    pub(crate) fn add(&mut self, other: &CpuSteps) {
+        self.check_ms += other.check_ms;
+        self.plan_ms += other.plan_ms;
+        self.gather_ms += other.gather_ms;
+        self.tables_ms += other.tables_ms;
+        self.upload_ms += other.upload_ms;
+        self.record_ms += other.record_ms;
     }
 }
 

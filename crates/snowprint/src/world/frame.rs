@@ -6,7 +6,9 @@
 use std::time::Instant;
 
 use super::nearby::INDEX_FROM;
-use super::plan::{FramePlan, PlanMeshes, PlanSettings, PlanSurface, PrimsTarget, plan_threads};
+use super::plan::{
+    FramePlan, PlanMeshes, PlanSettings, PlanSurface, PrimsTarget, elapsed_ms, plan_threads,
+};
 use super::{
     FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceState,
     SurfaceUpdate, WorldConfig,
@@ -39,6 +41,12 @@ impl PendingFrame {
     /// The frame's number ([`FrameStats::frame`]).
     pub fn frame(&self) -> u64 {
         self.frame
+    }
+
+    /// What the frame does and what its encode cost the CPU, as recorded
+    /// ([`SnowWorld::submitted`] returns them with the GPU times of an earlier frame).
+    pub fn stats(&self) -> &FrameStats {
+        &self.stats
     }
 }
 
@@ -139,13 +147,14 @@ impl SnowWorld {
         if self.in_flight.is_some() {
             return Err(SnowError::FramePending);
         }
-        let mut first = self.check_and_plan_first(layers)?;
+        let (mut first, check_ms) = self.check_and_plan_first(layers)?;
         self.probes_before_update(encoder);
         self.frames += 1;
         let mut stats = FrameStats {
             frame: self.frames,
             ..FrameStats::default()
         };
+        stats.cpu_steps.check_ms = check_ms;
         self.scratch_cpu.carries.clear();
         self.scratch_cpu.settles.clear();
         let kept = &mut self.scratch_cpu.kept;
@@ -170,11 +179,16 @@ impl SnowWorld {
             };
             self.probes.footsteps.extend_from_slice(&plan.footsteps);
             stats.add_layer(&plan.stats());
+            stats.cpu_steps.add(&plan.laps);
             // The spray's particles move by the layer's longest step (a step passes one dt).
             let dt = updates.iter().map(|u| u.elapsed).fold(0.0, f32::max);
             if !plan.is_empty() {
+                let start = Instant::now();
                 self.upload(&plan, (j > 0).then_some(&mut *encoder));
+                stats.cpu_steps.upload_ms += elapsed_ms(start);
+                let start = Instant::now();
                 self.record(encoder, &plan, &mut queries, (j, dt));
+                stats.cpu_steps.record_ms += elapsed_ms(start);
                 let s = &mut self.scratch_cpu;
                 remember_captures((&mut s.captured, &mut s.written), &mut plan);
             } else {
@@ -219,11 +233,13 @@ impl SnowWorld {
     fn check_and_plan_first(
         &mut self,
         layers: &[&[SurfaceUpdate<'_>]],
-    ) -> Result<Option<FramePlan>> {
+    ) -> Result<(Option<FramePlan>, f64)> {
+        let start = Instant::now();
         let checked = layers
             .iter()
             .enumerate()
             .try_for_each(|(j, updates)| self.validate(updates, j > 0));
+        let check_ms = elapsed_ms(start);
         let mut first = std::mem::take(&mut self.scratch_cpu.plan);
         let planned = checked.is_ok() && !layers.is_empty();
         if planned {
@@ -253,13 +269,13 @@ impl SnowWorld {
                 .iter()
                 .try_for_each(|updates| self.validate(updates, true))?;
             // Unreachable: what the quick check or the plan refuses, the whole check refuses.
-            return Ok(None);
+            return Ok((None, check_ms));
         }
         if let Err(e) = self.check_sizes(&first, layers.get(1..).unwrap_or_default()) {
             self.scratch_cpu.plan = first;
             return Err(e);
         }
-        Ok(Some(first))
+        Ok((Some(first), check_ms))
     }
 
     /// Refuse a frame whose per-frame buffers the device could not bind (wgpu would panic

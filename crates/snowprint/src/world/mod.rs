@@ -30,7 +30,9 @@ mod snapshot;
 mod spray;
 
 pub use crate::capture::{CaptureConfig, CaptureMode, CapturePath};
-pub use config::{FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig};
+pub use config::{
+    CpuSteps, FrameStats, MemoryReport, PassMode, StageTimes, SurfaceUpdate, WorldConfig,
+};
 pub use footstep::Footstep;
 pub use frame::PendingFrame;
 pub(crate) use plan::FramePlan;

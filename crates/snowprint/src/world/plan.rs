@@ -222,6 +222,9 @@ pub struct FramePlan {
     parts: Vec<FramePlan>,
     /// The threads the parts are planned on, kept between frames.
     planners: parallel::Planners,
+    /// How long the last rebuild took to plan, gather and finish (the world's
+    /// [`crate::CpuSteps`]; its other steps are zero).
+    pub(crate) laps: crate::CpuSteps,
     /// Whether the parts' primitives follow this plan's (a split plan): they are not appended,
     /// but written to the GPU from where they were planned ([`FramePlan::prims`]).
     prims_in_parts: bool,
@@ -262,11 +265,16 @@ impl FramePlan {
         surfaces: impl IntoIterator<Item = PlanSurface<'a>>,
         meshes: impl PlanMeshes,
     ) {
+        let start = std::time::Instant::now();
         self.clear();
         self.tiles_early = false;
         for s in surfaces {
             self.plan_surface(settings, &s, &meshes);
         }
+        self.laps = crate::CpuSteps {
+            plan_ms: elapsed_ms(start),
+            ..Default::default()
+        };
         self.finish(settings);
     }
 
@@ -284,11 +292,13 @@ impl FramePlan {
         };
         // A stable sort takes scratch memory of half the jobs: not when they are in order already
         // (a frame whose surfaces all take one way, say).
+        let start = std::time::Instant::now();
         if !self.jobs.is_sorted_by_key(order) {
             self.jobs.sort_by_key(order);
         }
         self.pack_atlas(settings);
         self.write_tables(settings);
+        self.laps.tables_ms = elapsed_ms(start);
     }
 
     /// Whether nothing is updated (no GPU work at all).
@@ -749,4 +759,9 @@ impl FramePlan {
             relax_tiles: self.relax.tile_words as u64 * 4,
         };
     }
+}
+
+/// Milliseconds since `start`.
+pub(crate) fn elapsed_ms(start: std::time::Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
 }

@@ -159,6 +159,7 @@ impl FramePlan {
             self.rebuild(settings, items.iter().filter_map(surface), meshes);
             return;
         }
+        let start = std::time::Instant::now();
         self.clear();
         self.tiles_early = true;
         // The first run is planned into the plan itself (nothing of it to copy), the others each
@@ -185,6 +186,7 @@ impl FramePlan {
         let plans = std::iter::once(&mut *self).chain(parts.iter_mut());
         let each = |(plan, run)| plan_run(plan, run);
         in_parallel(&mut planners, threads, plans.zip(runs), each, || ());
+        let planned = std::time::Instant::now();
         let bytes = std::mem::size_of::<GpuPrimitive>();
         let total = (self.capture.prims.len()
             + parts.iter().map(|p| p.capture.prims.len()).sum::<usize>())
@@ -195,6 +197,11 @@ impl FramePlan {
         self.prims_written = out.is_some();
         self.gather(&mut planners, &parts, threads, out);
         self.planners = planners;
+        self.laps = crate::CpuSteps {
+            plan_ms: (planned - start).as_secs_f64() * 1e3,
+            gather_ms: super::elapsed_ms(planned),
+            ..Default::default()
+        };
         self.parts = parts;
         self.prims_in_parts = true;
         self.finish(settings);
