@@ -49,7 +49,7 @@ pub struct WorldConfig {
     /// Kicked-up snow: particles spawned where an update deepens a print fast (`spray/`). `None`
     /// (the default): no spray pass, the update exactly as without it.
     pub spray: Option<crate::spray::SprayConfig>,
-    /// Threads that plan a frame of many surfaces (512 or more) on the CPU, each a run of them:
+    /// Threads that plan a frame of many surfaces (128 or more) on the CPU, each a run of them:
     /// the plan is the same whatever the count. 0 (the default): the machine's available
     /// parallelism, up to 8; 1: on the calling thread alone. The calling thread is one of them;
     /// the others are a pool the world makes at the first frame that needs it and keeps, parked

@@ -21,16 +21,17 @@ use crate::mesh::MeshId;
 use crate::relax::Settle;
 use crate::world::Footstep;
 
-/// Fewest surfaces in a frame from which its plan is split over threads: below it, starting the
-/// threads costs more than the work they share (tens of microseconds, against about a microsecond
-/// a surface). On the H100's 16-core host two threads of 128 surfaces took 0.30 to 0.34 ms
-/// against one thread's 0.25 to 0.26 (`docs/PERFORMANCE.md`, "The CPU's frame build and encode on
-/// the H100's host").
-pub(crate) const SPLIT_FROM: usize = 512;
+/// Fewest surfaces in a frame from which its plan is split over threads: below it, waking the
+/// threads and gathering their runs cost more than the work they share (about a microsecond a
+/// surface). With the threads kept between frames ([`Planners`]), on the H100's 16-core host 128
+/// surfaces took 0.17 to 0.21 ms split against 0.24 to 0.27 on one thread, 256 surfaces 0.24 to
+/// 0.28 against 0.37 to 0.47 (`docs/PERFORMANCE.md`, "Plan threads kept between frames"); 64
+/// took 0.07 ms to plan on one thread, too little to share.
+pub(crate) const SPLIT_FROM: usize = 128;
 
 /// Fewest surfaces a split plan has a thread for: a frame of `n` surfaces is planned on at most
 /// `n / RUN_MIN` threads (each of which may take more or fewer, as the runs come).
-pub(crate) const RUN_MIN: usize = 128;
+pub(crate) const RUN_MIN: usize = 32;
 
 /// Runs a split plan cuts its surfaces into, a thread (runs of [`RUN_MIN`] / 4 surfaces at least).
 pub(crate) const RUNS_A_THREAD: usize = 8;

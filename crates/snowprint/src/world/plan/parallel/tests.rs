@@ -3,7 +3,7 @@
 use glam::{Quat, Vec3};
 
 use super::super::*;
-use super::{AUTO_THREADS_MAX, PrimsTarget, RUN_MIN, SPLIT_FROM};
+use super::{AUTO_THREADS_MAX, PrimsTarget, RUN_MIN, RUNS_A_THREAD, SPLIT_FROM};
 use crate::deformer::{Pose, Shape};
 use crate::ground::{GroundField, SlopeRule};
 use crate::material::Material;
@@ -311,9 +311,10 @@ fn split_plan_is_the_serial_plan() {
                 }
             }
         }
-        // 5 threads: 40 runs of 18 surfaces, but no run is shorter than RUN_MIN / 4, so 22 runs
-        // of 32 (the last of 28); the first is planned into the plan itself.
-        assert_eq!(split.parts.len(), 700usize.div_ceil(RUN_MIN / 4) - 1);
+        // 5 threads: 8 runs a thread, of 18 surfaces (unless that is shorter than RUN_MIN / 4),
+        // so 39 runs; the first is planned into the plan itself.
+        let run = 700usize.div_ceil(5 * RUNS_A_THREAD).max(RUN_MIN / 4);
+        assert_eq!(split.parts.len(), 700usize.div_ceil(run) - 1);
         // Memory not opened: the primitives are left to be written from the parts.
         split.rebuild_split(&settings, &items, |s| *s, Meshes, (3, Some(&mut NoStaging)));
         assert!(!split.prims_written);
