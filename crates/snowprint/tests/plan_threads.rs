@@ -101,3 +101,62 @@ fn many_surfaces_planned_on_threads_update_as_on_one() {
         }
     }
 }
+
+/// Frame `f`'s deformers of every surface: `feet`, each ball 24 times (so that the frame's
+/// primitives, 0.8 MB, go through the world's staging buffers, from 0.5 MB).
+fn frame_lists(f: u32) -> Vec<Vec<Deformer>> {
+    (0..SURFACES).map(|i| feet(i, f).repeat(24)).collect()
+}
+
+fn updates<'a>(ids: &[SurfaceId], lists: &'a [Vec<Deformer>]) -> Vec<SurfaceUpdate<'a>> {
+    ids.iter()
+        .zip(lists)
+        .map(|(&surface, deformers)| SurfaceUpdate {
+            surface,
+            elapsed: 0.1,
+            deformers,
+        })
+        .collect()
+}
+
+/// A split frame whose primitives went to a staging buffer of the world's but that is then
+/// abandoned, or refused once planned (a deformer it cannot take), leaves nothing behind: the
+/// frames after it update the snow as a world planning on one thread, frame after frame (more
+/// frames than the world keeps staging buffers, so that they are used again).
+#[test]
+fn abandoned_and_refused_split_frames_leave_the_next_ones_whole() {
+    let gpu = common::gpu();
+    let (mut one, ids) = world(1, CapturePath::Update);
+    let (mut three, _) = world(3, CapturePath::Update);
+    // Abandoned: encoded into an encoder that is dropped.
+    let lists = frame_lists(0);
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    let pending = three.encode_update(&mut encoder, &updates(&ids, &lists));
+    drop((pending.expect("encode"), encoder));
+    three.abandon_pending();
+    // Refused: the last surface's sphere has a negative radius.
+    let mut bad = frame_lists(1);
+    bad[SURFACES as usize - 1] = vec![Deformer::new(
+        Shape::Sphere { radius: -1.0 },
+        Pose::at([0.0, 0.0, 0.0]),
+    )];
+    assert!(three.update(&updates(&ids, &bad)).is_err());
+    for f in 0..6 {
+        let lists = frame_lists(f);
+        let a = one.update(&updates(&ids, &lists)).expect("update");
+        let b = three.update(&updates(&ids, &lists)).expect("update");
+        assert_eq!(
+            (a.primitives, b.cpu_steps.gather_ms > 0.0),
+            (b.primitives, true)
+        );
+        assert!(b.primitives as usize * 80 > 512 << 10, "{}", b.primitives);
+    }
+    for &id in &ids {
+        assert_eq!(
+            one.read_packed(id).expect("heights"),
+            three.read_packed(id).expect("heights")
+        );
+    }
+}

@@ -7,8 +7,10 @@ use std::time::Instant;
 
 use super::nearby::INDEX_FROM;
 use super::plan::{
-    FramePlan, PlanMeshes, PlanSettings, PlanSurface, PrimsTarget, elapsed_ms, plan_threads,
+    FramePlan, NoPrims, PlanMeshes, PlanSettings, PlanSurface, PrimsTarget, elapsed_ms,
+    plan_threads,
 };
+use super::staging::RingTarget;
 use super::{
     FrameStats, InFlight, KEPT_CARRY, KEPT_SETTLE, SnowWorld, StageTimes, SurfaceState,
     SurfaceUpdate, WorldConfig,
@@ -17,7 +19,7 @@ use crate::accumulate::{self, AccumulateBuffers};
 use crate::capture::{self, CaptureBuffers, CaptureMesh, GpuPrimitive};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
-use crate::gpu::resources::{Growable, UNIFORM_STRIDE, write_runs};
+use crate::gpu::resources::{UNIFORM_STRIDE, write_runs};
 use crate::gpu::timestamps::StageQueries;
 use crate::mesh::MeshId;
 use crate::pool::{SurfaceRecord, TILE_LIST_HEADER};
@@ -185,6 +187,10 @@ impl SnowWorld {
             if !plan.is_empty() {
                 let start = Instant::now();
                 self.upload(&plan, (j > 0).then_some(&mut *encoder));
+                if plan.prims_written {
+                    let prims = &self.prims.buffer;
+                    self.staging.record_copy(encoder, prims, plan.sizes.prims);
+                }
                 stats.cpu_steps.upload_ms += elapsed_ms(start);
                 let start = Instant::now();
                 self.record(encoder, &plan, &mut queries, (j, dt));
@@ -244,13 +250,11 @@ impl SnowWorld {
         let planned = checked.is_ok() && !layers.is_empty();
         if planned {
             first.check_short_lists = true;
-            // A split plan copies its primitives straight into the staging memory of the
-            // frame's first write.
-            let mut staging = PrimsStaging {
+            // A split plan copies its primitives straight into a staging buffer of the world's,
+            // which the frame's encoder copies from (`world/staging.rs`).
+            let mut staging = RingTarget {
                 device: &self.device,
-                queue: &self.queue,
-                buffer: &mut self.prims,
-                view: None,
+                ring: &mut self.staging,
             };
             let inputs = PlanInputs {
                 config: &self.config,
@@ -264,6 +268,8 @@ impl SnowWorld {
             first.check_short_lists = false;
         }
         if checked.is_err() || (planned && first.refused) {
+            // The plan is not used: nor is the staging it filled.
+            self.staging.cancel();
             self.scratch_cpu.plan = first;
             layers
                 .iter()
@@ -272,6 +278,7 @@ impl SnowWorld {
             return Ok((None, check_ms));
         }
         if let Err(e) = self.check_sizes(&first, layers.get(1..).unwrap_or_default()) {
+            self.staging.cancel();
             self.scratch_cpu.plan = first;
             return Err(e);
         }
@@ -357,6 +364,7 @@ impl SnowWorld {
                 index: pending.frame as u32,
             })?;
         self.in_flight = None;
+        self.staging.release();
         self.scratch_cpu.carries.clear();
         self.scratch_cpu.settles.clear();
         self.probes_submitted();
@@ -382,6 +390,7 @@ impl SnowWorld {
     /// [`PendingFrame`] lost): its replenishment is not kept, and the world encodes again.
     pub fn abandon_pending(&mut self) {
         self.probes_abandoned();
+        self.staging.release();
         if let Some(f) = self.in_flight.take() {
             for (index, carry) in std::mem::take(&mut self.scratch_cpu.carries) {
                 if let Some(s) = self.surfaces.get_mut(index).and_then(Option::as_mut) {
@@ -484,7 +493,7 @@ impl SnowWorld {
                 vertices: &self.probes.mesh_vertices,
             },
         };
-        inputs.plan(plan, updates, None);
+        inputs.plan(plan, updates, None::<&mut NoPrims>);
     }
 
     /// Grow the per-frame buffers the plan needs and write its tables: with `queue.write_buffer`
@@ -547,10 +556,12 @@ impl SnowWorld {
                 write_at(list, TILE_LIST_HEADER * 4, bytemuck::cast_slice(&c.listed));
             }
         }
+        if sizes.prims > 0 {
+            self.prims.ensure(device, sizes.prims);
+        }
         if sizes.prims > 0 && !plan.prims_written {
             // Run by run from where each was planned (a split plan's parts are not appended), in
             // one write.
-            self.prims.ensure(device, sizes.prims);
             let runs = plan.prims().map(bytemuck::cast_slice);
             let total = std::mem::size_of::<GpuPrimitive>() * plan.prims_len();
             write_runs((device, queue), enc, &self.prims.buffer, total as u64, runs);
@@ -633,8 +644,8 @@ impl SnowWorld {
     }
 }
 
-/// What a frame's plan reads of the world, borrowed field by field (so that the world's
-/// primitives buffer can be borrowed beside it, [`PrimsStaging`]).
+/// What a frame's plan reads of the world, borrowed field by field (so that the world's staging
+/// ring can be borrowed beside it, [`RingTarget`]).
 struct PlanInputs<'a> {
     config: &'a WorldConfig,
     surfaces: &'a [Option<SurfaceState>],
@@ -648,7 +659,7 @@ impl<'a> PlanInputs<'a> {
         self,
         plan: &mut FramePlan,
         updates: &'a [SurfaceUpdate<'a>],
-        prims: Option<&mut dyn PrimsTarget>,
+        prims: Option<&mut impl PrimsTarget>,
     ) {
         let format = self.config.format;
         let states = self.surfaces;
@@ -676,35 +687,6 @@ impl<'a> PlanInputs<'a> {
         let settings = PlanSettings::of(self.config);
         let threads = plan_threads(self.config.plan_threads);
         plan.rebuild_split(&settings, updates, surface, self.meshes, (threads, prims));
-    }
-}
-
-/// The world's primitives buffer, grown to what a split plan asks and opened for it with
-/// `queue.write_buffer_with`: the plan's threads copy their primitives into the staging memory,
-/// which lands in the buffer at the next submission (as `queue.write_buffer`'s would).
-struct PrimsStaging<'w> {
-    device: &'w wgpu::Device,
-    queue: &'w wgpu::Queue,
-    buffer: &'w mut Growable,
-    view: Option<wgpu::QueueWriteBufferView>,
-}
-
-impl PrimsTarget for PrimsStaging<'_> {
-    fn open(&mut self, bytes: usize) -> Option<wgpu::WriteOnly<'_, [u8]>> {
-        let size = wgpu::BufferSize::new(bytes as u64)?;
-        // More than the device binds: the world refuses the frame once it is planned
-        // (`check_sizes`), and nothing is written.
-        let limits = self.device.limits();
-        if size.get()
-            > limits
-                .max_storage_buffer_binding_size
-                .min(limits.max_buffer_size)
-        {
-            return None;
-        }
-        self.buffer.ensure(self.device, size.get());
-        self.view = self.queue.write_buffer_with(&self.buffer.buffer, 0, size);
-        self.view.as_mut().map(|v| v.slice(..))
     }
 }
 

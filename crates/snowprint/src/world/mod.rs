@@ -28,6 +28,7 @@ mod readback;
 mod skinned;
 mod snapshot;
 mod spray;
+mod staging;
 
 pub use crate::capture::{CaptureConfig, CaptureMode, CapturePath};
 pub use config::{
@@ -137,6 +138,8 @@ pub struct SnowWorld {
     records: Growable,
     views: Growable,
     prims: Growable,
+    /// Mapped buffers a split plan copies its primitives into, copied from into `prims`.
+    staging: staging::StagingRing,
     draws: Growable,
     capture: Growable,
     winding: Growable,
@@ -279,6 +282,7 @@ impl SnowWorld {
                 U::STORAGE | U::COPY_DST,
                 80 * 64,
             ),
+            staging: staging::StagingRing::default(),
             draws: Growable::new(
                 &device,
                 "capture mesh draws",

@@ -35,7 +35,7 @@ mod surface;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use parallel::{PrimsTarget, plan_threads};
+pub(crate) use parallel::{NoPrims, PrimsTarget, plan_threads};
 
 pub use sizes::BufferSizes;
 pub use surface::replenish;
@@ -229,7 +229,7 @@ pub struct FramePlan {
     /// but written to the GPU from where they were planned ([`FramePlan::prims`]).
     prims_in_parts: bool,
     /// Whether a split plan's primitives were copied into the memory its caller opened for them
-    /// ([`parallel::PrimsTarget`]): then they need no other write to the GPU.
+    /// ([`parallel::PrimsTarget`]): then they need no other write to the GPU than its copy.
     pub(crate) prims_written: bool,
     /// The grid over a long list of deformers shared by surfaces (`encode_step`'s), kept for the
     /// frame's footsteps; forgotten at the next rebuild.

@@ -7,13 +7,11 @@
 //! their place in the plan's, their ranges shifted ([`FramePlan::gather`]), before the frame's own
 //! work (`FramePlan::finish`). The primitives, most of a frame's bytes, are not appended: they
 //! stay in the parts, after the first run's, and are copied from there straight into the GPU's
-//! staging memory when the caller gives it ([`PrimsTarget`]), in the same gathering, else written
-//! to the GPU from the parts ([`FramePlan::prims`]); either way copied once rather than twice. The
-//! plan is the one
-//! [`FramePlan::rebuild`] makes of the same surfaces, vector for vector and byte for byte
+//! staging memory when the caller gives it ([`PrimsTarget`]), each run's by the thread that
+//! gathers it, else written to the GPU from the parts ([`FramePlan::prims`]); either way copied
+//! once rather than twice. The plan is the one [`FramePlan::rebuild`] makes of the same surfaces,
+//! vector for vector and byte for byte
 //! (`tests.rs`, `split_plan_is_the_serial_plan`).
-
-use wgpu::WriteOnly;
 
 use super::{FramePlan, Job, PlanMeshes, PlanSettings, PlanSurface};
 use crate::capture::{GpuPrimitive, MeshDraw};
@@ -153,7 +151,7 @@ impl FramePlan {
         items: &'a [T],
         surface: impl Fn(&'a T) -> Option<PlanSurface<'a>> + Sync,
         meshes: impl PlanMeshes + Sync,
-        (threads, prims): (usize, Option<&mut dyn PrimsTarget>),
+        (threads, prims): (usize, Option<&mut impl PrimsTarget>),
     ) {
         let threads = threads.min(items.len() / RUN_MIN).max(1);
         if threads == 1 || items.len() < SPLIT_FROM {
@@ -188,13 +186,13 @@ impl FramePlan {
         let each = |(plan, run)| plan_run(plan, run);
         in_parallel(&mut planners, threads, plans.zip(runs), each, || ());
         let planned = std::time::Instant::now();
-        let bytes = std::mem::size_of::<GpuPrimitive>();
-        let total = (self.capture.prims.len()
-            + parts.iter().map(|p| p.capture.prims.len()).sum::<usize>())
-            * bytes;
+        let runs = std::iter::once(&*self).chain(&parts);
+        let lens: Vec<usize> = runs
+            .map(|p| size_of_val(p.capture.prims.as_slice()))
+            .collect();
         let out = prims
-            .and_then(|p| p.open(total))
-            .filter(|o| o.len() == total);
+            .and_then(|p| p.open(&lens))
+            .filter(|o| o.len() == lens.len());
         self.prims_written = out.is_some();
         self.gather(&mut planners, &parts, threads, out);
         self.planners = planners;
@@ -226,26 +224,24 @@ impl FramePlan {
 
     /// Append the partial plans of the surfaces after this plan's, as if they had been planned
     /// here, on up to `threads` threads, a part at a time: their jobs' ranges of primitives, draws
-    /// and tiles shifted past the runs' before them. `prims`, when given, receives every run's
-    /// primitives, this plan's first (they stay where they were planned, too), copied by this
-    /// thread while the others append: wgpu's staging memory cannot be handed to another thread.
-    fn gather(
+    /// and tiles shifted past the runs' before them. `prims`, when given, holds a piece of memory
+    /// for each run's primitives, this plan's first (`None` for a run without): the thread that
+    /// gathers a part copies its primitives into its piece (they stay where they were planned,
+    /// too).
+    fn gather<P: PrimsPiece>(
         &mut self,
         planners: &mut Planners,
         parts: &[FramePlan],
         threads: usize,
-        prims: Option<WriteOnly<'_, [u8]>>,
+        prims: Option<Vec<Option<P>>>,
     ) {
         let own = &self.capture.prims;
-        let copy_prims = move || {
-            if let Some(mut out) = prims {
-                let runs = std::iter::once(own).chain(parts.iter().map(|p| &p.capture.prims));
-                for run in runs {
-                    let bytes: &[u8] = bytemuck::cast_slice(run);
-                    let (mut head, rest) = out.split_at(bytes.len());
-                    head.copy_from_slice(bytes);
-                    out = rest;
-                }
+        let mut prims = prims.map(Vec::into_iter);
+        let mut next_piece = || prims.as_mut().and_then(Iterator::next).flatten();
+        let own_piece = next_piece();
+        let copy_own = move || {
+            if let Some(piece) = own_piece {
+                piece.fill(bytemuck::cast_slice(own));
             }
         };
         let mut shift = [own.len(), self.capture.draws.len(), self.reached.len()];
@@ -267,6 +263,7 @@ impl FramePlan {
                 carries: carries.next().unwrap_or_default(),
                 settles: settles.next().unwrap_or_default(),
                 footsteps: footsteps.next().unwrap_or_default(),
+                prims: next_piece(),
                 shift: shift.map(|n| n as u32),
             };
             work.push((part, dest));
@@ -281,17 +278,44 @@ impl FramePlan {
             threads,
             work.into_iter(),
             |(part, dest)| dest.fill(part),
-            copy_prims,
+            copy_own,
         );
     }
 }
 
-/// Memory for a split plan's primitives, opened once every run is planned (the GPU's staging
-/// memory for the frame's primitives buffer: `queue.write_buffer_with`).
+/// Memory for a split plan's primitives, opened once every run is planned: the world's mapped
+/// staging buffer for the frame's primitives buffer (`world/staging.rs`), a piece a run, laid end
+/// to end.
 pub(crate) trait PrimsTarget {
-    /// `bytes` bytes to fill with the frame's primitives, or `None` (they are then written from
-    /// the parts, [`FramePlan::prims`]).
-    fn open(&mut self, bytes: usize) -> Option<WriteOnly<'_, [u8]>>;
+    /// A piece of memory.
+    type Piece: PrimsPiece;
+
+    /// Pieces for runs of `lens` bytes, in order (`None` for an empty run), or `None` (the
+    /// primitives are then written from the parts, [`FramePlan::prims`]).
+    fn open(&mut self, lens: &[usize]) -> Option<Vec<Option<Self::Piece>>>;
+}
+
+/// A piece of memory for one run's primitives, filled by the thread that gathers the run.
+pub(crate) trait PrimsPiece: Send {
+    /// Copy `bytes` here (exactly the piece's length).
+    fn fill(self, bytes: &[u8]);
+}
+
+impl PrimsPiece for wgpu::BufferViewMut {
+    fn fill(mut self, bytes: &[u8]) {
+        self.copy_from_slice(bytes);
+    }
+}
+
+/// No memory: a split plan's primitives stay in its parts.
+pub(crate) struct NoPrims;
+
+impl PrimsTarget for NoPrims {
+    type Piece = wgpu::BufferViewMut;
+
+    fn open(&mut self, _lens: &[usize]) -> Option<Vec<Option<Self::Piece>>> {
+        None
+    }
 }
 
 /// The pieces of `v`, grown past its length by every part's elements (`of` a part), in the
@@ -318,9 +342,9 @@ fn pieces<'d, T: Clone>(
         .collect()
 }
 
-/// Where one part's vectors go in the plan's ([`FramePlan::gather`]), and how far its jobs'
-/// ranges of primitives, draws and tiles shift.
-struct Dest<'d> {
+/// Where one part's vectors go in the plan's ([`FramePlan::gather`]), and its primitives, and how
+/// far its jobs' ranges of primitives, draws and tiles shift.
+struct Dest<'d, P> {
     jobs: &'d mut [Job],
     draws: &'d mut [MeshDraw],
     draw_meshes: &'d mut [MeshId],
@@ -328,10 +352,11 @@ struct Dest<'d> {
     carries: &'d mut [(usize, f64)],
     settles: &'d mut [(usize, Settle)],
     footsteps: &'d mut [Footstep],
+    prims: Option<P>,
     shift: [u32; 3],
 }
 
-impl Dest<'_> {
+impl<P: PrimsPiece> Dest<'_, P> {
     /// Copy `part`'s vectors here, its jobs' ranges shifted.
     fn fill(self, part: &FramePlan) {
         let shifted = |r: &std::ops::Range<u32>, by: u32| r.start + by..r.end + by;
@@ -348,6 +373,9 @@ impl Dest<'_> {
         self.carries.copy_from_slice(&part.carries);
         self.settles.copy_from_slice(&part.settles);
         self.footsteps.copy_from_slice(&part.footsteps);
+        if let Some(piece) = self.prims {
+            piece.fill(bytemuck::cast_slice(&part.capture.prims));
+        }
     }
 }
 

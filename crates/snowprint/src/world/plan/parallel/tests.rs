@@ -3,11 +3,12 @@
 use glam::{Quat, Vec3};
 
 use super::super::*;
-use super::{AUTO_THREADS_MAX, PrimsTarget, RUN_MIN, RUNS_A_THREAD, SPLIT_FROM};
+use super::{
+    AUTO_THREADS_MAX, NoPrims, PrimsPiece, PrimsTarget, RUN_MIN, RUNS_A_THREAD, SPLIT_FROM,
+};
 use crate::deformer::{Pose, Shape};
 use crate::ground::{GroundField, SlopeRule};
 use crate::material::Material;
-use wgpu::WriteOnly;
 
 /// A small deterministic generator (xorshift), so that a failure is reproduced by its seed.
 struct Rng(u64);
@@ -239,23 +240,30 @@ fn assert_same(serial: &FramePlan, split: &FramePlan, case: &str) {
     assert!(tables.0 == tables.1, "{case}: written tables");
 }
 
-/// Memory for the primitives, as the world's staging opens it (filled with a byte no plan
-/// writes whole, so that a primitive left out shows).
-struct Staging(Vec<u8>);
-
-impl PrimsTarget for Staging {
-    fn open(&mut self, bytes: usize) -> Option<WriteOnly<'_, [u8]>> {
-        self.0 = vec![0xa5; bytes];
-        Some(WriteOnly::from(&mut self.0[..]))
+/// A piece of a test's memory.
+impl PrimsPiece for &mut [u8] {
+    fn fill(self, bytes: &[u8]) {
+        self.copy_from_slice(bytes);
     }
 }
 
-/// Memory the caller cannot open: the primitives stay in the parts, to be written from there.
-struct NoStaging;
+/// Memory for the primitives, cut into a piece a run as the world's staging is (filled with a
+/// byte no plan writes whole, so that a primitive left out shows); the runs' lengths as asked.
+struct Staging<'m>(Option<&'m mut [u8]>, Vec<usize>);
 
-impl PrimsTarget for NoStaging {
-    fn open(&mut self, _bytes: usize) -> Option<WriteOnly<'_, [u8]>> {
-        None
+impl<'m> PrimsTarget for Staging<'m> {
+    type Piece = &'m mut [u8];
+
+    fn open(&mut self, lens: &[usize]) -> Option<Vec<Option<Self::Piece>>> {
+        let mut rest = self.0.take()?;
+        rest.fill(0xa5);
+        self.1 = lens.to_vec();
+        let pieces = lens.iter().map(|&len| {
+            let (piece, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = tail;
+            (len > 0).then_some(piece)
+        });
+        Some(pieces.collect())
     }
 }
 
@@ -299,15 +307,18 @@ fn split_plan_is_the_serial_plan() {
             // The second pass reuses the parts' memory, and copies the primitives into memory
             // opened for them, as the world's staging.
             for pass in 0..2 {
-                let mut staging = Staging(Vec::new());
-                let target = (pass == 1).then_some(&mut staging as &mut dyn PrimsTarget);
+                let serial_bytes: &[u8] = bytemuck::cast_slice(&serial.capture.prims);
+                let mut memory = vec![0u8; serial_bytes.len()];
+                let mut staging = Staging(Some(&mut memory[..]), Vec::new());
+                let target = (pass == 1).then_some(&mut staging);
                 split.rebuild_split(&settings, &items, |s| *s, Meshes, (threads, target));
                 let case = format!("seed {seed}, {threads} threads, pass {pass}");
                 assert_same(&serial, &split, &case);
                 assert_eq!(split.prims_written, pass == 1, "{case}");
                 if pass == 1 {
-                    let serial_bytes: &[u8] = bytemuck::cast_slice(&serial.capture.prims);
-                    assert!(staging.0 == serial_bytes, "{case}: primitives copied");
+                    // A piece a run, the plan's own first.
+                    assert_eq!(staging.1.len(), split.parts.len() + 1, "{case}");
+                    assert!(memory == serial_bytes, "{case}: primitives copied");
                 }
             }
         }
@@ -316,11 +327,11 @@ fn split_plan_is_the_serial_plan() {
         let run = 700usize.div_ceil(5 * RUNS_A_THREAD).max(RUN_MIN / 4);
         assert_eq!(split.parts.len(), 700usize.div_ceil(run) - 1);
         // Memory not opened: the primitives are left to be written from the parts.
-        split.rebuild_split(&settings, &items, |s| *s, Meshes, (3, Some(&mut NoStaging)));
+        split.rebuild_split(&settings, &items, |s| *s, Meshes, (3, Some(&mut NoPrims)));
         assert!(!split.prims_written);
         assert_same(&serial, &split, &format!("seed {seed}, not opened"));
         // Planned serially again, the plan leaves the parts' primitives behind.
-        split.rebuild_split(&settings, &items, |s| *s, Meshes, (1, None));
+        split.rebuild_split(&settings, &items, |s| *s, Meshes, (1, None::<&mut NoPrims>));
         assert_same(&serial, &split, &format!("seed {seed}, serial after split"));
     }
 }
@@ -331,7 +342,7 @@ fn few_surfaces_are_planned_serially() {
     let items = surfaces(&f);
     let settings = PlanSettings::of(&WorldConfig::default());
     let mut plan = FramePlan::default();
-    plan.rebuild_split(&settings, &items, |s| *s, Meshes, (4, None));
+    plan.rebuild_split(&settings, &items, |s| *s, Meshes, (4, None::<&mut NoPrims>));
     assert!(plan.parts.is_empty());
     let serial = FramePlan::build(&settings, items.iter().flatten().copied(), Meshes);
     assert_same(&serial, &plan, "serial");
