@@ -250,11 +250,14 @@ impl SnowWorld {
         let planned = checked.is_ok() && !layers.is_empty();
         if planned {
             first.check_short_lists = true;
-            // A split plan copies its primitives straight into a staging buffer of the world's,
-            // which the frame's encoder copies from (`world/staging.rs`).
+            // A split plan copies its primitives straight into staging memory: a buffer of the
+            // world's that the frame's encoder copies from, or the queue's (`world/staging.rs`).
             let mut staging = RingTarget {
                 device: &self.device,
+                queue: &self.queue,
                 ring: &mut self.staging,
+                prims: &mut self.prims,
+                view: None,
             };
             let inputs = PlanInputs {
                 config: &self.config,

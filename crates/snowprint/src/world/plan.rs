@@ -35,7 +35,7 @@ mod surface;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use parallel::{NoPrims, PrimsTarget, plan_threads};
+pub(crate) use parallel::{NoPrims, Opened, PrimsTarget, plan_threads};
 
 pub use sizes::BufferSizes;
 pub use surface::replenish;

@@ -9,7 +9,8 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::plan::PrimsTarget;
+use super::plan::{Opened, PrimsTarget};
+use crate::gpu::resources::Growable;
 
 /// Buffers the ring keeps at most: with more frames in flight, a frame's primitives are written
 /// from the parts on one thread.
@@ -158,24 +159,41 @@ impl StagingRing {
     }
 }
 
-/// The ring as a split plan's [`PrimsTarget`], with the device it makes buffers on.
+/// Where a split plan's primitives go (its [`PrimsTarget`]): a frame of [`RING_FROM`] bytes of
+/// them or more into a buffer of the ring, a view a run; a smaller one into the staging memory of
+/// one `queue.write_buffer_with` into the primitives buffer, grown to them, which the calling
+/// thread fills (it lands at the next submission, as `queue.write_buffer`'s would).
 pub(crate) struct RingTarget<'w> {
     pub device: &'w wgpu::Device,
+    pub queue: &'w wgpu::Queue,
     pub ring: &'w mut StagingRing,
+    pub prims: &'w mut Growable,
+    /// The queue's staging memory, while the plan fills it.
+    pub view: Option<wgpu::QueueWriteBufferView>,
 }
 
 impl PrimsTarget for RingTarget<'_> {
     type Piece = wgpu::BufferViewMut;
 
-    fn open(&mut self, lens: &[usize]) -> Option<Vec<Option<Self::Piece>>> {
+    fn open(&mut self, lens: &[usize]) -> Option<Opened<'_, Self::Piece>> {
         let bytes = lens.iter().sum::<usize>() as u64;
+        let size = wgpu::BufferSize::new(bytes)?;
         // More than the device binds: the world refuses the frame once it is planned
         // (`check_sizes`), and nothing is written.
         let limits = self.device.limits();
-        if bytes < RING_FROM as u64 || bytes > limits.max_storage_buffer_binding_size {
+        if bytes
+            > limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size)
+        {
             return None;
         }
-        let i = self.ring.hold(self.device, bytes)?;
-        self.ring.views(i, lens)
+        if bytes >= RING_FROM as u64 {
+            let i = self.ring.hold(self.device, bytes)?;
+            return self.ring.views(i, lens).map(Opened::Pieces);
+        }
+        self.prims.ensure(self.device, bytes);
+        self.view = self.queue.write_buffer_with(&self.prims.buffer, 0, size);
+        self.view.as_mut().map(|v| Opened::Whole(v.slice(..)))
     }
 }

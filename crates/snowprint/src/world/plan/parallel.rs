@@ -190,9 +190,10 @@ impl FramePlan {
         let lens: Vec<usize> = runs
             .map(|p| size_of_val(p.capture.prims.as_slice()))
             .collect();
-        let out = prims
-            .and_then(|p| p.open(&lens))
-            .filter(|o| o.len() == lens.len());
+        let out = prims.and_then(|p| p.open(&lens)).filter(|o| match o {
+            Opened::Pieces(pieces) => pieces.len() == lens.len(),
+            Opened::Whole(whole) => whole.len() == lens.iter().sum::<usize>(),
+        });
         self.prims_written = out.is_some();
         self.gather(&mut planners, &parts, threads, out);
         self.planners = planners;
@@ -233,15 +234,30 @@ impl FramePlan {
         planners: &mut Planners,
         parts: &[FramePlan],
         threads: usize,
-        prims: Option<Vec<Option<P>>>,
+        prims: Option<Opened<'_, P>>,
     ) {
         let own = &self.capture.prims;
-        let mut prims = prims.map(Vec::into_iter);
-        let mut next_piece = || prims.as_mut().and_then(Iterator::next).flatten();
+        let (mut pieces_of, whole) = match prims {
+            Some(Opened::Pieces(pieces)) => (Some(pieces.into_iter()), None),
+            Some(Opened::Whole(whole)) => (None, Some(whole)),
+            None => (None, None),
+        };
+        let mut next_piece = || pieces_of.as_mut().and_then(Iterator::next).flatten();
         let own_piece = next_piece();
+        // This thread's share: its own run's piece, or every run into one piece of memory that
+        // cannot be handed to another thread.
         let copy_own = move || {
             if let Some(piece) = own_piece {
                 piece.fill(bytemuck::cast_slice(own));
+            }
+            if let Some(mut out) = whole {
+                let runs = std::iter::once(own).chain(parts.iter().map(|p| &p.capture.prims));
+                for run in runs {
+                    let bytes: &[u8] = bytemuck::cast_slice(run);
+                    let (mut head, rest) = out.split_at(bytes.len());
+                    head.copy_from_slice(bytes);
+                    out = rest;
+                }
             }
         };
         let mut shift = [own.len(), self.capture.draws.len(), self.reached.len()];
@@ -283,16 +299,25 @@ impl FramePlan {
     }
 }
 
-/// Memory for a split plan's primitives, opened once every run is planned: the world's mapped
-/// staging buffer for the frame's primitives buffer (`world/staging.rs`), a piece a run, laid end
-/// to end.
+/// Memory for a split plan's primitives, opened once every run is planned: staging memory for the
+/// frame's primitives buffer (`world/staging.rs`).
 pub(crate) trait PrimsTarget {
     /// A piece of memory.
     type Piece: PrimsPiece;
 
-    /// Pieces for runs of `lens` bytes, in order (`None` for an empty run), or `None` (the
-    /// primitives are then written from the parts, [`FramePlan::prims`]).
-    fn open(&mut self, lens: &[usize]) -> Option<Vec<Option<Self::Piece>>>;
+    /// Memory for runs of `lens` bytes, laid end to end, or `None` (the primitives are then
+    /// written from the parts, [`FramePlan::prims`]).
+    fn open(&mut self, lens: &[usize]) -> Option<Opened<'_, Self::Piece>>;
+}
+
+/// Memory a [`PrimsTarget`] opened.
+pub(crate) enum Opened<'m, P> {
+    /// A piece a run, in order (`None` for an empty run), each filled by the thread that gathers
+    /// its run.
+    Pieces(Vec<Option<P>>),
+    /// The runs' bytes together, filled by the calling thread (wgpu's `WriteOnly` memory cannot
+    /// be handed to another thread).
+    Whole(wgpu::WriteOnly<'m, [u8]>),
 }
 
 /// A piece of memory for one run's primitives, filled by the thread that gathers the run.
@@ -313,7 +338,7 @@ pub(crate) struct NoPrims;
 impl PrimsTarget for NoPrims {
     type Piece = wgpu::BufferViewMut;
 
-    fn open(&mut self, _lens: &[usize]) -> Option<Vec<Option<Self::Piece>>> {
+    fn open(&mut self, _lens: &[usize]) -> Option<Opened<'_, Self::Piece>> {
         None
     }
 }

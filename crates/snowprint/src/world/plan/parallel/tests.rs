@@ -4,11 +4,12 @@ use glam::{Quat, Vec3};
 
 use super::super::*;
 use super::{
-    AUTO_THREADS_MAX, NoPrims, PrimsPiece, PrimsTarget, RUN_MIN, RUNS_A_THREAD, SPLIT_FROM,
+    AUTO_THREADS_MAX, NoPrims, Opened, PrimsPiece, PrimsTarget, RUN_MIN, RUNS_A_THREAD, SPLIT_FROM,
 };
 use crate::deformer::{Pose, Shape};
 use crate::ground::{GroundField, SlopeRule};
 use crate::material::Material;
+use wgpu::WriteOnly;
 
 /// A small deterministic generator (xorshift), so that a failure is reproduced by its seed.
 struct Rng(u64);
@@ -247,23 +248,27 @@ impl PrimsPiece for &mut [u8] {
     }
 }
 
-/// Memory for the primitives, cut into a piece a run as the world's staging is (filled with a
-/// byte no plan writes whole, so that a primitive left out shows); the runs' lengths as asked.
-struct Staging<'m>(Option<&'m mut [u8]>, Vec<usize>);
+/// Memory for the primitives, cut into a piece a run as the world's ring is, or whole as the
+/// queue's staging (`.2`), filled with a byte no plan writes whole, so that a primitive left out
+/// shows; the runs' lengths as asked.
+struct Staging<'m>(Option<&'m mut [u8]>, Vec<usize>, bool);
 
 impl<'m> PrimsTarget for Staging<'m> {
     type Piece = &'m mut [u8];
 
-    fn open(&mut self, lens: &[usize]) -> Option<Vec<Option<Self::Piece>>> {
+    fn open(&mut self, lens: &[usize]) -> Option<Opened<'_, Self::Piece>> {
         let mut rest = self.0.take()?;
         rest.fill(0xa5);
         self.1 = lens.to_vec();
+        if self.2 {
+            return Some(Opened::Whole(WriteOnly::from(rest)));
+        }
         let pieces = lens.iter().map(|&len| {
             let (piece, tail) = std::mem::take(&mut rest).split_at_mut(len);
             rest = tail;
             (len > 0).then_some(piece)
         });
-        Some(pieces.collect())
+        Some(Opened::Pieces(pieces.collect()))
     }
 }
 
@@ -304,18 +309,18 @@ fn split_plan_is_the_serial_plan() {
             ..Default::default()
         };
         for threads in [2, 3, 5] {
-            // The second pass reuses the parts' memory, and copies the primitives into memory
-            // opened for them, as the world's staging.
-            for pass in 0..2 {
+            // The later passes reuse the parts' memory, and copy the primitives into memory
+            // opened for them as the world's staging: a piece a run, or whole.
+            for pass in 0..3 {
                 let serial_bytes: &[u8] = bytemuck::cast_slice(&serial.capture.prims);
                 let mut memory = vec![0u8; serial_bytes.len()];
-                let mut staging = Staging(Some(&mut memory[..]), Vec::new());
-                let target = (pass == 1).then_some(&mut staging);
+                let mut staging = Staging(Some(&mut memory[..]), Vec::new(), pass == 2);
+                let target = (pass > 0).then_some(&mut staging);
                 split.rebuild_split(&settings, &items, |s| *s, Meshes, (threads, target));
                 let case = format!("seed {seed}, {threads} threads, pass {pass}");
                 assert_same(&serial, &split, &case);
-                assert_eq!(split.prims_written, pass == 1, "{case}");
-                if pass == 1 {
+                assert_eq!(split.prims_written, pass > 0, "{case}");
+                if pass > 0 {
                     // A piece a run, the plan's own first.
                     assert_eq!(staging.1.len(), split.parts.len() + 1, "{case}");
                     assert!(memory == serial_bytes, "{case}: primitives copied");
