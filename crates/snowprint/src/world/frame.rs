@@ -26,6 +26,21 @@ use crate::pool::{SurfaceRecord, TILE_LIST_HEADER};
 use crate::relax::{self, RelaxBuffers};
 use crate::wgsl::consts::TILE_LIST_GRID_FIRST;
 
+/// A world's [`PlanInputs`], borrowed field by field where it is written, so that the borrows stay
+/// apart from the staging's (`RingTarget`).
+macro_rules! plan_inputs {
+    ($world:expr) => {
+        PlanInputs {
+            config: &$world.config,
+            surfaces: &$world.surfaces,
+            meshes: WorldMeshes {
+                capture: &$world.meshes,
+                vertices: &$world.probes.mesh_vertices,
+            },
+        }
+    };
+}
+
 /// A frame recorded into a caller's command encoder by [`SnowWorld::encode_update`] or
 /// [`SnowWorld::encode_step`], waiting for the caller's `queue.submit`. Give it back with
 /// [`SnowWorld::submitted`] after submitting the encoder: that keeps the frame's replenishment
@@ -259,14 +274,7 @@ impl SnowWorld {
                 prims: &mut self.prims,
                 view: None,
             };
-            let inputs = PlanInputs {
-                config: &self.config,
-                surfaces: &self.surfaces,
-                meshes: WorldMeshes {
-                    capture: &self.meshes,
-                    vertices: &self.probes.mesh_vertices,
-                },
-            };
+            let inputs = plan_inputs!(self);
             inputs.plan(&mut first, layers[0], Some(&mut staging));
             first.check_short_lists = false;
         }
@@ -488,14 +496,7 @@ impl SnowWorld {
 
     /// The frame's plan, from the surfaces' state and the (validated) updates.
     fn plan_into<'a>(&'a self, plan: &mut FramePlan, updates: &'a [SurfaceUpdate<'a>]) {
-        let inputs = PlanInputs {
-            config: &self.config,
-            surfaces: &self.surfaces,
-            meshes: WorldMeshes {
-                capture: &self.meshes,
-                vertices: &self.probes.mesh_vertices,
-            },
-        };
+        let inputs = plan_inputs!(self);
         inputs.plan(plan, updates, None::<&mut NoPrims>);
     }
 
