@@ -223,16 +223,7 @@ pub(crate) fn write_runs<'a>(
     let Some(size) = wgpu::BufferSize::new(total) else {
         return;
     };
-    let fill = |mut to: wgpu::WriteOnly<'_, [u8]>| {
-        for run in runs {
-            // Runs longer than `total` together are cut short (the caller's sum is theirs).
-            let Ok((mut head, rest)) = to.split_at_checked(run.len()) else {
-                return;
-            };
-            head.copy_from_slice(run);
-            to = rest;
-        }
-    };
+    let fill = |to| fill_runs(to, runs);
     match enc {
         None => {
             // `None` only where wgpu reports a validation error of its own (an error scope sees it).
@@ -253,5 +244,20 @@ pub(crate) fn write_runs<'a>(
             staging.unmap();
             enc.copy_buffer_to_buffer(&staging, 0, target, 0, total);
         }
+    }
+}
+
+/// Copy `runs`, one after the other, into `to` from its start; what does not fit is cut short (the
+/// callers size `to` to the runs together).
+pub(crate) fn fill_runs<'a>(
+    mut to: wgpu::WriteOnly<'_, [u8]>,
+    runs: impl IntoIterator<Item = &'a [u8]>,
+) {
+    for run in runs {
+        let Ok((mut head, rest)) = to.split_at_checked(run.len()) else {
+            return;
+        };
+        head.copy_from_slice(run);
+        to = rest;
     }
 }

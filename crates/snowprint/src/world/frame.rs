@@ -16,7 +16,7 @@ use super::{
     SurfaceUpdate, WorldConfig,
 };
 use crate::accumulate::{self, AccumulateBuffers};
-use crate::capture::{self, CaptureBuffers, CaptureMesh, GpuPrimitive};
+use crate::capture::{self, CaptureBuffers, CaptureMesh};
 use crate::deformer::{Deformer, Shape};
 use crate::error::{Result, SnowError};
 use crate::gpu::resources::{UNIFORM_STRIDE, write_runs};
@@ -562,13 +562,12 @@ impl SnowWorld {
         }
         if sizes.prims > 0 {
             self.prims.ensure(device, sizes.prims);
-        }
-        if sizes.prims > 0 && !plan.prims_written {
-            // Run by run from where each was planned (a split plan's parts are not appended), in
-            // one write.
-            let runs = plan.prims().map(bytemuck::cast_slice);
-            let total = std::mem::size_of::<GpuPrimitive>() * plan.prims_len();
-            write_runs((device, queue), enc, &self.prims.buffer, total as u64, runs);
+            if !plan.prims_written {
+                // Run by run from where each was planned (a split plan's parts are not
+                // appended), in one write.
+                let runs = plan.prims().map(bytemuck::cast_slice);
+                write_runs((device, queue), enc, &self.prims.buffer, sizes.prims, runs);
+            }
         }
     }
 

@@ -15,6 +15,7 @@
 
 use super::{FramePlan, Job, PlanMeshes, PlanSettings, PlanSurface};
 use crate::capture::{GpuPrimitive, MeshDraw};
+use crate::gpu::resources::fill_runs;
 use crate::mesh::MeshId;
 use crate::relax::Settle;
 use crate::world::Footstep;
@@ -250,14 +251,9 @@ impl FramePlan {
             if let Some(piece) = own_piece {
                 piece.fill(bytemuck::cast_slice(own));
             }
-            if let Some(mut out) = whole {
+            if let Some(out) = whole {
                 let runs = std::iter::once(own).chain(parts.iter().map(|p| &p.capture.prims));
-                for run in runs {
-                    let bytes: &[u8] = bytemuck::cast_slice(run);
-                    let (mut head, rest) = out.split_at(bytes.len());
-                    head.copy_from_slice(bytes);
-                    out = rest;
-                }
+                fill_runs(out, runs.map(|run| bytemuck::cast_slice(run)));
             }
         };
         let mut shift = [own.len(), self.capture.draws.len(), self.reached.len()];
