@@ -200,3 +200,74 @@ fn sweeping_sphere_is_one_capsule() {
     push_primitives(&high, &vol, &mut out);
     assert!(out.is_empty());
 }
+
+/// The update's tiles of a 64 x 64 surface of 1 m texels, worked by hand: a ball over texel (20,
+/// 20)'s centre alone reaches tile (1, 1) only; one over texel (31, 20) reaches tiles (1, 1) and
+/// (2, 1), whose blur reads texel 31 as its apron; one over the apron column 64 alone reaches tile
+/// (3, 1); one beyond the apron reaches none. Each tile is listed once, where it is first reached.
+#[test]
+fn update_tiles_are_those_whose_blur_reads_a_reached_centre() {
+    let at = |x: f32, z: f32| {
+        let c = Vec3::new(-32.0 + x + 0.5, 0.0, -32.0 + z + 0.5);
+        GpuPrimitive::capsule(c, c, 0.3)
+    };
+    let prims = [
+        at(20.0, 20.0),
+        at(31.0, 20.0),
+        at(64.0, 20.0),
+        at(66.0, 20.0),
+    ];
+    let half = glam::Vec2::splat(32.0);
+    let (mut seen, mut list) = (Vec::new(), Vec::new());
+    update_tiles_reached(&prims, (64, 64), half, 5, &mut seen, &mut list);
+    let tile = |x: u32, y: u32| (y << 16) | x;
+    assert_eq!(list, [[5, tile(1, 1)], [5, tile(2, 1)], [5, tile(3, 1)]]);
+}
+
+proptest! {
+    /// Against every texel centre a tile's blur reads, tested one by one: the update lists every
+    /// tile that reads a centre a footprint holds (the tile's texels and one around, the apron's
+    /// included), and none that reads no centre of a footprint grown by two slivers; each once.
+    #[test]
+    fn update_tiles_are_those_that_read_a_centre_a_footprint_holds(
+        caps in prop::collection::vec(
+            (prop::array::uniform3(-4.0f32..4.0), prop::array::uniform3(-4.0f32..4.0), 0.01f32..1.0),
+            1..8,
+        ),
+        (w, h) in (1u32..80, 1u32..80),
+        (hx, hz) in (0.5f32..3.0, 0.5f32..3.0),
+    ) {
+        let prims: Vec<GpuPrimitive> = caps
+            .iter()
+            .map(|&(a, b, r)| GpuPrimitive::capsule(Vec3::from(a), Vec3::from(b), r))
+            .collect();
+        let half = glam::Vec2::new(hx, hz);
+        let (mut seen, mut list) = (Vec::new(), Vec::new());
+        update_tiles_reached(&prims, (w, h), half, 3, &mut seen, &mut list);
+        let t = crate::pool::TILE_SIDE as i64;
+        let (tx, ty) = ((w as i64 + t - 1) / t, (h as i64 + t - 1) / t);
+        let texel = glam::DVec2::new(2.0 * hx as f64 / w as f64, 2.0 * hz as f64 / h as f64);
+        // Whether a footprint grown by `grow` texels holds a centre of texels `range` of a side.
+        let holds = |lo: f32, hi: f32, half: f32, t: f64, n: i64, range: std::ops::RangeInclusive<i64>, grow: f64| {
+            range.filter(|x| (-1..=n).contains(x)).any(|x| {
+                let c = -(half as f64) + (x as f64 + 0.5) * t;
+                lo as f64 - grow * t <= c && c <= hi as f64 + grow * t
+            })
+        };
+        for r in 0..ty {
+            for c in 0..tx {
+                let reads = |grow: f64| {
+                    prims.iter().any(|p| {
+                        let [x0, z0, x1, z1] = footprint(p);
+                        holds(x0, x1, hx, texel.x, w as i64, c * t - 1..=c * t + t, grow)
+                            && holds(z0, z1, hz, texel.y, h as i64, r * t - 1..=r * t + t, grow)
+                    })
+                };
+                let n = list.iter().filter(|&&e| e == [3, ((r as u32) << 16) | c as u32]).count();
+                prop_assert!(n <= 1, "tile ({}, {}) listed {} times", c, r, n);
+                prop_assert!(!reads(0.0) || n == 1, "tile ({}, {}) missed", c, r);
+                prop_assert!(reads(2.0 / 64.0) || n == 0, "tile ({}, {}) listed", c, r);
+            }
+        }
+    }
+}

@@ -71,12 +71,16 @@ pub fn tiles_reached(
     sparse
 }
 
+/// A texel's sliver of margin around a footprint, against rounding: the CPU's texel centres and
+/// the GPU's may differ in their last places, never by this much.
+const SLIVER: f32 = 1.0 / 64.0;
+
 /// Append to `list` an entry `[record, tile y << 16 | tile x]` for every 16 x 16 tile of the
-/// update of a `width` x `height` surface of half sides `half` whose blur may read a texel that a
-/// footprint of `prims` reaches: the footprint grown by two texels (the blur's one, and one of
-/// margin so that rounding never leaves out a texel the ray cast would hit), clamped to the
-/// surface. `seen` is scratch. The update ([`super::CapturePath::Update`]) tests each listed tile against
-/// the footprints again, so a tile listed in the margin costs a workgroup and changes nothing.
+/// update of a `width` x `height` surface of half sides `half` whose blur reads a texel centre that
+/// a footprint of `prims` reaches: its texels and one around them, the apron's included, against
+/// the centres of the texels a footprint covers grown by a [`SLIVER`]. `seen` is scratch. The
+/// update ([`super::CapturePath::Update`]) tests each listed tile against the footprints again,
+/// and ray-casts each texel with those that reach it.
 pub fn update_tiles_reached(
     prims: &[GpuPrimitive],
     (width, height): (u32, u32),
@@ -85,39 +89,47 @@ pub fn update_tiles_reached(
     seen: &mut Vec<bool>,
     list: &mut Vec<[u32; 2]>,
 ) {
-    let tile = crate::pool::TILE_SIDE;
-    let (tx, ty) = (width.div_ceil(tile), height.div_ceil(tile));
+    let (tx, ty) = (width.div_ceil(TILE as u32), height.div_ceil(TILE as u32));
     seen.clear();
     seen.resize((tx * ty) as usize, false);
     let texel = half * 2.0 / glam::Vec2::new(width as f32, height as f32);
-    let margin = texel * (APRON as f32 + 1.0);
-    // The surface's texel of a local coordinate, clamped to the surface (left of its first texel
-    // the quotient is negative, which the clamp takes to column 0).
-    let to_texel = |v: f32, h: f32, t: f32, n: u32| {
-        let q = (v + h) / t;
-        if q < 0.0 {
-            0
-        } else {
-            (q as u64).min(n as u64 - 1) as u32
-        }
-    };
     for p in prims {
         let [x0, z0, x1, z1] = footprint(p);
-        let (lo, hi) = (
-            glam::Vec2::new(x0, z0) - margin,
-            glam::Vec2::new(x1, z1) + margin,
-        );
-        if hi.x < -half.x || hi.y < -half.y || lo.x > half.x || lo.y > half.y {
+        let Some(columns) = tiles_read(x0, x1, (half.x, texel.x), width, tx) else {
             continue;
-        }
-        let tiles = (
-            to_texel(lo.x, half.x, texel.x, width) / tile
-                ..=to_texel(hi.x, half.x, texel.x, width) / tile,
-            to_texel(lo.y, half.y, texel.y, height) / tile
-                ..=to_texel(hi.y, half.y, texel.y, height) / tile,
-        );
-        push_unseen(record, tiles, tx, seen, list);
+        };
+        let Some(rows) = tiles_read(z0, z1, (half.y, texel.y), height, ty) else {
+            continue;
+        };
+        push_unseen(record, (columns, rows), tx, seen, list);
     }
+}
+
+/// Side of the update's tiles, texels (the shifts in `tiles_read` divide by it).
+const TILE: i64 = crate::pool::TILE_SIDE as i64;
+const _: () = assert!(TILE == 16);
+
+/// The tiles of a side of `n` texels (`tiles` tiles) whose blur reads the centre of a texel that
+/// a footprint from `lo` to `hi` (local metres; the side's half length and texel `(h, t)`)
+/// reaches: the texels from the first centre at or past `lo` to the last at or before `hi`, a
+/// [`SLIVER`] of margin, within the apron (-1 and `n`); tile `k` reads texels 16 k - 1 to
+/// 16 k + 16.
+fn tiles_read(
+    lo: f32,
+    hi: f32,
+    (h, t): (f32, f32),
+    n: u32,
+    tiles: u32,
+) -> Option<RangeInclusive<u32>> {
+    let b = n as i64 + 2;
+    // floor(v) for v clamped to [-n - 2, n + 2], without a libm call.
+    let floor = |v: f32| (v.clamp(-b as f32, b as f32) + b as f32) as i64 - b;
+    let first = (-floor(-((lo + h) / t - 0.5 - SLIVER))).max(-1);
+    let last = floor((hi + h) / t - 0.5 + SLIVER).min(n as i64);
+    // Tile k reads texel x where 16 k - 1 <= x <= 16 k + 16 (floor division by shifts).
+    let k0 = (-((-first) >> 4) - 1).max(0);
+    let k1 = ((last + 1) >> 4).min(tiles as i64 - 1);
+    (first <= last && k0 <= k1).then_some(k0 as u32..=k1 as u32)
 }
 
 /// Append `[id, tile y << 16 | tile x]` for each tile of the `(columns, rows)` ranges of a grid
