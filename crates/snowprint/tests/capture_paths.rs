@@ -13,8 +13,8 @@ use proptest::prelude::*;
 use snowprint::low_level::capture::{self, CaptureVolume};
 use snowprint::reference::capture as cap_cpu;
 use snowprint::{
-    CapturePath, Deformer, Ground, HeightGrid, Pose, Shape, SlopeRule, SnowWorld, SurfaceDesc,
-    SurfaceId, WorldConfig,
+    CapturePath, Deformer, Ground, HeightGrid, PoolFormat, Pose, Precision, Shape, SlopeRule,
+    SnowWorld, SurfaceDesc, SurfaceId, WorldConfig,
 };
 
 fn world(path: CapturePath, listed: bool) -> SnowWorld {
@@ -509,5 +509,65 @@ fn cast_and_captured_surfaces_in_one_frame_update_as_the_compute_path() {
         assert!(pressed > 0);
         assert!(worlds[1].read_last_capture(ids[0]).unwrap().is_none());
         assert!(worlds[1].read_last_capture(ids[1]).unwrap().is_some());
+    }
+}
+
+/// More cast tiles than a dispatch's row holds (65,535): 257 surfaces of 256^2 texels whose snow
+/// refills, so that the fused pass takes every tile of each (65,792 in two rows of workgroups);
+/// each pressed in its last tile, then in its first while the first print refills. Every surface's
+/// first print refilled says that every tile was updated, in either row.
+#[test]
+fn more_cast_tiles_than_a_dispatch_row_are_all_updated() {
+    let (side, n) = (256u32, 257usize);
+    let format = PoolFormat::new(Precision::Bits8);
+    let mut w = SnowWorld::new(
+        common::gpu(),
+        WorldConfig {
+            capture_path: CapturePath::Update,
+            refill_stream_from: u32::MAX,
+            format,
+            pool_bytes: format.slot_bytes(side, side) * n as u64,
+            ..WorldConfig::default()
+        },
+    )
+    .expect("world");
+    // Texels of 4 cm: `side` a side.
+    let metres = side as f32 * 0.04;
+    let x = |i: usize| i as f32 * (metres + 1.0);
+    let ids: Vec<SurfaceId> = (0..n)
+        .map(|i| {
+            let mut d = SurfaceDesc::new(&format!("s{i}"), [x(i), 0.0, 0.0], [metres; 2], 0.3);
+            d.replenish_rate = 0.5;
+            w.add_surface(d).unwrap()
+        })
+        .collect();
+    assert_eq!(w.layout(ids[0]).unwrap().width, side);
+    // A ball pressing to the ground near the (+x, +z) corner, or the (-x, -z) one.
+    let balls = |corner: f32| -> Vec<Deformer> {
+        let at = corner * (metres * 0.5 - 0.3);
+        (0..n)
+            .map(|i| {
+                Deformer::new(
+                    Shape::Sphere { radius: 0.2 },
+                    Pose::at([x(i) + at, 0.1, at]),
+                )
+            })
+            .collect()
+    };
+    w.step(0.1, &balls(1.0)).unwrap();
+    let first: Vec<Vec<u32>> = ids
+        .iter()
+        .map(|&id| w.read_channels(id).unwrap().0)
+        .collect();
+    w.step(0.1, &balls(-1.0)).unwrap();
+    for (k, &id) in ids.iter().enumerate() {
+        let after = w.read_channels(id).unwrap().0;
+        let (t, &deep) = first[k]
+            .iter()
+            .enumerate()
+            .max_by_key(|&(_, v)| *v)
+            .unwrap();
+        assert!(deep > 200, "surface {k} pressed to {deep}");
+        assert!(after[t] < deep, "surface {k}: its first print refilled");
     }
 }

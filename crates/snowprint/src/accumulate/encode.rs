@@ -2,7 +2,7 @@
 //! ([`AccumulatePlan`], built on the CPU by the world's frame plan) into one dispatch per stage.
 
 use super::{AccumulatePipelines, FUSED_WORKGROUP, REFILL_CHUNK, WORKGROUP};
-use crate::gpu::resources::bind_group;
+use crate::gpu::resources::{bind_group, dispatch_rows};
 use crate::gpu::timestamps::StageQueries;
 use crate::pool::SurfaceRecord;
 
@@ -150,9 +150,9 @@ pub fn encode_update(
             );
         }
         if plan.cast_tiles > 0 {
-            let n = plan.cast_tiles;
+            let (x, y) = dispatch_rows(plan.cast_tiles);
             pass.set_pipeline(&pipes.fused_cast);
-            pass.dispatch_workgroups(n.min(u16::MAX as u32), n.div_ceil(u16::MAX as u32), 1);
+            pass.dispatch_workgroups(x, y, 1);
         }
         if plan.listed {
             let seal_bg = bind_group(
@@ -211,11 +211,9 @@ pub fn encode_update(
 }
 
 /// Workgroups of the refill over a region of `words`: [`REFILL_CHUNK`] words each (refill.wgsl),
-/// in rows of at most 65535.
+/// in rows ([`dispatch_rows`]).
 fn refill_groups(words: u32) -> (u32, u32) {
-    let groups = words.div_ceil(REFILL_CHUNK).max(1);
-    let rows = groups.div_ceil(u16::MAX as u32);
-    (groups.div_ceil(rows), rows)
+    dispatch_rows(words.div_ceil(REFILL_CHUNK).max(1))
 }
 
 /// The normals' part of [`encode`], when the pool keeps them: normals of every record's new top.

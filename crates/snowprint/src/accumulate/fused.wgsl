@@ -70,8 +70,9 @@ fn fused_listed(
     @builtin(local_invocation_index) lid: u32,
     @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let e = list_entry(wid);
+    let e = list_entry(wid, groups);
     if !e.listed {
         return;
     }
@@ -94,8 +95,9 @@ fn fused_cast(
     @builtin(local_invocation_index) lid: u32,
     @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
 ) {
-    let e = list_entry(wid);
+    let e = list_entry(wid, groups);
     if !e.listed {
         return;
     }
@@ -115,9 +117,10 @@ struct Entry {
     tile: vec2<u32>,
 }
 
-// The entry of workgroup `wid` of a dispatch over the list (x + y * 65535).
-fn list_entry(wid: vec3<u32>) -> Entry {
-    let i = wid.x + wid.y * 65535u;
+// The entry of workgroup `wid` of a dispatch over the list of `groups.x` workgroups a row (x + y
+// * groups.x: gpu::resources::dispatch_rows, seal.wgsl).
+fn list_entry(wid: vec3<u32>, groups: vec3<u32>) -> Entry {
+    let i = wid.x + wid.y * groups.x;
     if i >= tile_list[3] {
         return Entry(false, 0u, vec2<u32>(0u));
     }

@@ -1,5 +1,6 @@
 // The indirect dispatch of `fused_listed` (fused.wgsl): one workgroup per entry of the capture's
-// tile list, in rows of 65535 (the largest dispatch along one axis).
+// tile list, in as few rows as the largest dispatch along one axis (65535) allows, as even as can
+// be (gpu::resources::dispatch_rows).
 // Reads: the list's entry count (word 3). Writes: the dispatch arguments (words 0-2).
 // Imports shared.wgsl only for PRECISION, which the update sets on every one of its passes.
 
@@ -10,7 +11,8 @@
 @compute @workgroup_size(1, 1, 1)
 fn seal_tiles() {
     let n = tile_list[3];
-    tile_list[0] = min(n, 65535u);
-    tile_list[1] = (n + 65534u) / 65535u;
+    let rows = max((n + 65534u) / 65535u, 1u);
+    tile_list[0] = (n + rows - 1u) / rows;
+    tile_list[1] = rows;
     tile_list[2] = 1u;
 }

@@ -292,9 +292,6 @@ pub fn encode(
     }
 }
 
-/// Workgroups a dispatch's x covers; y counts the groups of them.
-const ENTRIES_PER_X: u32 = 65535;
-
 /// The words that follow the view blocks in the views buffer for the compute path: the work
 /// list, then its first word and its length. Appends them to `bytes`, which holds the view blocks.
 pub fn append_work_table(plan: &CapturePlan, bytes: &mut Vec<u8>) {
@@ -346,5 +343,6 @@ fn encode_compute(
     pass.set_pipeline(&pipes.compute);
     pass.set_bind_group(0, &bg, &[]);
     let n = plan.work.len() as u32;
-    pass.dispatch_workgroups(n.min(ENTRIES_PER_X), n.div_ceil(ENTRIES_PER_X), 1);
+    let (x, y) = crate::gpu::resources::dispatch_rows(n);
+    pass.dispatch_workgroups(x, y, 1);
 }

@@ -60,13 +60,15 @@ var<workgroup> hit_count: atomic<u32>;
 @compute @workgroup_size(16, 16)
 fn capture_prims(
     @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_id) lid: vec3<u32>,
     @builtin(local_invocation_index) li: u32,
 ) {
     // Every return before the barriers depends on the workgroup alone.
     let n_words = arrayLength(&table);
     let list = table[n_words - 2u];
-    let entry = wg.x + wg.y * 65535u;
+    // Rows of `groups.x` workgroups (gpu::resources::dispatch_rows).
+    let entry = wg.x + wg.y * groups.x;
     if entry >= table[n_words - 1u] {
         return;
     }

@@ -261,3 +261,36 @@ pub(crate) fn fill_runs<'a>(
         to = rest;
     }
 }
+
+/// The most workgroups a dispatch takes along one axis (wgpu's default limit, WebGPU's).
+pub(crate) const DISPATCH_ROW_MAX: u32 = 65535;
+
+/// A dispatch of `n` workgroups, one an item, as `(x, y)`: `y` rows of `x` each, as few rows as
+/// the axis's limit allows and the rows as even as can be, so that at most `y - 1` workgroups
+/// past the items are launched (a shader takes item `id.x + id.y * num_workgroups.x` and leaves
+/// past `n`).
+pub(crate) fn dispatch_rows(n: u32) -> (u32, u32) {
+    let rows = n.div_ceil(DISPATCH_ROW_MAX).max(1);
+    (n.div_ceil(rows), rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{DISPATCH_ROW_MAX, dispatch_rows};
+
+    /// Every item has a workgroup, no row passes the limit, and at most `rows - 1` workgroups are
+    /// launched past the items.
+    #[test]
+    fn dispatch_rows_cover_the_items_with_few_to_spare() {
+        assert_eq!(dispatch_rows(0), (0, 1));
+        assert_eq!(dispatch_rows(1), (1, 1));
+        assert_eq!(dispatch_rows(65535), (65535, 1));
+        assert_eq!(dispatch_rows(65536), (32768, 2));
+        assert_eq!(dispatch_rows(81_000), (40_500, 2));
+        for n in [2, 1000, 65534, 65537, 131_070, 131_071, 200_003, 5_000_000] {
+            let (x, y) = dispatch_rows(n);
+            assert!(x <= DISPATCH_ROW_MAX && x * y >= n, "{n}: {x} x {y}");
+            assert!(x * y - n < y, "{n}: {x} x {y} launches {} past", x * y - n);
+        }
+    }
+}

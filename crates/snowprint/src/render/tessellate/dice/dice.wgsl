@@ -301,8 +301,13 @@ fn outside(to_clip: mat4x4<f32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
 }
 
 @compute @workgroup_size(64, 1, 1)
-fn dice_surface(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) wg: vec3<u32>) {
-    let index = wg.x + wg.y * 65535u;
+fn dice_surface(
+    @builtin(local_invocation_index) li: u32,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    // Rows of `groups.x` workgroups (gpu::resources::dispatch_rows).
+    let index = wg.x + wg.y * groups.x;
     if index >= dice.grid.w {
         return;
     }

@@ -267,7 +267,8 @@ impl DicePass {
         for (group, triangles) in self.bind_groups.iter().flatten() {
             p.set_bind_group(0, group, &[]);
             p.set_pipeline(&self.dice);
-            p.dispatch_workgroups((*triangles).min(65535), triangles.div_ceil(65535), 1);
+            let (x, y) = crate::gpu::resources::dispatch_rows(*triangles);
+            p.dispatch_workgroups(x, y, 1);
             p.set_pipeline(&self.seal);
             p.dispatch_workgroups(1, 1, 1);
         }
