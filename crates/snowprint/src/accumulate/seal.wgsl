@@ -1,6 +1,6 @@
 // The indirect dispatch of `fused_listed` (fused.wgsl): one workgroup per entry of the capture's
-// tile list, in as few rows as the largest dispatch along one axis (65535) allows, as even as can
-// be (gpu::resources::dispatch_rows).
+// tile list, in as few rows as the largest dispatch along one axis (DISPATCH_ROW_MAX) allows, as
+// even as can be (gpu::resources::dispatch_rows).
 // Reads: the list's entry count (word 3). Writes: the dispatch arguments (words 0-2).
 // Imports shared.wgsl only for PRECISION, which the update sets on every one of its passes.
 
@@ -11,7 +11,7 @@
 @compute @workgroup_size(1, 1, 1)
 fn seal_tiles() {
     let n = tile_list[3];
-    let rows = max((n + 65534u) / 65535u, 1u);
+    let rows = max((n + DISPATCH_ROW_MAX - 1u) / DISPATCH_ROW_MAX, 1u);
     tile_list[0] = (n + rows - 1u) / rows;
     tile_list[1] = rows;
     tile_list[2] = 1u;

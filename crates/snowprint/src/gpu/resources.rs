@@ -263,7 +263,7 @@ pub(crate) fn fill_runs<'a>(
 }
 
 /// The most workgroups a dispatch takes along one axis (wgpu's default limit, WebGPU's).
-pub(crate) const DISPATCH_ROW_MAX: u32 = 65535;
+pub(crate) const DISPATCH_ROW_MAX: u32 = crate::wgsl::consts::DISPATCH_ROW_MAX;
 
 /// A dispatch of `n` workgroups, one an item, as `(x, y)`: `y` rows of `x` each, as few rows as
 /// the axis's limit allows and the rows as even as can be, so that at most `y - 1` workgroups

@@ -340,8 +340,7 @@ impl SprayGpu {
         });
         pass.set_pipeline(&self.simulate);
         pass.set_bind_group(0, &sim_bg, &[]);
-        let groups = self.config.capacity.div_ceil(64);
-        let grid = (groups.min(65535), groups.div_ceil(65535));
+        let grid = crate::gpu::resources::dispatch_rows(self.config.capacity.div_ceil(64));
         pass.dispatch_workgroups(grid.0, grid.1, 1);
         if inputs.count == 0 {
             return;

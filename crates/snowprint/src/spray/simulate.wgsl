@@ -21,13 +21,18 @@ struct Ring {
     particles: array<Particle>,
 }
 
-fn slot_index(gid: vec3<u32>) -> u32 {
-    return gid.x + gid.y * 65535u * 64u;
+// The ring slot of invocation `gid` of a dispatch in rows of `groups.x` workgroups of 64
+// (gpu::resources::dispatch_rows).
+fn slot_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return gid.x + gid.y * groups.x * 64u;
 }
 
 @compute @workgroup_size(64, 1, 1)
-fn simulate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = slot_index(gid);
+fn simulate(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let i = slot_index(gid, groups);
     if i >= params.capacity {
         return;
     }
@@ -46,8 +51,11 @@ fn simulate(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 @compute @workgroup_size(64, 1, 1)
-fn place(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = slot_index(gid);
+fn place(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    let i = slot_index(gid, groups);
     if i >= params.capacity {
         return;
     }

@@ -18,6 +18,9 @@ const REFILL_GROUP: u32 = 256u;
 // 16-byte vectors of a heights region each invocation of the refill takes, all loaded before any
 // is stored.
 const REFILL_VECTORS: u32 = 2u;
+// The most workgroups a dispatch takes along one axis (wgpu's default limit, WebGPU's): a dispatch
+// over a list takes as few rows of them as this allows (gpu::resources::dispatch_rows, seal.wgsl).
+const DISPATCH_ROW_MAX: u32 = 65535u;
 // Words before the entries of the capture's tile list: the dispatch arguments (0-2), the count
 // (3), the first record of the fused pass's grid (TILE_LIST_GRID_FIRST), and three unused.
 const TILE_LIST_HEADER: u32 = 8u;
