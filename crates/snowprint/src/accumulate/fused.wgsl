@@ -1,7 +1,8 @@
 // Blur and merge in one pass, in place, for GPUs where a pass costs more than its memory
-// traffic. A 16x16 workgroup stages the depressions of its tile with a one-texel apron (18x18) in
-// workgroup memory, blurs each texel from there, then merges the tile's units (two texels along x
-// at 8 bits, one otherwise; 16 is even, so a unit never straddles tiles) into the heights region.
+// traffic. A workgroup (16x16 invocations; `fused_cast`'s, CAST_THREADS) stages the depressions
+// of its tile with a one-texel apron (18x18) in workgroup memory, blurs each texel from there, then
+// merges the tile's units (two texels along x at 8 bits, one otherwise; 16 is even, so a unit
+// never straddles tiles) into the heights region.
 // A texel's new value depends only on its own old value, so updating in place is safe whatever
 // order the workgroups run in.
 // Snowfall: a record marked MODE_REFILLED was refilled over its whole region by refill.wgsl
@@ -36,11 +37,19 @@ const SIDE: i32 = i32(TILE);
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
 var<workgroup> depressions: array<f32, 324>;   // DEP * DEP
 var<workgroup> blurred: array<f32, 256>;       // SIDE * SIDE
+// `fused_cast`'s workgroup: half a tile's units an invocation, so that twice as many of its
+// tiles, each waiting on a chain of dependent reads (entry, record, primitives), are resident at
+// once. Measured on the H100 (docs/PERFORMANCE.md): 128 beats 64, 96, 192 and 256.
+const CAST_THREADS: u32 = 128u;
+// The most units an invocation takes (SIDE * SIDE / CAST_THREADS).
+const UNIT_SLOTS: u32 = 2u;
+const_assert UNIT_SLOTS * CAST_THREADS == TILE * TILE;
+// cast_mask (cast.wgsl) tests a primitive an invocation.
+const_assert CAST_PRIMS_MAX <= CAST_THREADS;
 
 @compute @workgroup_size(TILE, TILE, 1)
 fn fused(
     @builtin(local_invocation_index) lid: u32,
-    @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
 ) {
     // The grid covers the records from the one the list's header names (before it: cast records
@@ -62,13 +71,12 @@ fn fused(
     if !has_capture && rep == 0u {
         return;
     }
-    update_tile(rec, wid.xy, has_capture, false, rep, lid, local.xy);
+    update_tile(rec, wid.xy, has_capture, false, rep, lid, TILE * TILE);
 }
 
 @compute @workgroup_size(TILE, TILE, 1)
 fn fused_listed(
     @builtin(local_invocation_index) lid: u32,
-    @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
@@ -83,17 +91,16 @@ fn fused_listed(
     if rep != 0u || (rec.mode & MODE_CAST) != 0u {
         return;
     }
-    update_tile(rec, e.tile, true, false, 0u, lid, local.xy);
+    update_tile(rec, e.tile, true, false, 0u, lid, TILE * TILE);
 }
 
 // The tiles of the cast records, which the plan lists first in `tile_list` (all of a record's
 // tiles where this pass refills it, else those its primitives' footprints reach, a margin
 // around), one workgroup an entry; dispatched over those entries alone, so an entry past them
 // (the capture's, of a record that is not cast) leaves at once.
-@compute @workgroup_size(TILE, TILE, 1)
+@compute @workgroup_size(CAST_THREADS, 1, 1)
 fn fused_cast(
     @builtin(local_invocation_index) lid: u32,
-    @builtin(local_invocation_id) local: vec3<u32>,
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
@@ -106,7 +113,7 @@ fn fused_cast(
         return;
     }
     // Whether anything presses the tile is known once its old texels are being loaded.
-    update_tile(rec, e.tile, true, true, replenished(rec), lid, local.xy);
+    update_tile(rec, e.tile, true, true, replenished(rec), lid, CAST_THREADS);
 }
 
 // An entry of the tile list: its record and tile, where the workgroup's index is within the
@@ -133,34 +140,36 @@ fn replenished(rec: SurfaceRecord) -> u32 {
     return select(rec.replenish_units, 0u, (rec.mode & MODE_REFILLED) != 0u);
 }
 
-// Blur and merge one tile of a surface, replenished by `rep` units, in place. A cast record's
-// (`casts`, a constant of each entry point, so that the others compile without the ray cast)
-// depressions are ray-cast from its primitives that reach the tile, and it has a capture where
-// one does. Called from uniform control flow.
+// Blur and merge one tile of a surface, replenished by `rep` units, in place, by a workgroup of
+// `threads` invocations (256 or CAST_THREADS, a constant of each entry point), invocation `lid`
+// taking the tile's units lid, lid + threads, ... A cast record's (`casts`, a constant of each
+// entry point, so that the others compile without the ray cast) depressions are ray-cast from its
+// primitives that reach the tile, and it has a capture where one does. Called from uniform
+// control flow.
 fn update_tile(
     rec: SurfaceRecord, tile_id: vec2<u32>, captured: bool, casts: bool, rep: u32, lid: u32,
-    local: vec2<u32>,
+    threads: u32,
 ) {
-    let tile = vec2<i32>(tile_id) * SIDE;
-    // Unit lid of the tile: row lid / (SIDE / per), first texel column (lid % (SIDE / per)) * per.
+    let tile = vec2<u32>(tile_id) * u32(SIDE);
     let per = unit_texels(PRECISION);
-    let row_units = u32(SIDE) / per;
-    let ux = (lid % row_units) * per;
-    let uy = lid / row_units;
-    let x = u32(tile.x) + ux;
-    let y = u32(tile.y) + uy;
-    let writes = lid < u32(SIDE * SIDE) / per && x < rec.width && y < rec.height;
-    // The unit's old texels are loaded first, so that their reads wait beside the capture's
+    // The units' old texels are loaded first, so that their reads wait beside the capture's
     // rather than after the blur.
-    var old_a = vec2<u32>(0u);
-    var old_b = vec2<u32>(0u);
-    if writes {
-        old_a = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y);
-        if per == 2u && x + 1u < rec.width {
-            old_b = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x + 1u, y);
+    var old_a: array<vec2<u32>, UNIT_SLOTS>;
+    var old_b: array<vec2<u32>, UNIT_SLOTS>;
+    for (var j = 0u; j < UNIT_SLOTS; j++) {
+        let u = unit_of(rec, tile, per, lid + j * threads);
+        old_a[j] = vec2<u32>(0u);
+        old_b[j] = vec2<u32>(0u);
+        if u.writes {
+            old_a[j] = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x, u.y);
+            if u.pair {
+                old_b[j] = pool_texel(
+                    PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x + 1u, u.y,
+                );
+            }
         }
     }
-    let dep_origin = tile - vec2<i32>(1);
+    let dep_origin = vec2<i32>(tile) - vec2<i32>(1);
     var has_capture = captured;
     var mask = 0u;
     if casts {
@@ -171,7 +180,7 @@ fn update_tile(
         }
     }
     if has_capture {
-        for (var k = i32(lid); k < DEP * DEP; k += SIDE * SIDE) {
+        for (var k = i32(lid); k < DEP * DEP; k += i32(threads)) {
             let x = dep_origin.x + k % DEP;
             let y = dep_origin.y + k / DEP;
             if casts {
@@ -183,23 +192,47 @@ fn update_tile(
     }
     workgroupBarrier();
     if has_capture {
-        // Texel (local.x, local.y) of the tile sits at (local + 1) in the depression tile.
-        let i = (i32(local.y) + 1) * DEP + i32(local.x) + 1;
-        blurred[lid] = blur_taps(
-            depressions[i - DEP - 1], depressions[i - DEP], depressions[i - DEP + 1],
-            depressions[i - 1], depressions[i], depressions[i + 1],
-            depressions[i + DEP - 1], depressions[i + DEP], depressions[i + DEP + 1],
-        );
+        for (var t = i32(lid); t < SIDE * SIDE; t += i32(threads)) {
+            // Texel (t % SIDE, t / SIDE) of the tile sits one texel in, in the depression tile.
+            let i = (t / SIDE + 1) * DEP + t % SIDE + 1;
+            blurred[t] = blur_taps(
+                depressions[i - DEP - 1], depressions[i - DEP], depressions[i - DEP + 1],
+                depressions[i - 1], depressions[i], depressions[i + 1],
+                depressions[i + DEP - 1], depressions[i + DEP], depressions[i + DEP + 1],
+            );
+        }
     }
     workgroupBarrier();
-    if !writes {
-        return;
+    for (var j = 0u; j < UNIT_SLOTS; j++) {
+        let u = unit_of(rec, tile, per, lid + j * threads);
+        if u.writes {
+            let at = (u.y - tile.y) * u32(SIDE) + u.x - tile.x;
+            let a = merge_channels(old_a[j], blurred[at], has_capture, rep);
+            var b = vec2<u32>(0u);
+            if u.pair {
+                b = merge_channels(old_b[j], blurred[at + 1u], has_capture, rep);
+            }
+            pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x, u.y, a, b);
+        }
     }
-    let a = merge_channels(old_a, blurred[uy * u32(SIDE) + ux], has_capture, rep);
-    var b = vec2<u32>(0u);
-    if per == 2u && x + 1u < rec.width {
-        b = merge_channels(old_b, blurred[uy * u32(SIDE) + ux + 1u], has_capture, rep);
-    }
-    pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, x, y, a, b);
 }
 
+// A unit of a tile: its first texel (x, y) of the surface, whether it is one to write (within
+// the tile's units and the surface) and whether it has a second texel within the surface.
+struct Unit {
+    x: u32,
+    y: u32,
+    writes: bool,
+    pair: bool,
+}
+
+// Unit `n` of the tile whose first texel is `tile`, `per` texels a unit (two texels along x at 8
+// bits, one otherwise; 16 is even, so a unit never straddles tiles): row n / (SIDE / per), first
+// column (n % (SIDE / per)) * per.
+fn unit_of(rec: SurfaceRecord, tile: vec2<u32>, per: u32, n: u32) -> Unit {
+    let row_units = u32(SIDE) / per;
+    let x = tile.x + (n % row_units) * per;
+    let y = tile.y + n / row_units;
+    let writes = n < u32(SIDE * SIDE) / per && x < rec.width && y < rec.height;
+    return Unit(x, y, writes, writes && per == 2u && x + 1u < rec.width);
+}
