@@ -1,8 +1,9 @@
 // cast.wgsl (module `update_cast`): the fused update's own ray cast, for the records marked
 // MODE_CAST (`CapturePath::Update`): no capture pass runs for them and no capture buffer holds
 // them; a tile's workgroup finds the record's primitives that reach the texels its blur reads
-// and keeps them in workgroup memory (`cast_mask`), and each texel staged for the blur ray-casts those (`cast_depression`) with the
-// capture's own functions (capture/cast.wgsl) at the same region texel centres, keeping the
+// and keeps their footprints in workgroup memory (`cast_mask`), and each texel staged for the blur
+// ray-casts those whose footprints hold its centre (`cast_depression`) with the capture's own
+// functions (capture/cast.wgsl) at the same region texel centres, keeping the
 // lowest code as the capture's atomic max does. So the depressions, and everything after them, are
 // the bits the capture's paths give (tests/capture_paths.rs).
 // The importer declares `prims: array<Primitive>` and `ground: array<vec2<f32>>` (read).
@@ -30,9 +31,10 @@ fn cast_cell(rec: SurfaceRecord, x: i32, y: i32) -> vec2<u32> {
 
 var<workgroup> cast_bits: atomic<u32>;
 var<workgroup> cast_mask_shared: u32;
-// The record's primitives and their footprints clipped to the region as the capture draws them,
-// by their index in the record, kept for the workgroup's ray casts by `cast_mask`.
-var<workgroup> cast_prims: array<Primitive, CAST_PRIMS_MAX>;
+// The record's primitives' footprints clipped to the region as the capture draws them, by their
+// index in the record, kept for the workgroup's ray casts by `cast_mask`. The primitives
+// themselves are read from `prims` where a footprint holds a texel's centre: a copy in workgroup
+// memory would hold fewer workgroups resident (docs/PERFORMANCE.md).
 var<workgroup> cast_rects: array<vec4<f32>, CAST_PRIMS_MAX>;
 
 // The record's primitives whose footprints reach the texel centres of the staging rectangle
@@ -55,7 +57,6 @@ fn cast_mask(rec: SurfaceRecord, first: vec2<i32>, side: i32, lid: u32) -> u32 {
         let f_hi = min(f.zw, reach);
         if all(f_lo <= hi) && all(f_hi >= lo) {
             atomicOr(&cast_bits, 1u << lid);
-            cast_prims[lid] = p;
             cast_rects[lid] = vec4<f32>(f_lo, f_hi);
         }
     }
@@ -82,7 +83,7 @@ fn cast_depression(rec: SurfaceRecord, mask: u32, x: i32, y: i32) -> f32 {
         if any(centre < f.xy) || any(centre > f.zw) {
             continue;
         }
-        let code = prim_code(v, cast_prims[k], cell, c);
+        let code = prim_code(v, prims[rec.prims + k], cell, c);
         if code != NO_HIT {
             best = max(best, code);
         }

@@ -1,8 +1,8 @@
 // Blur and merge in one pass, in place, for GPUs where a pass costs more than its memory
 // traffic. A workgroup (16x16 invocations; `fused_cast`'s, CAST_THREADS) stages the depressions
-// of its tile with a one-texel apron (18x18) in workgroup memory, blurs each texel from there, then
-// merges the tile's units (two texels along x at 8 bits, one otherwise; 16 is even, so a unit
-// never straddles tiles) into the heights region.
+// of its tile with a one-texel apron (18x18) in workgroup memory, then merges the tile's units
+// (two texels along x at 8 bits, one otherwise; 16 is even, so a unit never straddles tiles) into
+// the heights region, each texel blurred from there as it is merged.
 // A texel's new value depends only on its own old value, so updating in place is safe whatever
 // order the workgroups run in.
 // Snowfall: a record marked MODE_REFILLED was refilled over its whole region by refill.wgsl
@@ -36,10 +36,11 @@
 const SIDE: i32 = i32(TILE);
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
 var<workgroup> depressions: array<f32, 324>;   // DEP * DEP
-var<workgroup> blurred: array<f32, 256>;       // SIDE * SIDE
 // `fused_cast`'s workgroup: half a tile's units an invocation, so that twice as many of its
 // tiles, each waiting on a chain of dependent reads (entry, record, primitives), are resident at
-// once. Measured on the H100 (docs/PERFORMANCE.md): 128 beats 64, 96, 192 and 256.
+// once. Measured on the H100 (docs/PERFORMANCE.md): 128 beats 64, 96, 192 and 256. Its workgroup
+// memory is kept small for the same reason (the depressions, and cast.wgsl's footprints: no
+// blurred copy, no primitives).
 const CAST_THREADS: u32 = 128u;
 // The most units an invocation takes (SIDE * SIDE / CAST_THREADS).
 const UNIT_SLOTS: u32 = 2u;
@@ -152,21 +153,13 @@ fn update_tile(
 ) {
     let tile = vec2<u32>(tile_id) * u32(SIDE);
     let per = unit_texels(PRECISION);
-    // The units' old texels are loaded first, so that their reads wait beside the capture's
-    // rather than after the blur.
-    var old_a: array<vec2<u32>, UNIT_SLOTS>;
-    var old_b: array<vec2<u32>, UNIT_SLOTS>;
-    for (var j = 0u; j < UNIT_SLOTS; j++) {
-        let u = unit_of(rec, tile, per, lid + j * threads);
-        old_a[j] = vec2<u32>(0u);
-        old_b[j] = vec2<u32>(0u);
-        if u.writes {
-            old_a[j] = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x, u.y);
-            if u.pair {
-                old_b[j] = pool_texel(
-                    PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x + 1u, u.y,
-                );
-            }
+    // Where the depressions are read from a capture, the units' old texels are loaded first, so
+    // that their reads wait beside the capture's rather than after the blur. A cast reads no
+    // capture: its units are loaded after the cast, so that nothing is held through it.
+    var old: array<Old, UNIT_SLOTS>;
+    if !casts {
+        for (var j = 0u; j < UNIT_SLOTS; j++) {
+            old[j] = old_unit(rec, unit_of(rec, tile, per, lid + j * threads));
         }
     }
     let dep_origin = vec2<i32>(tile) - vec2<i32>(1);
@@ -191,30 +184,56 @@ fn update_tile(
         }
     }
     workgroupBarrier();
-    if has_capture {
-        for (var t = i32(lid); t < SIDE * SIDE; t += i32(threads)) {
-            // Texel (t % SIDE, t / SIDE) of the tile sits one texel in, in the depression tile.
-            let i = (t / SIDE + 1) * DEP + t % SIDE + 1;
-            blurred[t] = blur_taps(
-                depressions[i - DEP - 1], depressions[i - DEP], depressions[i - DEP + 1],
-                depressions[i - 1], depressions[i], depressions[i + 1],
-                depressions[i + DEP - 1], depressions[i + DEP], depressions[i + DEP + 1],
-            );
-        }
-    }
-    workgroupBarrier();
     for (var j = 0u; j < UNIT_SLOTS; j++) {
         let u = unit_of(rec, tile, per, lid + j * threads);
-        if u.writes {
-            let at = (u.y - tile.y) * u32(SIDE) + u.x - tile.x;
-            let a = merge_channels(old_a[j], blurred[at], has_capture, rep);
-            var b = vec2<u32>(0u);
-            if u.pair {
-                b = merge_channels(old_b[j], blurred[at + 1u], has_capture, rep);
-            }
-            pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x, u.y, a, b);
+        if !u.writes {
+            continue;
+        }
+        if casts {
+            old[j] = old_unit(rec, u);
+        }
+        let at = vec2<u32>(u.x, u.y) - tile;
+        let a = merge_channels(old[j].a, blurred_at(at, has_capture), has_capture, rep);
+        var b = vec2<u32>(0u);
+        if u.pair {
+            let right = blurred_at(at + vec2<u32>(1u, 0u), has_capture);
+            b = merge_channels(old[j].b, right, has_capture, rep);
+        }
+        pool_store_unit(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x, u.y, a, b);
+    }
+}
+
+// A unit's old texels: its first, and its second where it has one.
+struct Old {
+    a: vec2<u32>,
+    b: vec2<u32>,
+}
+
+// The old texels of unit `u` (zeros where it writes nothing).
+fn old_unit(rec: SurfaceRecord, u: Unit) -> Old {
+    var o = Old(vec2<u32>(0u), vec2<u32>(0u));
+    if u.writes {
+        o.a = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x, u.y);
+        if u.pair {
+            o.b = pool_texel(PRECISION, rec.heights, rec.width, rec.height, rec.wrap, u.x + 1u, u.y);
         }
     }
+    return o;
+}
+
+// The blurred depression of texel `at` of the tile, from the staged depressions (where the tile
+// has a capture; else 0, which no merge without one reads).
+fn blurred_at(at: vec2<u32>, has_capture: bool) -> f32 {
+    if !has_capture {
+        return 0.0;
+    }
+    // Texel `at` of the tile sits one texel in, in the depression tile.
+    let i = (i32(at.y) + 1) * DEP + i32(at.x) + 1;
+    return blur_taps(
+        depressions[i - DEP - 1], depressions[i - DEP], depressions[i - DEP + 1],
+        depressions[i - 1], depressions[i], depressions[i + 1],
+        depressions[i + DEP - 1], depressions[i + DEP], depressions[i + DEP + 1],
+    );
 }
 
 // A unit of a tile: its first texel (x, y) of the surface, whether it is one to write (within
