@@ -305,10 +305,11 @@ fn a_region_over_an_earlier_frames_capture_reads_none_of_it() {
 
 /// The heightmaps of every surface after each frame of a random world run with `first` and then
 /// with `second`, the update on its list of tiles or on its grid, the snowfall streamed or not, the
-/// heights stored at `precision`.
+/// heights stored at `precision`, the update's own cast in workgroups of 128 invocations (`many`)
+/// or of 256.
 fn heightmaps_of_two_paths(
     paths: [CapturePath; 2],
-    (listed, streamed): (bool, bool),
+    (listed, streamed, many): (bool, bool, bool),
     precision: Precision,
     spots: &[Spot],
     per: u32,
@@ -321,6 +322,7 @@ fn heightmaps_of_two_paths(
                 capture_path: path,
                 list_tiles_from: if listed { 0 } else { u32::MAX },
                 refill_stream_from: if streamed { 0 } else { u32::MAX },
+                cast_many_from: if many { 0 } else { u32::MAX },
                 format: PoolFormat::new(precision),
                 ..WorldConfig::default()
             },
@@ -364,7 +366,8 @@ proptest! {
     /// every frame, as the compute path's capture does, bit for bit: on hills and on flat ground,
     /// yawed, with the update on its grid (the tiles test the footprints) and on its list (the plan
     /// lists the tiles), snow refilling in the fused pass or streamed before it, at each precision
-    /// (8 bits: a workgroup's invocation takes a unit of two texels).
+    /// (8 bits: a workgroup's invocation takes a unit of two texels), the cast's workgroups of 128
+    /// invocations and of 256 each taking one precision or two.
     #[test]
     fn the_updates_own_ray_cast_gives_the_compute_paths_heights(
         spots in prop::collection::vec(
@@ -376,16 +379,23 @@ proptest! {
         seed in 0.0f32..1.0,
         listed in any::<bool>(),
         streamed in any::<bool>(),
+        flip in any::<bool>(),
     ) {
         let paths = [CapturePath::Compute, CapturePath::Update];
         let mut pressed = false;
-        for precision in [Precision::Bits8, Precision::Bits16, Precision::Bits32] {
-            let maps =
-                heightmaps_of_two_paths(paths, (listed, streamed), precision, &spots, per, seed);
+        for (i, precision) in [Precision::Bits8, Precision::Bits16, Precision::Bits32]
+            .into_iter()
+            .enumerate()
+        {
+            let many = (i % 2 == 1) != flip;
+            let ways = (listed, streamed, many);
+            let maps = heightmaps_of_two_paths(paths, ways, precision, &spots, per, seed);
             for (k, [a, b]) in maps.iter().enumerate() {
                 let diff = a.iter().zip(b).filter(|(x, y)| x != y).count();
                 let (frame, surface) = (k / spots.len(), k % spots.len());
-                prop_assert_eq!(diff, 0, "{:?}: frame {} surface {} differs", precision, frame, surface);
+                prop_assert_eq!(
+                    diff, 0, "{:?}, many {}: frame {} surface {} differs", precision, many, frame, surface
+                );
             }
             pressed |= maps.iter().any(|[a, _]| a.iter().any(|&v| v > 0));
         }

@@ -31,6 +31,9 @@ pub struct AccumulatePlan {
     /// Entries at the head of the tile list that the plan wrote, the tiles of the records the
     /// fused pass ray-casts itself: one workgroup each of its dispatch over them.
     pub cast_tiles: u32,
+    /// Whether they are many ([`crate::WorldConfig::cast_many_from`]): then each workgroup has
+    /// 128 invocations rather than 256.
+    pub cast_many: bool,
     /// Widest record, texels.
     pub max_width: u32,
     /// Tallest record, texels.
@@ -48,6 +51,7 @@ impl AccumulatePlan {
         self.listed = false;
         self.grid = 0;
         self.cast_tiles = 0;
+        self.cast_many = false;
         self.max_width = 0;
         self.max_height = 0;
     }
@@ -151,7 +155,7 @@ pub fn encode_update(
         }
         if plan.cast_tiles > 0 {
             let (x, y) = dispatch_rows(plan.cast_tiles);
-            pass.set_pipeline(&pipes.fused_cast);
+            pass.set_pipeline(pipes.fused_cast(device, plan.cast_many));
             pass.dispatch_workgroups(x, y, 1);
         }
         if plan.listed {

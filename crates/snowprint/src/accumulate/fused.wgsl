@@ -1,6 +1,6 @@
 // Blur and merge in one pass, in place, for GPUs where a pass costs more than its memory
-// traffic. A workgroup (16x16 invocations; `fused_cast`'s, CAST_THREADS) stages the depressions
-// of its tile with a one-texel apron (18x18) in workgroup memory, then merges the tile's units
+// traffic. A workgroup (16x16 invocations; `fused_cast_many`'s, CAST_THREADS) stages the
+// depressions of its tile with a one-texel apron (18x18) in workgroup memory, then merges its units
 // (two texels along x at 8 bits, one otherwise; 16 is even, so a unit never straddles tiles) into
 // the heights region, each texel blurred from there as it is merged.
 // A texel's new value depends only on its own old value, so updating in place is safe whatever
@@ -9,13 +9,13 @@
 // before this pass, so here it replenishes nothing and changes only where the capture reached
 // (deepening a refilled texel equals merging with the refill: accumulate::cpu::refill_word);
 // any other record that refills snow has every tile refilled here.
-// Three entry points share that work: `fused`, a grid over every tile of a run of records, from
-// the one the tile list's header names (a tile with nothing to deepen or refill leaves at
-// once), and `fused_listed`, one workgroup per tile in
-// the capture's tile list for the records whose every tile the grid does not take (a record
-// refilled here and not by refill.wgsl), dispatched indirectly (seal.wgsl writes the arguments).
-// A record marked MODE_CAST has no capture: `fused_cast` takes its tiles from the plan's entries at
-// the head of the tile list, and ray-casts its primitives itself (cast.wgsl).
+// Four entry points share that work: `fused`, a grid over every tile of a run of records, from
+// the one the tile list's header names (a tile with nothing to deepen or refill leaves at once),
+// and `fused_listed`, one workgroup per tile in the capture's tile list for the records whose
+// every tile the grid does not take (a record refilled here and not by refill.wgsl), dispatched
+// indirectly (seal.wgsl writes the arguments). A record marked MODE_CAST has no capture:
+// `fused_cast` or `fused_cast_many` takes its tiles from the plan's entries at the head of the
+// tile list, and ray-casts its primitives itself (cast.wgsl).
 // Reads: `records`, `tiles`, `tile_list`, `capture`, `winding`, `prims`, `ground`, each record's
 // heights in `pool`.
 // Writes: the same heights regions.
@@ -36,11 +36,11 @@
 const SIDE: i32 = i32(TILE);
 const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
 var<workgroup> depressions: array<f32, 324>;   // DEP * DEP
-// `fused_cast`'s workgroup: half a tile's units an invocation, so that twice as many of its
+// `fused_cast_many`'s workgroup: half a tile's units an invocation, so that twice as many of its
 // tiles, each waiting on a chain of dependent reads (entry, record, primitives), are resident at
-// once. Measured on the H100 (docs/PERFORMANCE.md): 128 beats 64, 96, 192 and 256. Its workgroup
-// memory is kept small for the same reason (the depressions, and cast.wgsl's footprints: no
-// blurred copy, no primitives).
+// once. Measured on the H100 (docs/PERFORMANCE.md): 128 beats 64, 96, 192 and 256 for many
+// tiles. The workgroup memory is kept small for the same reason (the depressions, and cast.wgsl's
+// footprints: no blurred copy, no primitives).
 const CAST_THREADS: u32 = 128u;
 // The most units an invocation takes (SIDE * SIDE / CAST_THREADS).
 const UNIT_SLOTS: u32 = 2u;
@@ -98,13 +98,30 @@ fn fused_listed(
 // The tiles of the cast records, which the plan lists first in `tile_list` (all of a record's
 // tiles where this pass refills it, else those its primitives' footprints reach, a margin
 // around), one workgroup an entry; dispatched over those entries alone, so an entry past them
-// (the capture's, of a record that is not cast) leaves at once.
-@compute @workgroup_size(CAST_THREADS, 1, 1)
+// (the capture's, of a record that is not cast) leaves at once. Two entry points: `fused_cast`,
+// a 16x16 workgroup a tile, for a few tiles (the whole list resident at once: each tile's chain
+// of reads is the pass's time, and more invocations a tile shorten it), and `fused_cast_many`,
+// CAST_THREADS a tile, for many (`WorldConfig::cast_narrow_from`).
+@compute @workgroup_size(TILE, TILE, 1)
 fn fused_cast(
     @builtin(local_invocation_index) lid: u32,
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
+    cast_tile(lid, wid, groups, TILE * TILE);
+}
+
+@compute @workgroup_size(CAST_THREADS, 1, 1)
+fn fused_cast_many(
+    @builtin(local_invocation_index) lid: u32,
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    cast_tile(lid, wid, groups, CAST_THREADS);
+}
+
+// The cast tile of workgroup `wid`, by a workgroup of `threads` invocations.
+fn cast_tile(lid: u32, wid: vec3<u32>, groups: vec3<u32>, threads: u32) {
     let e = list_entry(wid, groups);
     if !e.listed {
         return;
@@ -113,8 +130,7 @@ fn fused_cast(
     if (rec.mode & MODE_CAST) == 0u {
         return;
     }
-    // Whether anything presses the tile is known once its old texels are being loaded.
-    update_tile(rec, e.tile, true, true, replenished(rec), lid, CAST_THREADS);
+    update_tile(rec, e.tile, true, true, replenished(rec), lid, threads);
 }
 
 // An entry of the tile list: its record and tile, where the workgroup's index is within the

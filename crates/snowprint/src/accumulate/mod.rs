@@ -20,6 +20,8 @@ mod encode;
 
 pub use encode::{AccumulateBuffers, AccumulatePlan, encode, encode_normals, encode_update};
 
+use std::sync::OnceLock;
+
 use crate::pool::Precision;
 
 use crate::wgsl::ShaderModule;
@@ -54,8 +56,13 @@ pub struct AccumulatePipelines {
     /// Blur and merge fused, over the capture's listed tiles of the records the grid leaves.
     pub fused_listed: wgpu::ComputePipeline,
     /// The fused pass over the tiles of the records it ray-casts itself (`MODE_CAST`), which the
-    /// plan lists at the head of the tile list.
-    pub fused_cast: wgpu::ComputePipeline,
+    /// plan lists at the head of the tile list, a workgroup of 256 invocations a tile, and the same
+    /// over many tiles ([`AccumulatePlan::cast_many`]), 128 a tile: compiled when first wanted
+    /// ([`Self::fused_cast`], [`Self::compile_casts`]), as a world on another capture path never
+    /// casts.
+    fused_cast: [OnceLock<wgpu::ComputePipeline>; 2],
+    /// The heights' precision the passes were compiled for.
+    precision: Precision,
     /// Writes the listed pass's indirect dispatch.
     pub seal: wgpu::ComputePipeline,
     /// Layout of the seal's group 0: the tile list.
@@ -78,34 +85,13 @@ impl AccumulatePipelines {
         use crate::wgsl::{BLUR, FUSED, MERGE, NORMALS, REFILL, SEAL};
         let blur_layout = BLUR.bind_group_layout(device, "blur", 0);
         let merge_layout = MERGE.bind_group_layout(device, "merge", 0);
-        // One layout for the three fused entry points: the module's group 0 covers what either reads.
+        // One layout for the four fused entry points: the module's group 0 covers what either reads.
         let fused_layout = FUSED.bind_group_layout(device, "fused", 0);
         let seal_layout = SEAL.bind_group_layout(device, "seal", 0);
         let refill_layout = REFILL.bind_group_layout(device, "refill", 0);
         let normals_layout = NORMALS.bind_group_layout(device, "normals", 0);
-        let constants = [("PRECISION", precision.bits() as f64)];
         let make = |name: &str, shader: &ShaderModule, layout: &wgpu::BindGroupLayout| {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(name),
-                source: wgpu::ShaderSource::Wgsl(shader.source.into()),
-            });
-            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(name),
-                bind_group_layouts: &[Some(layout)],
-                immediate_size: 0,
-            });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(name),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    // Every pass writes its workgroup arrays before reading them.
-                    zero_initialize_workgroup_memory: false,
-                },
-                cache: None,
-            })
+            pipeline(device, name, shader, layout, precision)
         };
         Self {
             blur: make("blur", &BLUR, &blur_layout),
@@ -114,7 +100,8 @@ impl AccumulatePipelines {
             refill: make("refill", &REFILL, &refill_layout),
             fused: make("fused", &FUSED, &fused_layout),
             fused_listed: make("fused_listed", &FUSED, &fused_layout),
-            fused_cast: make("fused_cast", &FUSED, &fused_layout),
+            fused_cast: [OnceLock::new(), OnceLock::new()],
+            precision,
             seal: make("seal_tiles", &SEAL, &seal_layout),
             seal_layout,
             refill_layout,
@@ -124,6 +111,51 @@ impl AccumulatePipelines {
             fused_layout,
         }
     }
+
+    /// The fused pass's entry point over the tiles it ray-casts, for many tiles or a few
+    /// ([`AccumulatePlan::cast_many`]), compiled at its first call.
+    pub fn fused_cast(&self, device: &wgpu::Device, many: bool) -> &wgpu::ComputePipeline {
+        let name = if many {
+            "fused_cast_many"
+        } else {
+            "fused_cast"
+        };
+        self.fused_cast[usize::from(many)].get_or_init(|| {
+            pipeline(
+                device,
+                name,
+                &crate::wgsl::FUSED,
+                &self.fused_layout,
+                self.precision,
+            )
+        })
+    }
+
+    /// Compile both of the fused pass's cast entry points now, rather than at the first frame
+    /// that casts: for a world whose capture path casts ([`crate::CapturePath::Update`]).
+    pub fn compile_casts(&self, device: &wgpu::Device) {
+        for many in [false, true] {
+            self.fused_cast(device, many);
+        }
+    }
+}
+
+/// The compute pipeline of entry point `name` of `shader`, its group 0 laid out as `layout`, for
+/// heights of `precision`.
+fn pipeline(
+    device: &wgpu::Device,
+    name: &str,
+    shader: &ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+    precision: Precision,
+) -> wgpu::ComputePipeline {
+    let [p] = shader.compute_pipelines(
+        device,
+        [name],
+        layout,
+        &[("PRECISION", precision.bits() as f64)],
+    );
+    p
 }
 
 #[cfg(test)]

@@ -204,33 +204,17 @@ impl RelaxPipelines {
     pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
         let shader = &crate::wgsl::RELAX;
         let layout = shader.bind_group_layout(device, "relax", 0);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("relax"),
-            source: wgpu::ShaderSource::Wgsl(shader.source.into()),
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("relax"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         let constants = [("PRECISION", precision.bits() as f64)];
-        let make = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    zero_initialize_workgroup_memory: false,
-                },
-                cache: None,
-            })
-        };
+        let [from_pool, to_pool, copy] = shader.compute_pipelines(
+            device,
+            ["relax_from_pool", "relax_to_pool", "relax_copy"],
+            &layout,
+            &constants,
+        );
         Self {
-            from_pool: make("relax_from_pool"),
-            to_pool: make("relax_to_pool"),
-            copy: make("relax_copy"),
+            from_pool,
+            to_pool,
+            copy,
             layout,
         }
     }

@@ -246,26 +246,8 @@ impl SprayGpu {
                     layout: &wgpu::BindGroupLayout,
                     entry: &str,
                     constants: &[(&str, f64)]| {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(entry),
-                source: wgpu::ShaderSource::Wgsl(shader.source.into()),
-            });
-            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(entry),
-                bind_group_layouts: &[Some(layout)],
-                immediate_size: 0,
-            });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    zero_initialize_workgroup_memory: false,
-                },
-                cache: None,
-            })
+            let [p] = shader.compute_pipelines(device, [entry], layout, constants);
+            p
         };
         let buffer = |label: &str, size: u64, usage: U| {
             device.create_buffer(&wgpu::BufferDescriptor {

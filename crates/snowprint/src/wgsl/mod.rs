@@ -250,6 +250,41 @@ impl ShaderModule {
         self.bind_group_layout_for(device, label, group, true)
     }
 
+    /// The compute pipelines of entry points `entries`, of one module, their one bind group laid
+    /// out as `layout`, with the override `constants`, each labelled by its entry point; workgroup
+    /// memory is not zeroed (each pass writes its workgroup arrays before reading them).
+    pub(crate) fn compute_pipelines<const N: usize>(
+        &self,
+        device: &wgpu::Device,
+        entries: [&str; N],
+        layout: &wgpu::BindGroupLayout,
+        constants: &[(&str, f64)],
+    ) -> [wgpu::ComputePipeline; N] {
+        let label = entries.first().copied();
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label,
+            source: wgpu::ShaderSource::Wgsl(self.source.into()),
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label,
+            bind_group_layouts: &[Some(layout)],
+            immediate_size: 0,
+        });
+        entries.map(|entry| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    zero_initialize_workgroup_memory: false,
+                },
+                cache: None,
+            })
+        })
+    }
+
     /// The bind-group layout of group `group` on a device that filters `Rgba16Float` or not
     /// ([`Self::layout_entries_for`]), labelled `label`.
     pub(crate) fn bind_group_layout_for(

@@ -107,34 +107,18 @@ impl StripGpu {
     pub fn new(device: &wgpu::Device, precision: Precision) -> Self {
         let shader = &crate::wgsl::WINDOW_STRIP;
         let layout = shader.bind_group_layout(device, "window strip", 0);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("window strip"),
-            source: wgpu::ShaderSource::Wgsl(shader.source.into()),
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("window strip"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         let constants = [("PRECISION", precision.bits() as f64)];
-        let make = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    zero_initialize_workgroup_memory: false,
-                },
-                cache: None,
-            })
-        };
+        let [out, into, max] = shader.compute_pipelines(
+            device,
+            ["strip_out", "strip_in", "strip_max"],
+            &layout,
+            &constants,
+        );
         use wgpu::BufferUsages as U;
         Self {
-            out: make("strip_out"),
-            into: make("strip_in"),
-            max: make("strip_max"),
+            out,
+            into,
+            max,
             layout,
             params: Growable::new(
                 device,

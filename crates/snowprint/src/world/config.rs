@@ -38,6 +38,14 @@ pub struct WorldConfig {
     /// all: default 2 Mi words (8 MiB, thirty-two 512^2 surfaces at 16 bits), where the two ways
     /// cost the same on the H100 (`docs/PERFORMANCE.md`). 0 always streams; `u32::MAX` never does.
     pub refill_stream_from: u32,
+    /// With [`CapturePath::Update`], the fewest tiles (16x16 texels) the update ray-casts itself
+    /// in one frame from which each is taken by a workgroup of 128 invocations rather than 256.
+    /// Half the invocations a tile holds twice as many tiles resident at once, which pays where
+    /// the tiles wait on their reads in many waves, and lengthens each tile's own time, which is
+    /// the whole pass's where they are few: default 512, between the H100's figures at 256 tiles
+    /// (256 invocations the faster) and 1024 (128 the faster; `docs/PERFORMANCE.md`). 0 always;
+    /// `u32::MAX` never.
+    pub cast_many_from: u32,
     /// How heightmaps are stored: bits a channel, and whether normals are kept.
     pub format: PoolFormat,
     /// Which path captures analytic deformers: `Update` leaves them to the fused update, which
@@ -82,6 +90,7 @@ impl Default for WorldConfig {
             passes: PassMode::Auto,
             list_tiles_from: 16384,
             refill_stream_from: 1 << 21,
+            cast_many_from: 512,
             format: PoolFormat::default(),
             capture_path: CapturePath::Auto,
             spray: None,

@@ -261,7 +261,7 @@ impl SnowWorld {
         .then(|| TimestampRing::new(&device, &gpu.queue, "snowprint timestamps", 256));
         Ok(Self {
             capture_pipes: CapturePipelines::new(&device),
-            acc: AccumulatePipelines::new(&device, config.format.precision),
+            acc: accumulate_pipelines(&device, &config),
             relax: crate::relax::RelaxGpu::new(&device, config.format.precision),
             probes: probe::Probes::new(&device),
             records: Growable::new(
@@ -584,4 +584,15 @@ impl SnowWorld {
     pub fn capabilities(&self) -> &Capabilities {
         &self.caps
     }
+}
+
+/// The accumulation's pipelines for a world of `config` (its capture path resolved): the fused
+/// pass's cast entry points compiled up front where the update casts, so that no frame waits on
+/// them.
+fn accumulate_pipelines(device: &wgpu::Device, config: &WorldConfig) -> AccumulatePipelines {
+    let pipes = AccumulatePipelines::new(device, config.format.precision);
+    if config.capture_path == CapturePath::Update {
+        pipes.compile_casts(device);
+    }
+    pipes
 }

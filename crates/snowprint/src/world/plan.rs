@@ -54,6 +54,8 @@ pub struct PlanSettings {
     pub list_tiles_from: u32,
     /// See [`WorldConfig::refill_stream_from`].
     pub refill_stream_from: u32,
+    /// See [`WorldConfig::cast_many_from`].
+    pub cast_many_from: u32,
     /// Largest side of the capture atlas, texels.
     pub atlas_side: u32,
     /// Which path captures analytic deformers.
@@ -71,6 +73,7 @@ impl PlanSettings {
             passes: config.passes,
             list_tiles_from: config.list_tiles_from,
             refill_stream_from: config.refill_stream_from,
+            cast_many_from: config.cast_many_from,
             atlas_side: config.atlas_side,
             capture_path: config.capture_path,
             spray: config.spray.is_some(),
@@ -709,6 +712,7 @@ impl FramePlan {
             });
         }
         a.cast_tiles = c.listed.len() as u32;
+        a.cast_many = a.cast_tiles >= settings.cast_many_from;
         c.plan_clears();
         if self.jobs.is_empty() {
             return;

@@ -465,3 +465,31 @@ fn slumping_materials_relax_while_they_settle() {
     let plan = FramePlan::build(&settings(), surfaces, no_meshes);
     assert!(plan.is_empty() && plan.relax.is_empty());
 }
+
+/// The update's own cast takes workgroups of 128 invocations from `cast_many_from` of its tiles
+/// in a frame, and of 256 below.
+#[test]
+fn the_cast_is_narrowed_from_its_many_tiles() {
+    let descs = [still("a", 0.0), still("b", 10.0)];
+    let deformers = vec![
+        vec![sphere_at([0.5, 0.1, 0.5]), sphere_at([-1.0, 0.1, -1.0])],
+        vec![sphere_at([10.0, 0.1, 1.0])],
+    ];
+    let plan_from = |from: u32| {
+        let mut s = settings();
+        s.capture_path = capture::CapturePath::Update;
+        s.cast_many_from = from;
+        FramePlan::build(&s, inputs(&descs, &deformers, 0.1), no_meshes).accumulate
+    };
+    let tiles = plan_from(u32::MAX).cast_tiles;
+    assert!(tiles >= 3, "three spheres reach {tiles} tiles");
+    for (from, many) in [
+        (0, true),
+        (tiles, true),
+        (tiles + 1, false),
+        (u32::MAX, false),
+    ] {
+        let a = plan_from(from);
+        assert_eq!((a.cast_tiles, a.cast_many), (tiles, many), "from {from}");
+    }
+}
