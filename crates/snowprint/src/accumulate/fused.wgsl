@@ -38,9 +38,10 @@ const DEP: i32 = 18;    // SIDE + 1 texel of apron on each side
 var<workgroup> depressions: array<f32, 324>;   // DEP * DEP
 // `fused_cast_many`'s workgroup: half a tile's units an invocation, so that twice as many of its
 // tiles, each waiting on a chain of dependent reads (entry, record, primitives), are resident at
-// once. Measured on the H100 (docs/PERFORMANCE.md): 128 beats 64, 96, 192 and 256 for many
-// tiles. The workgroup memory is kept small for the same reason (the depressions, and cast.wgsl's
-// footprints: no blurred copy, no primitives).
+// once. Measured on the H100 against 64, 96, 192 and 256 (docs/PERFORMANCE.md): 64 is faster
+// only from about 20,000 tiles (a frame of 1024 surfaces of 128^2), slower below. The workgroup
+// memory is kept small for the same reason (the depressions, and cast.wgsl's footprints: no
+// blurred copy, no primitives).
 const CAST_THREADS: u32 = 128u;
 // The most units an invocation takes (SIDE * SIDE / CAST_THREADS).
 const UNIT_SLOTS: u32 = 2u;
@@ -101,7 +102,7 @@ fn fused_listed(
 // (the capture's, of a record that is not cast) leaves at once. Two entry points: `fused_cast`,
 // a 16x16 workgroup a tile, for a few tiles (the whole list resident at once: each tile's chain
 // of reads is the pass's time, and more invocations a tile shorten it), and `fused_cast_many`,
-// CAST_THREADS a tile, for many (`WorldConfig::cast_narrow_from`).
+// CAST_THREADS a tile, for many (`WorldConfig::cast_many_from`).
 @compute @workgroup_size(TILE, TILE, 1)
 fn fused_cast(
     @builtin(local_invocation_index) lid: u32,

@@ -587,11 +587,11 @@ impl SnowWorld {
 }
 
 /// The accumulation's pipelines for a world of `config` (its capture path resolved): the fused
-/// pass's cast entry points compiled up front where the update casts, so that no frame waits on
+/// pass's cast entry points compiled up front where the plan casts, so that no frame waits on
 /// them.
 fn accumulate_pipelines(device: &wgpu::Device, config: &WorldConfig) -> AccumulatePipelines {
     let pipes = AccumulatePipelines::new(device, config.format.precision);
-    if config.capture_path == CapturePath::Update {
+    if plan::PlanSettings::of(config).casts() {
         pipes.compile_casts(device);
     }
     pipes

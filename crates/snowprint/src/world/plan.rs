@@ -83,6 +83,12 @@ impl PlanSettings {
     fn fused(&self) -> bool {
         self.passes != PassMode::Separate
     }
+
+    /// Whether the update ray-casts a surface's analytic primitives itself (`Way::Cast`) where it
+    /// has few enough: the world asks for it, the update is fused and no spray reads the capture.
+    pub(crate) fn casts(&self) -> bool {
+        self.capture_path == capture::CapturePath::Update && self.fused() && !self.spray
+    }
 }
 
 /// What a plan knows of the world's meshes.

@@ -82,11 +82,7 @@ pub(super) fn way(settings: &PlanSettings, prims: u32, meshes: bool) -> Way {
     {
         return Way::Raster;
     }
-    if settings.capture_path == CapturePath::Update
-        && settings.fused()
-        && !settings.spray
-        && prims <= capture::CAST_PRIMS_MAX
-    {
+    if settings.casts() && prims <= capture::CAST_PRIMS_MAX {
         return Way::Cast;
     }
     Way::Compute
